@@ -1,0 +1,104 @@
+// draglab/drag_db/database.h: the SQLite drag-law database.
+//
+// Holds every law version with its provenance (law.h: LawRecord). Published versions are
+// immutable, enforced by SQL triggers as well as here: any change is a new version. Retracted
+// versions stay loadable with a warning. The file is opened in WAL mode so readers keep working
+// while a writer commits; every write is one transaction (nothing is ever half-written).
+//
+// References: "name" or "name@latest" (latest published version), "name@3" (version 3),
+// "name@<hex>" (the version whose content hash starts with <hex>, at least 4 digits).
+//
+// Schema: a schema_version table and forward migrations (docs/database.md). A file written by
+// a newer draglab (higher schema version) is refused with Error(kSchemaTooNew).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "draglab/drag_db/law.h"
+
+struct sqlite3;
+
+namespace draglab {
+
+/// Options for Database::open.
+struct DatabaseOptions {
+  bool create_if_missing = true;  ///< Create (and seed) a new file if none exists.
+  bool seed_literature = true;    ///< Seed the literature library into a newly created file.
+  bool read_only = false;         ///< Open read-only (no migration, no seeding).
+  bool migrate = true;            ///< Apply forward migrations to an older schema on open.
+  int busy_timeout_ms = 5000;     ///< How long a writer waits for a lock before failing.
+  bool IsValid(std::string* error) const;
+};
+
+/// Result of Database::check().
+struct DatabaseCheckReport {
+  bool ok = true;
+  int schema_version = 0;
+  int laws_checked = 0;
+  std::vector<std::string> problems;  ///< One line per problem (integrity, hash mismatch, ...).
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+/// An open draglab database. Not thread-safe: use one Database per thread (Law objects loaded
+/// from it are thread-safe and independent of it).
+class Database {
+ public:
+  /// The schema version this build writes.
+  static int current_schema_version();
+  /// Default path: $DRAGLAB_DB if set and non-empty, else "./draglab.db".
+  static std::string default_path();
+
+  /// Opens (creating, migrating and seeding as the options say). Throws Error: kNotADatabase for
+  /// a corrupt or non-SQLite file, kSchemaTooNew for a newer schema, kDatabase for I/O errors.
+  explicit Database(const std::string& path, const DatabaseOptions& options = DatabaseOptions());
+  ~Database();
+  Database(const Database&) = delete;
+  Database& operator=(const Database&) = delete;
+
+  const std::string& path() const { return path_; }
+  int schema_version() const;
+  /// Applies forward migrations up to `target` (default: current); returns the versions applied.
+  std::vector<int> migrate(int target = -1);
+
+  /// All versions of all laws (or of `name`), ordered by name then version.
+  std::vector<LawRecord> list(const std::string& name = "", bool include_drafts = true) const;
+  /// Resolves a reference (see file comment); throws Error(kNotFound) with a helpful message.
+  LawRecord resolve(const std::string& reference) const;
+  /// Resolves and binds to the registered form. A retracted version loads with `*warning` set
+  /// (if given); a draft loads with a warning too.
+  std::shared_ptr<Law> load(const std::string& reference, RangePolicy policy = RangePolicy::kError,
+                            std::string* warning = nullptr) const;
+
+  /// Stores a new draft version of record.name (version = last + 1), validating the form,
+  /// parameters and validity box and computing the content hash. Returns the stored record.
+  LawRecord add_draft(LawRecord record);
+  /// Replaces the parameters/covariance/notes of a draft (published versions: kImmutable).
+  LawRecord update_draft(const LawRecord& record);
+  /// Draft -> published (immutable from now on).
+  LawRecord publish(const std::string& name, int version);
+  /// Convenience: add_draft + publish in one transaction.
+  LawRecord add_published(LawRecord record);
+  /// Published -> retracted, with a reason (kept loadable, with a warning).
+  LawRecord retract(const std::string& name, int version, const std::string& reason);
+  /// Deletes a draft (published or retracted versions cannot be deleted: kImmutable).
+  void delete_draft(const std::string& name, int version);
+
+  /// Seeds the literature library (one published version 1 per registered literature form that
+  /// is not yet present). Returns the number of laws added.
+  int seed_literature();
+
+  /// SQLite integrity check, schema version, recomputed content hashes, known forms.
+  DatabaseCheckReport check() const;
+
+  /// The raw handle, for modules that add their own tables through migrations.
+  sqlite3* handle() const { return db_; }
+
+ private:
+  std::string path_;
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace draglab

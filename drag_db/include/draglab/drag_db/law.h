@@ -1,0 +1,138 @@
+// draglab/drag_db/law.h: a law version (record) and the loaded, immutable evaluator (Law).
+//
+// A LawRecord is what the database stores for `name@version`: the form key, the parameter values,
+// the native convention, the validity box, the provenance and the content hash.
+// A Law is a LawRecord bound to its registered form: load it once, then evaluate it from any
+// number of threads without touching the database.
+//
+// Units: F, K, beta d^2/mu, C_d are dimensionless; beta() takes SI inputs and returns
+// kg m^-3 s^-1. Conventions (which F, which Re, which velocity): conventions.h.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "draglab/drag_db/conventions.h"
+#include "draglab/drag_db/law_form.h"
+
+namespace draglab {
+
+/// Life cycle of a law version. Published and retracted versions are immutable.
+enum class LawStatus { kDraft, kPublished, kRetracted };
+const char* to_string(LawStatus s);
+LawStatus law_status_from_string(const std::string& s);
+
+/// A parameter value of a law version.
+struct LawParameter {
+  std::string name;
+  double value = 0.0;
+  std::string unit = "1";
+};
+
+/// Where a law version comes from.
+struct Provenance {
+  std::string kind = "literature";  ///< "literature", "fitted" or "manual".
+  std::string citation;             ///< Literature reference (literature laws).
+  std::string dataset_id;           ///< Fitted laws: the dataset the fit used.
+  std::string data_hash;            ///< Fitted laws: hash of the data points.
+  std::string fitter_settings;      ///< Fitted laws: the fitter's options, JSON text.
+  std::string code_version;         ///< draglab version (git describe) that wrote the record.
+};
+
+/// One stored law version. Content hash: SHA-256 over form, parameters, convention and validity
+/// (content_hash_of); name, version, status, provenance and notes are not part of it.
+struct LawRecord {
+  std::string name;
+  int version = 0;
+  std::string form;
+  std::vector<LawParameter> parameters;
+  std::vector<double> covariance;  ///< Row-major n x n (n = parameters.size()) or empty.
+  NativeConvention convention;
+  ValidityBox validity;
+  Provenance provenance;
+  std::string content_hash;  ///< 64 hex digits.
+  LawStatus status = LawStatus::kDraft;
+  std::string created_at;  ///< ISO 8601 UTC.
+  std::string notes;
+  std::string retraction_reason;  ///< Set when status == kRetracted.
+
+  /// "name@version".
+  std::string reference() const { return name + "@" + std::to_string(version); }
+  std::vector<double> parameter_values() const;
+};
+
+/// SHA-256 (hex) of the canonical JSON of form, parameters (name, value as %.17g, unit),
+/// convention and validity box.
+std::string content_hash_of(const LawRecord& record);
+
+/// A record for `form` with its published default parameters, convention and validity box
+/// (name = form key, provenance = the form's citation). Version and status are left to the caller.
+LawRecord literature_record(const LawForm& form);
+
+/// What to do with inputs outside the law's validity box (inputs that are physically impossible,
+/// such as eps outside (0, 1], Re < 0, NaN or inf, are always an error).
+enum class RangePolicy {
+  kError,        ///< Throw / return an error status (default).
+  kClamp,        ///< Clamp phi, Re and extra inputs into the box and count the event.
+  kExtrapolate,  ///< Evaluate the formula as is and count the event.
+};
+const char* to_string(RangePolicy p);
+RangePolicy range_policy_from_string(const std::string& s);
+
+/// A loaded law version: immutable formula and parameters, thread-safe evaluation.
+/// The range policy and the out-of-range counter are atomics; set the policy before sharing.
+class Law {
+ public:
+  /// Binds `record` to its registered form; throws Error(kNotFound) for an unknown form and
+  /// Error(kInvalidArgument) if the parameters do not match the form's.
+  explicit Law(LawRecord record, RangePolicy policy = RangePolicy::kError);
+  Law(const Law&) = delete;
+  Law& operator=(const Law&) = delete;
+
+  const LawRecord& record() const { return record_; }
+  const LawForm& form() const { return *form_; }
+  std::string reference() const { return record_.reference(); }
+  int num_extra_inputs() const { return form_->num_extra_inputs; }
+
+  void set_range_policy(RangePolicy p) { policy_.store(p); }
+  RangePolicy range_policy() const { return policy_.load(); }
+  /// Evaluations outside the validity box that were clamped or extrapolated since load.
+  std::uint64_t out_of_range_count() const { return out_of_range_.load(); }
+
+  /// Canonical drag-only F(phi, Re). `extra` holds num_extra_inputs() values (polydisperse
+  /// forms: y_i = d_i/<d>), or may be null for forms without extra inputs.
+  double F(double phi, double re, const double* extra = nullptr) const;
+  /// Array path: out[i] = F(phi[i], re[i], extra + i*num_extra_inputs()). On error nothing
+  /// beyond the checked prefix is meaningful and an Error names the first bad index.
+  void F(std::size_t n, const double* phi, const double* re, double* out,
+         const double* extra = nullptr) const;
+  /// beta d^2/mu = 18 phi (1-phi) F.
+  double beta_d2_over_mu(double phi, double re, const double* extra = nullptr) const;
+  /// K = F/(1-phi), the total force including the mean pressure gradient part.
+  double K(double phi, double re, const double* extra = nullptr) const;
+  /// C_d Re_p = 24 eps F (interstitial Re_p = Re/eps), finite at Re = 0.
+  double drag_coefficient_times_re_p(double phi, double re, const double* extra = nullptr) const;
+  /// C_d with the interstitial slip in the dynamic pressure; Re must be > 0.
+  double drag_coefficient(double phi, double re, const double* extra = nullptr) const;
+  /// Friction coefficient beta [kg m^-3 s^-1] from dimensional inputs (argument order of MFiX's
+  /// usr_drag): gas fraction eps_g, gas viscosity mu_g [Pa s], gas density rho_g [kg/m^3],
+  /// interstitial slip |u_g - u_s| [m/s], particle diameter d_p [m].
+  double beta(double eps_g, double mu_g, double rho_g, double slip, double d_p,
+              const double* extra = nullptr) const;
+
+ private:
+  /// Validates (phi, re, extra) and applies the range policy; returns the values to evaluate.
+  void prepare(double& phi, double& re, double* extra_out, const double* extra_in,
+               std::size_t index, bool array) const;
+
+  LawRecord record_;
+  const LawForm* form_;
+  std::vector<double> params_;
+  mutable std::atomic<RangePolicy> policy_;
+  mutable std::atomic<std::uint64_t> out_of_range_{0};
+};
+
+}  // namespace draglab
