@@ -58,8 +58,9 @@ DRAGLAB_EXPORT const char* draglab_version(void);
 DRAGLAB_EXPORT int draglab_db_open(const char* path, draglab_db** db);
 DRAGLAB_EXPORT void draglab_db_close(draglab_db* db);
 
-/* Loads "name", "name@3", "name@latest" or "name@<hash prefix>". A retracted version loads with
- * status 0 and a warning in draglab_last_error(). */
+/* Loads "name", "name@3", "name@latest" or "name@<hash prefix>". A retracted (or draft) version
+ * loads with status 0 and a warning in draglab_last_error(); any other successful load sets
+ * draglab_last_error() to "". */
 DRAGLAB_EXPORT int draglab_law_load(draglab_db* db, const char* ref, draglab_law** law);
 DRAGLAB_EXPORT void draglab_law_free(draglab_law* law);
 
@@ -71,8 +72,14 @@ DRAGLAB_EXPORT const char* draglab_law_hash(const draglab_law* law);
 /* Number of extra inputs (polydisperse forms: 1, the size ratio y = d_i/<d>; else 0). */
 DRAGLAB_EXPORT int draglab_law_num_extra(const draglab_law* law);
 
+/* Validity box of the law: phi in [phi_min, phi_max], Re in [re_min, re_max] (a bound may be
+ * +-HUGE_VAL where the law is unbounded on that side). */
+DRAGLAB_EXPORT int draglab_law_validity(const draglab_law* law, double* phi_min, double* phi_max,
+                                        double* re_min, double* re_max);
+
 /* Range policy (DRAGLAB_RANGE_*); set it before sharing the law between threads. */
 DRAGLAB_EXPORT int draglab_law_set_range_policy(draglab_law* law, int policy);
+DRAGLAB_EXPORT int draglab_law_range_policy(const draglab_law* law, int* policy);
 /* Number of clamped/extrapolated evaluations since load. */
 DRAGLAB_EXPORT int draglab_law_out_of_range_count(const draglab_law* law, long long* count);
 
@@ -81,7 +88,9 @@ DRAGLAB_EXPORT int draglab_law_F(const draglab_law* law, double phi, double re, 
 /* Same with extra inputs (num_extra values). */
 DRAGLAB_EXPORT int draglab_law_F_extra(const draglab_law* law, double phi, double re,
                                        const double* extra, double* F);
-/* Array path: F[i] = F(phi[i], re[i]). */
+/* Array path: F[i] = F(phi[i], re[i]). n = 0 is a no-op (the pointers may then be NULL). On error
+ * the message names the first bad index and the contents of F are unspecified (the arrays are
+ * evaluated in blocks; no copy of the output is made). */
 DRAGLAB_EXPORT int draglab_law_F_n(const draglab_law* law, size_t n, const double* phi,
                                    const double* re, double* F);
 /* beta d^2/mu = 18 phi (1-phi) F and K = F/(1-phi) (total force incl. mean pressure part). */
@@ -94,6 +103,27 @@ DRAGLAB_EXPORT int draglab_law_K(const draglab_law* law, double phi, double re, 
 DRAGLAB_EXPORT int draglab_law_beta(const draglab_law* law, double eps_g, double mu_g,
                                     double rho_g, double slip, double d_p, double rho_s,
                                     double* beta);
+
+/* MFiX's DRAG_USR output lDgA = beta / phi = 18 mu_g eps_g F / d_p^2 [kg m^-3 s^-1], the model-A
+ * coefficient per unit solids fraction (MFiX multiplies it by EP_SM, EP_SM/EPg for model B, or
+ * by the particle volume in DES). Same arguments and checks as draglab_law_beta; finite at
+ * eps_g = 1. */
+DRAGLAB_EXPORT int draglab_law_dga(const draglab_law* law, double eps_g, double mu_g,
+                                   double rho_g, double slip, double d_p, double rho_s,
+                                   double* dga);
+/* Array path of draglab_law_beta over cells or particles: beta[i] from eps_g[i], mu_g[i],
+ * rho_g[i], slip[i], d_p[i] (SI units). On error the message names the first bad index and the
+ * contents of beta are unspecified. */
+DRAGLAB_EXPORT int draglab_law_beta_n(const draglab_law* law, size_t n, const double* eps_g,
+                                      const double* mu_g, const double* rho_g,
+                                      const double* slip, const double* d_p, double* beta);
+
+/* Standalone source of the loaded law version, as `draglab law export`: format "c", "fortran" or
+ * "json". Writes at most `size` bytes including the terminating NUL into `buffer` and the full
+ * length (without NUL) into *length. Query the length with buffer = NULL, size = 0 (status 0);
+ * a non-NULL buffer that is too small gives DRAGLAB_INVALID_ARGUMENT (with *length set). */
+DRAGLAB_EXPORT int draglab_law_export(const draglab_law* law, const char* format, char* buffer,
+                                      size_t size, size_t* length);
 
 /* Message of the last failing call on this thread ("" if none). */
 DRAGLAB_EXPORT const char* draglab_last_error(void);

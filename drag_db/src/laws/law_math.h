@@ -36,6 +36,14 @@ inline T pow_nonneg(const T& x, double p) {
   return select(x > 0.0, pow(x, p), T(0.0));
 }
 
+/// sqrt(x) for x >= 0 that is exactly 0 at x = 0 with a zero derivative. Plain sqrt has the
+/// derivative 1/(2 sqrt x) = inf there, which turns even an unseeded input into 0 * inf = NaN in
+/// automatic derivatives (e.g. the parameter gradient of a law fitted to Re = 0 data).
+template <typename T>
+inline T sqrt_nonneg(const T& x) {
+  return select(x > 0.0, sqrt(x), T(0.0));
+}
+
 /// x ln x, continuously extended by 0 at x = 0 (Hill-Koch-Ladd's (135/64) phi ln phi).
 template <typename T>
 inline T x_log_x(const T& x) {
@@ -53,6 +61,15 @@ inline T schiller_naumann_cd_re(const T& re) {
 template <typename T>
 inline T dalla_valle_cd_re(const T& re) {
   const T s = sqrt(re) * 0.63 + 4.8;
+  return s * s;
+}
+
+/// Dalla Valle C_d * Re_p as dalla_valle_cd_re, written with sqrt_nonneg so that automatic
+/// derivatives stay finite at Re = 0 (same values for double; the Re-derivative there is reported
+/// as 0 instead of the true +inf of the sqrt(Re) term).
+template <typename T>
+inline T dalla_valle_cd_re_nonneg(const T& re) {
+  const T s = sqrt_nonneg(re) * 0.63 + 4.8;
   return s * s;
 }
 

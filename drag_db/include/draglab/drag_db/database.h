@@ -42,6 +42,17 @@ struct DatabaseCheckReport {
   std::string FullReport() const;
 };
 
+/// One entry of the append-only history of a law version (schema version 2, table law_events).
+/// Written by SQL triggers, so changes made outside draglab (sqlite3 shell) are recorded too.
+struct LawEvent {
+  std::string name;
+  int version = 0;
+  std::string event;         ///< "created", "updated", "published", "retracted" or "deleted".
+  std::string at;            ///< ISO 8601 UTC, second resolution.
+  std::string content_hash;  ///< Content hash of the version after the event.
+  std::string detail;        ///< Retraction reason, or what an update changed.
+};
+
 /// An open draglab database. Not thread-safe: use one Database per thread (Law objects loaded
 /// from it are thread-safe and independent of it).
 class Database {
@@ -76,6 +87,8 @@ class Database {
   /// parameters and validity box and computing the content hash. Returns the stored record.
   LawRecord add_draft(LawRecord record);
   /// Replaces the parameters/covariance/notes of a draft (published versions: kImmutable).
+  /// Also taken from `record`: validity box and provenance; name, version, form, convention,
+  /// status and created_at stay as stored. The content hash is recomputed.
   LawRecord update_draft(const LawRecord& record);
   /// Draft -> published (immutable from now on).
   LawRecord publish(const std::string& name, int version);
@@ -92,6 +105,11 @@ class Database {
 
   /// SQLite integrity check, schema version, recomputed content hashes, known forms.
   DatabaseCheckReport check() const;
+
+  /// History of law `name` (all its versions, or only `version` if > 0), oldest first.
+  /// Needs schema version 2 or later. An unknown name gives an empty list (deleted drafts keep
+  /// their history).
+  std::vector<LawEvent> history(const std::string& name, int version = 0) const;
 
   /// The raw handle, for modules that add their own tables through migrations.
   sqlite3* handle() const { return db_; }

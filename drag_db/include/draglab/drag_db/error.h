@@ -31,7 +31,7 @@ class Error : public std::runtime_error {
   /// True for errors caused by the caller's input (CLI exit code 2).
   bool is_bad_input() const noexcept {
     return code_ == ErrorCode::kInvalidArgument || code_ == ErrorCode::kOutOfValidity ||
-           code_ == ErrorCode::kNotFound;
+           code_ == ErrorCode::kNotFound || code_ == ErrorCode::kNotADatabase;
   }
 
  private:

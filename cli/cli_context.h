@@ -1,0 +1,60 @@
+// Shared state and helpers of the draglab command line (cli/).
+//
+// Output discipline: results go to stdout (a table, or JSON with --json), messages to stderr.
+// Exit codes: 0 success, 1 failure, 2 bad input (draglab::Error::is_bad_input(), UsageError,
+// or a command-line parse error).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "draglab/drag_db/database.h"
+
+namespace draglab {
+namespace cli {
+
+/// Bad command-line input detected after parsing (exit code 2).
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Options shared by every command, and the command chosen by the parser.
+struct CliContext {
+  std::string db_path;  ///< --db, else $DRAGLAB_DB, else ./draglab.db.
+  bool json = false;    ///< --json: machine-readable results on stdout.
+  bool quiet = false;   ///< --quiet: no informational messages on stderr.
+  /// The action of the selected subcommand (set by its parse callback, run by main()).
+  std::function<void()> action;
+
+  std::string resolved_db_path() const {
+    return db_path.empty() ? Database::default_path() : db_path;
+  }
+  /// Opens the database (creating and seeding it on first use unless read_only).
+  std::unique_ptr<Database> open_database(bool read_only = false) const;
+  /// Informational message on stderr (suppressed by --quiet).
+  void info(const std::string& message) const;
+  /// Warning on stderr (always shown).
+  void warn(const std::string& message) const;
+  /// Prints JSON on stdout (indent 2).
+  void print_json(const nlohmann::json& j) const;
+};
+
+/// Registers `draglab law ...` (law_commands.cc).
+void add_law_commands(CLI::App& app, CliContext& ctx);
+/// Registers `draglab db ...` (db_commands.cc).
+void add_db_commands(CLI::App& app, CliContext& ctx);
+
+/// Parses "a,b,c" into doubles; throws UsageError naming `field`.
+std::vector<double> parse_double_list(const std::string& text, const std::string& field);
+/// Formats a double with `digits` significant digits.
+std::string format_number(double x, int digits = 6);
+
+}  // namespace cli
+}  // namespace draglab

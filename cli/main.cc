@@ -1,0 +1,119 @@
+// draglab: command line of the drag-law toolkit.
+//
+// Sample runs:
+//   draglab law list
+//   draglab law eval bvk2007 --phi 0.3 --re 50
+//   draglab law eval tang2015@1 --grid --json
+//   draglab law diff bvk2007 tang2015
+//   draglab law export bvk2007@1 --format fortran -o bvk2007.f90
+//   draglab law compare
+//   draglab db info --db my.db
+#include <cstdio>
+#include <iostream>
+
+#include <fmt/core.h>
+
+#include "cli/cli_context.h"
+#include "draglab/drag_db/error.h"
+#include "drag_db_version.h"
+
+namespace draglab {
+namespace cli {
+
+std::unique_ptr<Database> CliContext::open_database(bool read_only) const {
+  DatabaseOptions options;
+  options.read_only = read_only;
+  options.create_if_missing = !read_only;
+  return std::make_unique<Database>(resolved_db_path(), options);
+}
+
+void CliContext::info(const std::string& message) const {
+  if (!quiet) std::cerr << message << '\n';
+}
+
+void CliContext::warn(const std::string& message) const {
+  std::cerr << "warning: " << message << '\n';
+}
+
+void CliContext::print_json(const nlohmann::json& j) const { std::cout << j.dump(2) << '\n'; }
+
+std::vector<double> parse_double_list(const std::string& text, const std::string& field) {
+  std::vector<double> values;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(item, &used);
+      if (used != item.size()) throw std::invalid_argument(item);
+      values.push_back(v);
+    } catch (const std::exception&) {
+      throw UsageError(field + ": '" + item + "' is not a number (expected e.g. 0.1,0.2,0.3)");
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return values;
+}
+
+std::string format_number(double x, int digits) { return fmt::format("{:.{}g}", x, digits); }
+
+}  // namespace cli
+}  // namespace draglab
+
+int main(int argc, char** argv) {
+  using draglab::cli::CliContext;
+  CliContext ctx;
+  CLI::App app{
+      "draglab: drag closures for dense gas-solid fluidized beds.\n"
+      "Versioned drag laws (SQLite) with provenance, evaluated in the canonical convention\n"
+      "F = F_d/(3 pi mu d eps u) (drag only), Re = rho eps d u/mu, beta d^2/mu = 18 phi eps F.",
+      "draglab"};
+  app.set_version_flag("--version", std::string("draglab ") + draglab::kDragDbVersion);
+  app.fallthrough();  // global options (--db, --json, --quiet) are accepted after subcommands
+  app.add_option("--db", ctx.db_path,
+                 "Database file (default: $DRAGLAB_DB, else ./draglab.db; created and seeded "
+                 "with the literature library on first use)");
+  app.add_flag("--json", ctx.json, "Machine-readable JSON results on stdout");
+  app.add_flag("-q,--quiet", ctx.quiet, "No informational messages on stderr");
+  app.require_subcommand(1);
+  app.footer(
+      "Examples:\n"
+      "  draglab law list\n"
+      "  draglab law eval bvk2007 --phi 0.3 --re 50\n"
+      "  draglab law compare\n"
+      "  draglab db info\n"
+      "Exit codes: 0 success, 1 failure, 2 bad input.");
+
+  draglab::cli::add_law_commands(app, ctx);
+  draglab::cli::add_db_commands(app, ctx);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);  // prints the message and the usage hint
+    return 2;
+  }
+
+  try {
+    if (ctx.action) ctx.action();
+    return 0;
+  } catch (const draglab::cli::UsageError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const draglab::Error& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return e.is_bad_input() ? 2 : 1;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 1;
+  }
+}

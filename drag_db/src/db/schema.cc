@@ -1,0 +1,319 @@
+// Forward migrations of the draglab database (schema.h, docs/database.md).
+//
+// Immutability is enforced by triggers so that it holds for every client, the sqlite3 shell
+// included. SQLite 3.40's RAISE() accepts only a literal message, which cannot name the law; the
+// guards that must name it instead evaluate json_extract('{}', <message>): a JSON path that does
+// not start with '$' is always an error, and SQLite quotes the path (our message) in the error
+// text, so the statement is aborted with e.g.
+//   JSON path error near 'draglab: law bvk2007@1 is published and immutable; ...'
+// Like RAISE(ABORT), any error inside a trigger undoes the whole statement.
+#include "db/schema.h"
+
+#include "db/sqlite_util.h"
+
+namespace draglab {
+namespace db {
+namespace {
+
+// Aborts the running statement with a message naming law `id_expr` (an SQL expression for
+// laws.id). Only used where the WHEN clause has established that the law row exists.
+std::string abort_naming_law(const std::string& id_expr, const std::string& what) {
+  return "SELECT json_extract('{}', (SELECT 'draglab: law ' || name || '@' || version || ' is ' "
+         "|| status || ' and immutable (" +
+         what + "); " + kImmutableMarker + "' FROM laws WHERE id = " + id_expr + "));\n";
+}
+
+// The three guards of a child table of laws (rows keyed by law_id): no insert, update or
+// delete of rows that belong to a published or retracted version.
+std::string child_table_guards(const std::string& table) {
+  const std::string status_of = "(SELECT status FROM laws WHERE id = ";
+  std::string sql;
+  sql += "CREATE TRIGGER " + table + "_immutable_insert BEFORE INSERT ON " + table + "\nWHEN " +
+         status_of + "NEW.law_id) <> 'draft'\nBEGIN\n  " +
+         abort_naming_law("NEW.law_id", "INSERT INTO " + table) + "END;\n";
+  sql +=
+      "CREATE TRIGGER " + table + "_immutable_update BEFORE UPDATE ON " + table + "\nWHEN " +
+      status_of + "OLD.law_id) <> 'draft' OR " + status_of + "NEW.law_id) <> 'draft'\nBEGIN\n  " +
+      abort_naming_law(
+          "CASE WHEN " + status_of + "OLD.law_id) <> 'draft' THEN OLD.law_id ELSE NEW.law_id END",
+          "UPDATE " + table) +
+      "END;\n";
+  sql += "CREATE TRIGGER " + table + "_immutable_delete BEFORE DELETE ON " + table + "\nWHEN " +
+         status_of + "OLD.law_id) <> 'draft'\nBEGIN\n  " +
+         abort_naming_law("OLD.law_id", "DELETE FROM " + table) + "END;\n";
+  return sql;
+}
+
+// Version 1: law versions with parameters, covariance and extra inputs; immutability triggers.
+std::string migration_1() {
+  std::string sql = R"sql(
+CREATE TABLE schema_version (
+  version      INTEGER PRIMARY KEY,
+  description  TEXT NOT NULL,
+  applied_at   TEXT NOT NULL,            -- ISO 8601 UTC
+  code_version TEXT NOT NULL             -- draglab version that applied the migration
+);
+
+CREATE TABLE laws (
+  id                INTEGER PRIMARY KEY,
+  name              TEXT NOT NULL CHECK (length(name) BETWEEN 1 AND 100 AND instr(name, '@') = 0),
+  version           INTEGER NOT NULL CHECK (version >= 1),
+  form              TEXT NOT NULL,       -- registered law form key
+  -- native convention (conventions.h string forms)
+  force_kind        TEXT NOT NULL,
+  normalisation     TEXT NOT NULL,
+  reynolds          TEXT NOT NULL,
+  tfm_model         TEXT NOT NULL,
+  -- validity box (extra inputs: law_extra_inputs)
+  phi_min           REAL NOT NULL,
+  phi_max           REAL NOT NULL,
+  re_min            REAL NOT NULL,
+  re_max            REAL NOT NULL,
+  -- provenance
+  provenance_kind   TEXT NOT NULL,       -- literature / fitted / manual
+  citation          TEXT NOT NULL DEFAULT '',
+  dataset_id        TEXT NOT NULL DEFAULT '',
+  data_hash         TEXT NOT NULL DEFAULT '',
+  fitter_settings   TEXT NOT NULL DEFAULT '',
+  code_version      TEXT NOT NULL DEFAULT '',
+  content_hash      TEXT NOT NULL CHECK (length(content_hash) = 64),
+  status            TEXT NOT NULL DEFAULT 'draft'
+                    CHECK (status IN ('draft', 'published', 'retracted')),
+  created_at        TEXT NOT NULL,
+  published_at      TEXT,
+  retracted_at      TEXT,
+  retraction_reason TEXT NOT NULL DEFAULT '',
+  notes             TEXT NOT NULL DEFAULT '',
+  UNIQUE (name, version),
+  CHECK (phi_min <= phi_max AND re_min <= re_max)
+);
+
+CREATE TABLE law_parameters (
+  law_id   INTEGER NOT NULL REFERENCES laws(id) ON DELETE CASCADE,
+  position INTEGER NOT NULL CHECK (position >= 0),   -- order of the form's parameters
+  name     TEXT NOT NULL,
+  value    REAL NOT NULL,
+  unit     TEXT NOT NULL,
+  PRIMARY KEY (law_id, position),
+  UNIQUE (law_id, name)
+) WITHOUT ROWID;
+
+CREATE TABLE law_covariance (
+  law_id    INTEGER NOT NULL REFERENCES laws(id) ON DELETE CASCADE,
+  row_index INTEGER NOT NULL CHECK (row_index >= 0),
+  col_index INTEGER NOT NULL CHECK (col_index >= 0),
+  value     REAL NOT NULL,
+  PRIMARY KEY (law_id, row_index, col_index)
+) WITHOUT ROWID;
+
+CREATE TABLE law_extra_inputs (
+  law_id      INTEGER NOT NULL REFERENCES laws(id) ON DELETE CASCADE,
+  position    INTEGER NOT NULL CHECK (position >= 0),
+  name        TEXT NOT NULL,
+  description TEXT NOT NULL DEFAULT '',
+  min_value   REAL NOT NULL,
+  max_value   REAL NOT NULL CHECK (min_value <= max_value),
+  PRIMARY KEY (law_id, position)
+) WITHOUT ROWID;
+
+-- A version is inserted as a draft and published once its parameter rows are stored (the
+-- parameter guards below refuse rows of published versions).
+CREATE TRIGGER laws_insert_as_draft BEFORE INSERT ON laws
+WHEN NEW.status <> 'draft'
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: a law version is inserted as a draft and published after its parameters are stored');
+END;
+
+-- Drafts are deleted, not retracted: only published versions can be retracted.
+CREATE TRIGGER laws_retract_only_published BEFORE UPDATE OF status ON laws
+WHEN OLD.status = 'draft' AND NEW.status = 'retracted'
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: only published law versions can be retracted; delete a draft instead');
+END;
+
+-- A retraction is shown to everyone who loads the version: it must say why.
+CREATE TRIGGER laws_retract_needs_reason BEFORE UPDATE OF status ON laws
+WHEN OLD.status = 'published' AND NEW.status = 'retracted' AND trim(NEW.retraction_reason) = ''
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: a retraction needs a reason (set retraction_reason)');
+END;
+
+-- Published and retracted versions never change, except published -> retracted with the
+-- retraction time and reason (every other column must stay as it is).
+CREATE TRIGGER laws_immutable_update BEFORE UPDATE ON laws
+WHEN OLD.status <> 'draft' AND NOT (
+  OLD.status = 'published' AND NEW.status = 'retracted'
+  AND NEW.id IS OLD.id AND NEW.name IS OLD.name AND NEW.version IS OLD.version
+  AND NEW.form IS OLD.form
+  AND NEW.force_kind IS OLD.force_kind AND NEW.normalisation IS OLD.normalisation
+  AND NEW.reynolds IS OLD.reynolds AND NEW.tfm_model IS OLD.tfm_model
+  AND NEW.phi_min IS OLD.phi_min AND NEW.phi_max IS OLD.phi_max
+  AND NEW.re_min IS OLD.re_min AND NEW.re_max IS OLD.re_max
+  AND NEW.provenance_kind IS OLD.provenance_kind AND NEW.citation IS OLD.citation
+  AND NEW.dataset_id IS OLD.dataset_id AND NEW.data_hash IS OLD.data_hash
+  AND NEW.fitter_settings IS OLD.fitter_settings AND NEW.code_version IS OLD.code_version
+  AND NEW.content_hash IS OLD.content_hash AND NEW.created_at IS OLD.created_at
+  AND NEW.published_at IS OLD.published_at AND NEW.notes IS OLD.notes)
+BEGIN
+)sql";
+  sql += "  " + abort_naming_law("OLD.id", "UPDATE laws") + "END;\n";
+  sql += R"sql(
+CREATE TRIGGER laws_immutable_delete BEFORE DELETE ON laws
+WHEN OLD.status <> 'draft'
+BEGIN
+)sql";
+  sql += "  " + abort_naming_law("OLD.id", "DELETE FROM laws; retract it") + "END;\n";
+  sql += child_table_guards("law_parameters");
+  sql += child_table_guards("law_covariance");
+  sql += child_table_guards("law_extra_inputs");
+  return sql;
+}
+
+// Version 2: an append-only history of every law version (created, updated, published,
+// retracted, deleted), written by triggers so that it also records changes made outside draglab.
+std::string migration_2() {
+  return R"sql(
+CREATE TABLE law_events (
+  id           INTEGER PRIMARY KEY,
+  name         TEXT NOT NULL,
+  version      INTEGER NOT NULL,
+  event        TEXT NOT NULL
+               CHECK (event IN ('created', 'updated', 'published', 'retracted', 'deleted')),
+  at           TEXT NOT NULL,                -- ISO 8601 UTC
+  content_hash TEXT NOT NULL,
+  detail       TEXT NOT NULL DEFAULT ''      -- retraction reason, what changed
+);
+CREATE INDEX law_events_by_law ON law_events (name, version, id);
+
+-- Backfill from the laws already stored (their times are known from the laws table).
+INSERT INTO law_events (name, version, event, at, content_hash, detail)
+  SELECT name, version, 'created', created_at, content_hash, 'recorded by migration 2'
+  FROM laws ORDER BY id;
+INSERT INTO law_events (name, version, event, at, content_hash, detail)
+  SELECT name, version, 'published', published_at, content_hash, 'recorded by migration 2'
+  FROM laws WHERE published_at IS NOT NULL ORDER BY id;
+INSERT INTO law_events (name, version, event, at, content_hash, detail)
+  SELECT name, version, 'retracted', coalesce(retracted_at, published_at, created_at),
+         content_hash, retraction_reason
+  FROM laws WHERE status = 'retracted' ORDER BY id;
+
+CREATE TRIGGER law_events_on_insert AFTER INSERT ON laws
+BEGIN
+  INSERT INTO law_events (name, version, event, at, content_hash)
+  VALUES (NEW.name, NEW.version, 'created', NEW.created_at, NEW.content_hash);
+END;
+
+CREATE TRIGGER law_events_on_draft_update AFTER UPDATE ON laws
+WHEN OLD.status = 'draft' AND NEW.status = 'draft'
+BEGIN
+  INSERT INTO law_events (name, version, event, at, content_hash, detail)
+  VALUES (NEW.name, NEW.version, 'updated', strftime('%Y-%m-%dT%H:%M:%SZ', 'now'),
+          NEW.content_hash,
+          CASE WHEN NEW.content_hash IS OLD.content_hash THEN 'metadata changed'
+               ELSE 'content changed (was ' || OLD.content_hash || ')' END);
+END;
+
+CREATE TRIGGER law_events_on_publish AFTER UPDATE OF status ON laws
+WHEN OLD.status = 'draft' AND NEW.status = 'published'
+BEGIN
+  INSERT INTO law_events (name, version, event, at, content_hash)
+  VALUES (NEW.name, NEW.version, 'published',
+          coalesce(NEW.published_at, strftime('%Y-%m-%dT%H:%M:%SZ', 'now')), NEW.content_hash);
+END;
+
+CREATE TRIGGER law_events_on_retract AFTER UPDATE OF status ON laws
+WHEN OLD.status = 'published' AND NEW.status = 'retracted'
+BEGIN
+  INSERT INTO law_events (name, version, event, at, content_hash, detail)
+  VALUES (NEW.name, NEW.version, 'retracted',
+          coalesce(NEW.retracted_at, strftime('%Y-%m-%dT%H:%M:%SZ', 'now')), NEW.content_hash,
+          NEW.retraction_reason);
+END;
+
+CREATE TRIGGER law_events_on_delete AFTER DELETE ON laws
+BEGIN
+  INSERT INTO law_events (name, version, event, at, content_hash)
+  VALUES (OLD.name, OLD.version, 'deleted', strftime('%Y-%m-%dT%H:%M:%SZ', 'now'),
+          OLD.content_hash);
+END;
+
+CREATE TRIGGER law_events_append_only_update BEFORE UPDATE ON law_events
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: law_events is an append-only history and cannot be changed');
+END;
+
+CREATE TRIGGER law_events_append_only_delete BEFORE DELETE ON law_events
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: law_events is an append-only history and cannot be changed');
+END;
+)sql";
+}
+
+}  // namespace
+
+const std::vector<Migration>& migrations() {
+  static const std::vector<Migration> all = {
+      {1, "law versions, parameters, covariance, extra inputs; immutability triggers",
+       migration_1()},
+      {2, "law_events: append-only history of every law version", migration_2()},
+  };
+  return all;
+}
+
+int latest_schema_version() { return migrations().back().version; }
+
+int read_schema_version(sqlite3* db) {
+  Statement has_table(db,
+                      "SELECT count(*) FROM sqlite_schema WHERE type = 'table' AND "
+                      "name = 'schema_version'");
+  has_table.step();
+  if (has_table.integer(0) == 0) return 0;
+  Statement max_version(db, "SELECT coalesce(MAX(version), 0) FROM schema_version");
+  max_version.step();
+  return static_cast<int>(max_version.integer(0));
+}
+
+std::vector<int> apply_migrations(sqlite3* db, int from, int to, const std::string& code_version) {
+  std::vector<int> applied;
+  for (const Migration& m : migrations()) {
+    if (m.version <= from || m.version > to) continue;
+    exec(db, m.sql, "applying schema migration " + std::to_string(m.version));
+    if (m.version == 1) {
+      exec(db, "PRAGMA application_id = " + std::to_string(kApplicationId),
+           "marking the file as a draglab database");
+    }
+    Statement record(db,
+                     "INSERT INTO schema_version (version, description, applied_at, code_version) "
+                     "VALUES (?1, ?2, ?3, ?4)");
+    record.bind(1, m.version).bind(2, m.description).bind(3, utc_now_iso8601());
+    record.bind(4, code_version);
+    record.run();
+    applied.push_back(m.version);
+  }
+  return applied;
+}
+
+std::vector<std::string> expected_triggers(int schema_version) {
+  std::vector<std::string> names;
+  if (schema_version >= 1) {
+    names = {"laws_insert_as_draft", "laws_retract_only_published", "laws_retract_needs_reason",
+             "laws_immutable_update", "laws_immutable_delete"};
+    for (const char* table : {"law_parameters", "law_covariance", "law_extra_inputs"}) {
+      for (const char* op : {"insert", "update", "delete"}) {
+        names.push_back(std::string(table) + "_immutable_" + op);
+      }
+    }
+  }
+  if (schema_version >= 2) {
+    for (const char* name :
+         {"law_events_on_insert", "law_events_on_draft_update", "law_events_on_publish",
+          "law_events_on_retract", "law_events_on_delete", "law_events_append_only_update",
+          "law_events_append_only_delete"}) {
+      names.push_back(name);
+    }
+  }
+  return names;
+}
+
+}  // namespace db
+}  // namespace draglab

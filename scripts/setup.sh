@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages draglab needs (only those missing), then configures and builds
+# draglab in Release into build/. Idempotent; non-interactive; works as root, uses sudo otherwise.
+#
+#   scripts/setup.sh            # install what is missing, configure, build
+#   scripts/setup.sh --no-build # install only
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="${DRAGLAB_BUILD_DIR:-$here/build}"
+
+# Why each package is here: see README.md, section "Dependencies".
+packages=(
+  cmake g++ make pkg-config         # build
+  gfortran                          # Fortran module and its test program
+  libsqlite3-dev sqlite3            # law database (sqlite3 shell: immutability tests)
+  libssl-dev                        # SHA-256 content hashes (OpenSSL libcrypto)
+  nlohmann-json3-dev                # JSON output and records
+  libceres-dev libeigen3-dev        # automatic derivatives (Jet), fitting
+  libcli11-dev libfmt-dev           # command line
+  libgtest-dev                      # test suite
+  python3                           # Python bindings test (Debian's /usr/bin/python3)
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]})); then
+  echo "setup: installing missing Debian packages: ${missing[*]}" >&2
+  if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+[ "${1:-}" = "--no-build" ] && exit 0
+
+jobs="$(nproc 2>/dev/null || echo 2)"
+cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build_dir" -j "$jobs"

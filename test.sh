@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Set-up if needed, build (Release), then the whole test suite with ctest.
+#   ./test.sh                      # everything CI runs
+#   ./test.sh -L validation        # extra ctest arguments are passed through
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+"$here/scripts/setup.sh"
+jobs="$(nproc 2>/dev/null || echo 2)"
+ctest --test-dir "${DRAGLAB_BUILD_DIR:-$here/build}" --output-on-failure -j "$jobs" "$@"

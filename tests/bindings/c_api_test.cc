@@ -1,0 +1,380 @@
+// The C ABI (draglab.h) seen from a C++ caller: statuses, messages, null pointers, range
+// policies, the array paths, the dimensional entry points and thread-local errors.
+//
+// Set-up: a fresh database in a temporary folder, seeded with the literature library; the law
+// under test is bvk2007@1 (Beetstra, van der Hoef & Kuipers 2007, AIChE J. 53:489).
+// Reference values: F(0.1, 0) = 2.42878 and F(0.4, 100) = 30.7416, the BVK 2007 formula
+// evaluated independently from the published coefficients (reference dossier drag_laws.md
+// section 2.4 and its law_check_values.csv, 6 significant figures). Identities between F, K,
+// beta and lDgA are the canonical conversions of the brief (beta = 18 mu phi eps F / d^2,
+// K = F/(1 - phi), lDgA = beta/phi).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "draglab/draglab.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Sentinel written into outputs before a failing call: it must survive the call.
+constexpr double kUntouched = -12345.0;
+
+// The published check values have 6 significant figures: 1e-5 relative covers their rounding
+// (at most 5e-6 relative for 2.42878) with margin.
+constexpr double kCheckValueTolerance = 1e-5;
+// Identities evaluated in a different order of operations: a few rounding errors of ~1e-16.
+constexpr double kRoundingTolerance = 1e-13;
+
+fs::path fresh_dir() {
+  static std::atomic<int> counter{0};
+  std::random_device rd;
+  fs::path dir = fs::temp_directory_path() /
+                 ("draglab_c_api_" + std::to_string(rd()) + "_" + std::to_string(counter++));
+  fs::create_directories(dir);
+  return dir;
+}
+
+class CApi : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fresh_dir();
+    ASSERT_EQ(draglab_db_open((dir_ / "test.db").string().c_str(), &db_), DRAGLAB_OK)
+        << draglab_last_error();
+    ASSERT_EQ(draglab_law_load(db_, "bvk2007@1", &law_), DRAGLAB_OK) << draglab_last_error();
+  }
+  void TearDown() override {
+    draglab_law_free(law_);
+    draglab_db_close(db_);
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  double F(double phi, double re) {
+    double value = kUntouched;
+    EXPECT_EQ(draglab_law_F(law_, phi, re, &value), DRAGLAB_OK) << draglab_last_error();
+    return value;
+  }
+
+  fs::path dir_;
+  draglab_db* db_ = nullptr;
+  draglab_law* law_ = nullptr;
+};
+
+TEST(CApiLibrary, VersionIsNotEmpty) {
+  ASSERT_NE(draglab_version(), nullptr);
+  EXPECT_GT(std::string(draglab_version()).size(), 0u);
+}
+
+TEST_F(CApi, IdentityOfTheLoadedLaw) {
+  EXPECT_STREQ(draglab_law_name(law_), "bvk2007");
+  EXPECT_EQ(draglab_law_version(law_), 1);
+  EXPECT_STREQ(draglab_law_form(law_), "bvk2007");
+  const std::string hash = draglab_law_hash(law_);
+  EXPECT_EQ(hash.size(), 64u);
+  EXPECT_EQ(hash.find_first_not_of("0123456789abcdef"), std::string::npos);
+  EXPECT_EQ(draglab_law_num_extra(law_), 0);
+  // A clean load leaves no message behind (a retracted one would leave a warning).
+  EXPECT_STREQ(draglab_last_error(), "");
+  double phi_min, phi_max, re_min, re_max;
+  ASSERT_EQ(draglab_law_validity(law_, &phi_min, &phi_max, &re_min, &re_max), DRAGLAB_OK);
+  EXPECT_LT(phi_min, phi_max);
+  EXPECT_LE(re_min, re_max);
+}
+
+TEST_F(CApi, PublishedCheckValues) {
+  EXPECT_NEAR(F(0.1, 0.0), 2.42878, kCheckValueTolerance * 2.42878);
+  EXPECT_NEAR(F(0.4, 100.0), 30.7416, kCheckValueTolerance * 30.7416);
+}
+
+TEST_F(CApi, LoadingTheSameLawByHashPrefixGivesTheSameValues) {
+  const std::string ref = "bvk2007@" + std::string(draglab_law_hash(law_)).substr(0, 8);
+  draglab_law* again = nullptr;
+  ASSERT_EQ(draglab_law_load(db_, ref.c_str(), &again), DRAGLAB_OK) << draglab_last_error();
+  double a = 0, b = 0;
+  ASSERT_EQ(draglab_law_F(again, 0.35, 42.0, &a), DRAGLAB_OK);
+  ASSERT_EQ(draglab_law_F(law_, 0.35, 42.0, &b), DRAGLAB_OK);
+  EXPECT_EQ(a, b);
+  draglab_law_free(again);
+}
+
+TEST_F(CApi, PhysicallyImpossibleInputsAreErrorsNeverNaN) {
+  struct Case {
+    double phi, re;
+    const char* names;  // what the message must mention
+  };
+  const Case cases[] = {{1.2, 10.0, "phi"},  {1.0, 10.0, "phi"}, {-0.1, 10.0, "phi"},
+                        {kNaN, 10.0, "phi"}, {kInf, 10.0, "phi"}, {0.3, -1.0, "Re"},
+                        {0.3, kNaN, "Re"},   {0.3, kInf, "Re"}};
+  for (const Case& c : cases) {
+    double value = kUntouched;
+    EXPECT_EQ(draglab_law_F(law_, c.phi, c.re, &value), DRAGLAB_INVALID_ARGUMENT)
+        << "phi=" << c.phi << " re=" << c.re;
+    EXPECT_EQ(value, kUntouched);
+    EXPECT_NE(std::string(draglab_last_error()).find(c.names), std::string::npos)
+        << draglab_last_error();
+  }
+  // Every policy refuses them: they are not "outside the validity box", they are impossible.
+  ASSERT_EQ(draglab_law_set_range_policy(law_, DRAGLAB_RANGE_EXTRAPOLATE), DRAGLAB_OK);
+  double value = kUntouched;
+  EXPECT_EQ(draglab_law_F(law_, 1.2, 10.0, &value), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_F(law_, 0.3, kNaN, &value), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(value, kUntouched);
+}
+
+TEST_F(CApi, RangePolicies) {
+  // phi = 0.05 is physical but below the validity box of bvk2007 (phi >= 0.1).
+  double value = kUntouched;
+  EXPECT_EQ(draglab_law_F(law_, 0.05, 10.0, &value), DRAGLAB_OUT_OF_VALIDITY);
+  EXPECT_EQ(value, kUntouched);
+  EXPECT_NE(std::string(draglab_last_error()).find("validity"), std::string::npos);
+  long long count = -1;
+  ASSERT_EQ(draglab_law_out_of_range_count(law_, &count), DRAGLAB_OK);
+  EXPECT_EQ(count, 0);
+
+  int policy = -1;
+  ASSERT_EQ(draglab_law_set_range_policy(law_, DRAGLAB_RANGE_CLAMP), DRAGLAB_OK);
+  ASSERT_EQ(draglab_law_range_policy(law_, &policy), DRAGLAB_OK);
+  EXPECT_EQ(policy, DRAGLAB_RANGE_CLAMP);
+  ASSERT_EQ(draglab_law_F(law_, 0.05, 10.0, &value), DRAGLAB_OK);
+  double phi_min, phi_max, re_min, re_max;
+  ASSERT_EQ(draglab_law_validity(law_, &phi_min, &phi_max, &re_min, &re_max), DRAGLAB_OK);
+  EXPECT_EQ(value, F(phi_min, 10.0));  // clamped onto the edge of the box
+  ASSERT_EQ(draglab_law_out_of_range_count(law_, &count), DRAGLAB_OK);
+  EXPECT_EQ(count, 1);
+
+  ASSERT_EQ(draglab_law_set_range_policy(law_, DRAGLAB_RANGE_EXTRAPOLATE), DRAGLAB_OK);
+  double extrapolated = kUntouched;
+  ASSERT_EQ(draglab_law_F(law_, 0.05, 10.0, &extrapolated), DRAGLAB_OK);
+  EXPECT_TRUE(std::isfinite(extrapolated));
+  EXPECT_LT(extrapolated, value);  // F increases with phi: the formula itself, not the edge
+  ASSERT_EQ(draglab_law_out_of_range_count(law_, &count), DRAGLAB_OK);
+  EXPECT_EQ(count, 2);
+
+  EXPECT_EQ(draglab_law_set_range_policy(law_, 7), DRAGLAB_INVALID_ARGUMENT);
+  ASSERT_EQ(draglab_law_range_policy(law_, &policy), DRAGLAB_OK);
+  EXPECT_EQ(policy, DRAGLAB_RANGE_EXTRAPOLATE);  // unchanged by the refused call
+}
+
+TEST_F(CApi, NullPointersAreInvalidArguments) {
+  double value = kUntouched;
+  EXPECT_EQ(draglab_law_F(nullptr, 0.3, 1.0, &value), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_F(law_, 0.3, 1.0, nullptr), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_K(law_, 0.3, 1.0, nullptr), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_beta(nullptr, 0.6, 1.8e-5, 1.2, 0.5, 5e-4, 2500.0, &value),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_beta(law_, 0.6, 1.8e-5, 1.2, 0.5, 5e-4, 2500.0, nullptr),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_F_n(law_, 3, nullptr, nullptr, nullptr), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_F_extra(law_, 0.3, 1.0, nullptr, nullptr), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_out_of_range_count(law_, nullptr), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_set_range_policy(nullptr, 0), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_version(nullptr), -1);
+  EXPECT_EQ(draglab_law_num_extra(nullptr), -1);
+  EXPECT_STREQ(draglab_law_name(nullptr), "");
+  EXPECT_EQ(value, kUntouched);
+
+  draglab_law* law = nullptr;
+  EXPECT_EQ(draglab_law_load(nullptr, "bvk2007", &law), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_load(db_, nullptr, &law), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_load(db_, "bvk2007", nullptr), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(law, nullptr);
+  EXPECT_EQ(draglab_db_open("x.db", nullptr), DRAGLAB_INVALID_ARGUMENT);
+  // Freeing or closing NULL is a no-op, as free(NULL).
+  draglab_law_free(nullptr);
+  draglab_db_close(nullptr);
+}
+
+TEST_F(CApi, UnknownLawsAreNotFound) {
+  draglab_law* law = nullptr;
+  EXPECT_EQ(draglab_law_load(db_, "no_such_law", &law), DRAGLAB_NOT_FOUND);
+  EXPECT_NE(std::string(draglab_last_error()).find("no_such_law"), std::string::npos);
+  EXPECT_EQ(draglab_law_load(db_, "bvk2007@999", &law), DRAGLAB_NOT_FOUND);
+  EXPECT_EQ(law, nullptr);
+}
+
+TEST(CApiDatabase, ACorruptFileIsNotADatabase) {
+  const fs::path dir = fresh_dir();
+  const fs::path path = dir / "garbage.db";
+  {
+    std::ofstream out(path, std::ios::binary);
+    for (int i = 0; i < 4096; ++i) out.put(static_cast<char>(i * 37 + 11));
+  }
+  draglab_db* db = nullptr;
+  EXPECT_EQ(draglab_db_open(path.string().c_str(), &db), DRAGLAB_NOT_A_DATABASE);
+  EXPECT_EQ(db, nullptr);
+  EXPECT_GT(std::string(draglab_last_error()).size(), 0u);
+  fs::remove_all(dir);
+}
+
+TEST_F(CApi, LawOutlivesItsDatabase) {
+  const double before = F(0.3, 20.0);
+  draglab_db_close(db_);
+  db_ = nullptr;
+  EXPECT_EQ(F(0.3, 20.0), before);
+}
+
+TEST_F(CApi, ArrayPathEqualsScalarPath) {
+  const std::vector<double> phi = {0.1, 0.2, 0.3, 0.45, 0.6, 0.33};
+  const std::vector<double> re = {0.0, 1.0, 10.0, 100.0, 1000.0, 0.5};
+  std::vector<double> out(phi.size(), kUntouched);
+  ASSERT_EQ(draglab_law_F_n(law_, phi.size(), phi.data(), re.data(), out.data()), DRAGLAB_OK)
+      << draglab_last_error();
+  for (std::size_t i = 0; i < phi.size(); ++i) EXPECT_EQ(out[i], F(phi[i], re[i])) << i;
+  // n = 0 is a no-op even with NULL arrays.
+  EXPECT_EQ(draglab_law_F_n(law_, 0, nullptr, nullptr, nullptr), DRAGLAB_OK);
+  // A bad element: the error names its index.
+  std::vector<double> bad_re = re;
+  bad_re[2] = kNaN;
+  EXPECT_EQ(draglab_law_F_n(law_, phi.size(), phi.data(), bad_re.data(), out.data()),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(draglab_last_error()).find("index 2"), std::string::npos)
+      << draglab_last_error();
+}
+
+TEST_F(CApi, ConversionsOfF) {
+  const double phi = 0.4, re = 100.0;
+  const double f = F(phi, re);
+  double K = 0, b = 0;
+  ASSERT_EQ(draglab_law_K(law_, phi, re, &K), DRAGLAB_OK);
+  EXPECT_NEAR(K, f / (1.0 - phi), kRoundingTolerance * K);
+  ASSERT_EQ(draglab_law_beta_d2_over_mu(law_, phi, re, &b), DRAGLAB_OK);
+  EXPECT_NEAR(b, 18.0 * phi * (1.0 - phi) * f, kRoundingTolerance * b);
+}
+
+TEST_F(CApi, BetaFromDimensionalInputs) {
+  // Air-like gas and 0.5 mm particles: eps_g = 0.6, u = 0.5 m/s.
+  const double eps_g = 0.6, mu_g = 1.8e-5, rho_g = 1.2, slip = 0.5, d_p = 5e-4, rho_s = 2500.0;
+  const double phi = 1.0 - eps_g;
+  const double re = rho_g * eps_g * d_p * slip / mu_g;  // superficial Re of the brief
+  const double f = F(phi, re);
+  const double expected_beta = 18.0 * mu_g * phi * eps_g * f / (d_p * d_p);
+  double beta = kUntouched, dga = kUntouched;
+  ASSERT_EQ(draglab_law_beta(law_, eps_g, mu_g, rho_g, slip, d_p, rho_s, &beta), DRAGLAB_OK)
+      << draglab_last_error();
+  EXPECT_NEAR(beta, expected_beta, kRoundingTolerance * expected_beta);
+  ASSERT_EQ(draglab_law_dga(law_, eps_g, mu_g, rho_g, slip, d_p, rho_s, &dga), DRAGLAB_OK);
+  EXPECT_NEAR(dga, beta / phi, kRoundingTolerance * dga);
+
+  // rho_s is unused but must be physical; so must every other input.
+  double value = kUntouched;
+  EXPECT_EQ(draglab_law_beta(law_, eps_g, mu_g, rho_g, slip, d_p, 0.0, &value),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(draglab_last_error()).find("rho_s"), std::string::npos);
+  EXPECT_EQ(draglab_law_beta(law_, eps_g, mu_g, rho_g, slip, d_p, kNaN, &value),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_beta(law_, 1.2, mu_g, rho_g, slip, d_p, rho_s, &value),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_beta(law_, 0.0, mu_g, rho_g, slip, d_p, rho_s, &value),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_beta(law_, eps_g, -mu_g, rho_g, slip, d_p, rho_s, &value),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_dga(law_, eps_g, mu_g, rho_g, -slip, d_p, rho_s, &value),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(value, kUntouched);
+
+  // lDgA stays finite at eps_g = 1 (phi = 0, outside the box: extrapolate) where beta/phi is 0/0.
+  ASSERT_EQ(draglab_law_set_range_policy(law_, DRAGLAB_RANGE_EXTRAPOLATE), DRAGLAB_OK);
+  ASSERT_EQ(draglab_law_dga(law_, 1.0, mu_g, rho_g, slip, d_p, rho_s, &dga), DRAGLAB_OK);
+  const double re1 = rho_g * d_p * slip / mu_g;
+  EXPECT_NEAR(dga, 18.0 * mu_g * F(0.0, re1) / (d_p * d_p), kRoundingTolerance * dga);
+}
+
+TEST_F(CApi, BetaArrayPathEqualsScalarPath) {
+  const std::vector<double> eps = {0.45, 0.6, 0.75, 0.9};
+  const std::vector<double> mu = {1.8e-5, 1.8e-5, 2.0e-5, 1.7e-5};
+  const std::vector<double> rho = {1.2, 1.0, 1.3, 1.2};
+  const std::vector<double> slip = {0.0, 0.1, 0.5, 2.0};
+  const std::vector<double> d = {5e-4, 1e-4, 5e-4, 2e-3};
+  std::vector<double> out(eps.size(), kUntouched);
+  ASSERT_EQ(draglab_law_beta_n(law_, eps.size(), eps.data(), mu.data(), rho.data(), slip.data(),
+                               d.data(), out.data()),
+            DRAGLAB_OK)
+      << draglab_last_error();
+  for (std::size_t i = 0; i < eps.size(); ++i) {
+    double b = 0;
+    ASSERT_EQ(draglab_law_beta(law_, eps[i], mu[i], rho[i], slip[i], d[i], 2500.0, &b),
+              DRAGLAB_OK);
+    EXPECT_EQ(out[i], b) << i;
+  }
+  std::vector<double> bad = eps;
+  bad[3] = 1.5;
+  EXPECT_EQ(draglab_law_beta_n(law_, eps.size(), bad.data(), mu.data(), rho.data(), slip.data(),
+                               d.data(), out.data()),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(draglab_last_error()).find("index 3"), std::string::npos);
+}
+
+TEST_F(CApi, LastErrorIsPerThread) {
+  double value = 0;
+  ASSERT_EQ(draglab_law_F(law_, 1.5, 1.0, &value), DRAGLAB_INVALID_ARGUMENT);
+  const std::string mine = draglab_last_error();
+  ASSERT_FALSE(mine.empty());
+  std::string other_before, other_after;
+  std::thread other([&] {
+    other_before = draglab_last_error();  // a fresh thread has no message
+    double v = 0;
+    draglab_law_F(law_, 0.3, -5.0, &v);
+    other_after = draglab_last_error();
+  });
+  other.join();
+  EXPECT_EQ(other_before, "");
+  EXPECT_NE(other_after.find("Re"), std::string::npos);
+  EXPECT_EQ(std::string(draglab_last_error()), mine);  // untouched by the other thread
+}
+
+TEST_F(CApi, ConcurrentEvaluationGivesTheSerialResults) {
+  std::vector<double> phi, re, serial;
+  for (int i = 0; i < 200; ++i) {
+    phi.push_back(0.1 + 0.5 * (i % 20) / 19.0);
+    re.push_back(1000.0 * (i / 20) / 9.0);
+    serial.push_back(F(phi.back(), re.back()));
+  }
+  std::atomic<int> mismatches{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&] {
+      for (int repeat = 0; repeat < 50; ++repeat) {
+        for (std::size_t i = 0; i < phi.size(); ++i) {
+          double v = 0;
+          if (draglab_law_F(law_, phi[i], re[i], &v) != DRAGLAB_OK || v != serial[i]) ++mismatches;
+        }
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(mismatches.load(), 0);
+}
+
+TEST_F(CApi, ExportThroughTheAbi) {
+  std::size_t length = 0;
+  ASSERT_EQ(draglab_law_export(law_, "c", nullptr, 0, &length), DRAGLAB_OK)
+      << draglab_last_error();
+  ASSERT_GT(length, 100u);
+  std::vector<char> buffer(length + 1, 'x');
+  ASSERT_EQ(draglab_law_export(law_, "c", buffer.data(), buffer.size(), &length), DRAGLAB_OK);
+  const std::string text(buffer.data());
+  EXPECT_EQ(text.size(), length);
+  EXPECT_NE(text.find("double bvk2007_v1_F(double phi, double re)"), std::string::npos);
+  EXPECT_NE(text.find(draglab_law_hash(law_)), std::string::npos);
+
+  std::vector<char> small(10, 'x');
+  EXPECT_EQ(draglab_law_export(law_, "c", small.data(), small.size(), &length),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_law_export(law_, "pascal", nullptr, 0, &length), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(draglab_last_error()).find("fortran"), std::string::npos);
+}
+
+}  // namespace

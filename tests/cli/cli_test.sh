@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# End-to-end test of the draglab CLI on a fresh database in a temporary directory.
+# Checks: exit codes (0 ok, 1 failure, 2 bad input), --json shapes and values, messages on
+# stderr only, and that bad input leaves nothing behind. Values checked against
+# data/law_check_values.csv (bvk2007 at phi 0.4, Re 100: F = 30.7416, 6 significant figures).
+set -u
+draglab="$1"
+py=/usr/bin/python3
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+export DRAGLAB_DB="$work/default.db"
+failures=0; passed=0
+
+check() {  # check NAME EXPECTED_EXIT CMD...
+  local name="$1" expected="$2"; shift 2
+  "$@" >"$work/out" 2>"$work/err"
+  local rc=$?
+  if [ "$rc" -ne "$expected" ]; then
+    echo "FAIL $name: exit $rc, expected $expected"; sed 's/^/  stderr: /' "$work/err" | head -5
+    failures=$((failures + 1))
+  else
+    passed=$((passed + 1))
+  fi
+}
+json_check() {  # json_check NAME PYTHON_EXPRESSION_ON_j
+  if "$py" -c "import json,sys; j=json.load(open('$work/out')); sys.exit(0 if ($2) else 1)"; then
+    passed=$((passed + 1))
+  else
+    echo "FAIL $1: JSON check '$2' failed on:"; head -c 600 "$work/out"; echo
+    failures=$((failures + 1))
+  fi
+}
+
+# Database creation on first use, seeded with the literature library.
+check "law list --json" 0 "$draglab" law list --json
+json_check "list has the literature library" \
+  "isinstance(j, list) and {'bvk2007','tang2015','vdh2004','gidaspow','hill_koch_ladd'} <= {x['name'] for x in j} and all({'name','version','status','form'} <= set(x) for x in j)"
+[ -f "$DRAGLAB_DB" ] || { echo "FAIL: DRAGLAB_DB not created"; failures=$((failures + 1)); }
+
+# --db takes precedence over $DRAGLAB_DB.
+check "explicit --db" 0 "$draglab" --db "$work/explicit.db" db info --json
+json_check "db info" "j['path'].endswith('explicit.db') and j['schema_version'] == j['code_schema_version'] and j['law_versions'] >= 15"
+
+# law eval, JSON and table.
+check "law eval --json" 0 "$draglab" law eval bvk2007 --phi 0.4 --re 100 --json
+json_check "eval fields" "all(k in j for k in ('law','version','phi','re','F','beta_d2_over_mu','K'))"
+json_check "eval value (data/law_check_values.csv)" "abs(j['F'] - 30.7416) / 30.7416 < 2e-6"
+json_check "eval conversions" "abs(j['beta_d2_over_mu'] - 18*0.4*0.6*j['F']) < 1e-9*j['beta_d2_over_mu'] and abs(j['K'] - j['F']/0.6) < 1e-12*j['K']"
+check "law eval table" 0 "$draglab" law eval tang2015 --phi 0.3 --re 10
+grep -q "beta d^2/mu" "$work/out" || { echo "FAIL: eval table"; failures=$((failures + 1)); }
+check "law eval grid json" 0 "$draglab" law eval bvk2007@1 --grid --json
+json_check "grid" "len(j) == 30 and all('F' in x for x in j)"
+
+# Bad input: exit 2 with a message naming the field.
+check "phi out of physical range" 2 "$draglab" law eval bvk2007 --phi 1.2 --re 10
+grep -q "phi" "$work/err" || { echo "FAIL: message does not name phi"; failures=$((failures + 1)); }
+check "negative Re" 2 "$draglab" law eval bvk2007 --phi 0.3 --re -1
+check "NaN phi" 2 "$draglab" law eval bvk2007 --phi nan --re 1
+check "outside validity" 2 "$draglab" law eval bvk2007 --phi 0.05 --re 1
+check "clamp policy" 0 "$draglab" law eval bvk2007 --phi 0.05 --re 1 --range-policy clamp --json
+json_check "clamped value equals phi=0.1" "abs(j['F'] - 2.49816) < 1e-5"
+check "unknown law" 2 "$draglab" law eval no_such_law --phi 0.3 --re 1
+grep -q "bvk2007" "$work/err" || { echo "FAIL: unknown law does not list known names"; failures=$((failures + 1)); }
+check "unknown option" 2 "$draglab" law eval bvk2007 --phii 0.3
+check "missing subcommand" 2 "$draglab" law
+check "help" 0 "$draglab" law eval --help
+grep -q "Examples" "$work/out" || { echo "FAIL: help without examples"; failures=$((failures + 1)); }
+
+# diff, show, export.
+check "law diff" 0 "$draglab" law diff bvk2007 tang2015 --json
+json_check "diff fields" "j['max_relative_difference'] > 0.1 and 'phi' in j['at']"
+check "law diff self" 0 "$draglab" law diff bvk2007 bvk2007@1 --json
+json_check "diff self is zero" "j['max_relative_difference'] == 0 and j['same_content']"
+check "law show json" 0 "$draglab" law show vdh2004 --json
+check "law export c" 0 "$draglab" law export bvk2007@1 --format c -o "$work/bvk.c"
+[ -s "$work/bvk.c" ] || { echo "FAIL: export wrote nothing"; failures=$((failures + 1)); }
+check "export unwritable" 2 "$draglab" law export bvk2007 --format c -o "$work/no/such/dir/x.c"
+ls "$work/no" >/dev/null 2>&1 && { echo "FAIL: export left files"; failures=$((failures + 1)); }
+
+# Retraction: stays loadable, with a warning.
+check "retract" 0 "$draglab" law retract ergun@1 --reason "test retraction"
+check "retracted loads" 0 "$draglab" law eval ergun@1 --phi 0.4 --re 10
+grep -qi "retracted" "$work/err" || { echo "FAIL: no retraction warning"; failures=$((failures + 1)); }
+
+# Bad database files.
+echo "this is not a database" >"$work/bad.db"
+check "not a database" 2 "$draglab" --db "$work/bad.db" law list
+grep -q "bad.db" "$work/err" || { echo "FAIL: corrupt db message does not name the file"; failures=$((failures + 1)); }
+check "db check" 0 "$draglab" db check
+
+# The main job.
+check "law compare" 0 "$draglab" law compare
+grep -q "bvk2007" "$work/out" || { echo "FAIL: compare table"; failures=$((failures + 1)); }
+
+echo "cli: $passed passed, $failures failed"
+[ "$failures" -eq 0 ]
