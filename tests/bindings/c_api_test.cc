@@ -115,7 +115,7 @@ TEST_F(CApi, PhysicallyImpossibleInputsAreErrorsNeverNaN) {
     double phi, re;
     const char* names;  // what the message must mention
   };
-  const Case cases[] = {{1.2, 10.0, "phi"},  {1.0, 10.0, "phi"}, {-0.1, 10.0, "phi"},
+  const Case cases[] = {{1.2, 10.0, "phi"},  {1.0, 10.0, "phi"},  {-0.1, 10.0, "phi"},
                         {kNaN, 10.0, "phi"}, {kInf, 10.0, "phi"}, {0.3, -1.0, "Re"},
                         {0.3, kNaN, "Re"},   {0.3, kInf, "Re"}};
   for (const Case& c : cases) {
@@ -293,7 +293,7 @@ TEST_F(CApi, BetaFromDimensionalInputs) {
 }
 
 TEST_F(CApi, BetaArrayPathEqualsScalarPath) {
-  const std::vector<double> eps = {0.45, 0.6, 0.75, 0.9};
+  const std::vector<double> eps = {0.45, 0.6, 0.75, 0.85};
   const std::vector<double> mu = {1.8e-5, 1.8e-5, 2.0e-5, 1.7e-5};
   const std::vector<double> rho = {1.2, 1.0, 1.3, 1.2};
   const std::vector<double> slip = {0.0, 0.1, 0.5, 2.0};
@@ -305,8 +305,7 @@ TEST_F(CApi, BetaArrayPathEqualsScalarPath) {
       << draglab_last_error();
   for (std::size_t i = 0; i < eps.size(); ++i) {
     double b = 0;
-    ASSERT_EQ(draglab_law_beta(law_, eps[i], mu[i], rho[i], slip[i], d[i], 2500.0, &b),
-              DRAGLAB_OK);
+    ASSERT_EQ(draglab_law_beta(law_, eps[i], mu[i], rho[i], slip[i], d[i], 2500.0, &b), DRAGLAB_OK);
     EXPECT_EQ(out[i], b) << i;
   }
   std::vector<double> bad = eps;
@@ -360,8 +359,7 @@ TEST_F(CApi, ConcurrentEvaluationGivesTheSerialResults) {
 
 TEST_F(CApi, ExportThroughTheAbi) {
   std::size_t length = 0;
-  ASSERT_EQ(draglab_law_export(law_, "c", nullptr, 0, &length), DRAGLAB_OK)
-      << draglab_last_error();
+  ASSERT_EQ(draglab_law_export(law_, "c", nullptr, 0, &length), DRAGLAB_OK) << draglab_last_error();
   ASSERT_GT(length, 100u);
   std::vector<char> buffer(length + 1, 'x');
   ASSERT_EQ(draglab_law_export(law_, "c", buffer.data(), buffer.size(), &length), DRAGLAB_OK);

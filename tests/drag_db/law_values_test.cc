@@ -47,8 +47,7 @@ struct CsvCell {
       mantissa = mantissa.substr(0, e);
     }
     const std::size_t dot = mantissa.find('.');
-    const int decimals =
-        dot == std::string::npos ? 0 : static_cast<int>(mantissa.size() - dot - 1);
+    const int decimals = dot == std::string::npos ? 0 : static_cast<int>(mantissa.size() - dot - 1);
     return 0.5 * std::pow(10.0, exponent - decimals);
   }
 };
@@ -122,9 +121,11 @@ std::vector<double> with(const std::string& key, const std::map<std::string, dou
   return p;
 }
 
-/// Our value rounds to the printed table value.
-void expect_matches_printed(const std::string& what, double ours, const CsvCell& table) {
-  const double tolerance = table.half_unit_of_last_digit() + 1e-12 * std::fabs(ours);
+/// Our value rounds to the printed table value. `units` = allowed difference in units of the last
+/// printed digit: 0.5 for a correctly rounded table.
+void expect_matches_printed(const std::string& what, double ours, const CsvCell& table,
+                            double units = 0.5) {
+  const double tolerance = 2.0 * units * table.half_unit_of_last_digit() + 1e-12 * std::fabs(ours);
   EXPECT_NEAR(ours, table.value(), tolerance) << what << " (table prints " << table.text << ")";
 }
 
@@ -140,28 +141,37 @@ TEST(LawValues, DossierCheckValues) {
   }
 }
 
+// The dossier's 4-digit tables were rounded twice (6 -> 5 -> 4 significant figures): e.g. seed04 at
+// phi = 0.1 is 2.56148 (6 digits in law_check_values.csv, and ours) -> 2.5615 -> 2.562, tenneti at
+// 0.1 is 2.25747 -> 2.258, HKL at (0.4, 100) is 24.6247 -> 24.63. Double rounding through one extra
+// digit errs by at most 0.5 + 0.05 units of the last digit, which is the tolerance used for them.
+constexpr double kDoubleRoundedUnits = 0.55;
+
 TEST(LawValues, RandomArrayStokesTable) {
   const CsvTable t = read_csv("random_array_stokes_table.csv");
   for (const auto& row : t.rows) {
     const double phi = row.at("phi").value();
     const std::string at = " phi=" + row.at("phi").text;
     for (const char* law : {"vdh2005", "bvk2007", "tang2015"}) {
-      expect_matches_printed(law + at, eval(law, phi, 0.0), row.at("vdh05"));
+      expect_matches_printed(law + at, eval(law, phi, 0.0), row.at("vdh05"), kDoubleRoundedUnits);
     }
-    expect_matches_printed("vdh2004" + at, eval("vdh2004", phi, 0.0), row.at("seed04"));
-    expect_matches_printed("tenneti2011" + at, eval("tenneti2011", phi, 0.0), row.at("tgs_eps"));
+    expect_matches_printed("vdh2004" + at, eval("vdh2004", phi, 0.0), row.at("seed04"),
+                           kDoubleRoundedUnits);
+    expect_matches_printed("tenneti2011" + at, eval("tenneti2011", phi, 0.0), row.at("tgs_eps"),
+                           kDoubleRoundedUnits);
     // The table's HKL columns are F0 x (1-phi). For phi <= 0.01 the law (MFiX) uses the Oseen
     // branch instead (documented deviation, checked below); F0 is seen just above 0.01.
     const double phi_hkl = phi <= 0.01 ? phi + 1e-12 : phi;
     expect_matches_printed("hill_koch_ladd" + at, eval("hill_koch_ladd", phi_hkl, 0.0),
-                           row.at("hkl_17_14"));
+                           row.at("hkl_17_14"), kDoubleRoundedUnits);
     // CFDEM's 16.14 column is not our law, but our form reproduces it with c0 = 16.14.
-    expect_matches_printed("hill_koch_ladd(c0=16.14)" + at,
-                           eval("hill_koch_ladd", phi_hkl, 0.0, with("hill_koch_ladd", {{"c0", 16.14}})),
-                           row.at("hkl_16_14"));
+    expect_matches_printed(
+        "hill_koch_ladd(c0=16.14)" + at,
+        eval("hill_koch_ladd", phi_hkl, 0.0, with("hill_koch_ladd", {{"c0", 16.14}})),
+        row.at("hkl_16_14"), kDoubleRoundedUnits);
     if (phi >= 0.4) {
-      expect_matches_printed("hill_koch_ladd (Carman-Kozeny)" + at, eval("hill_koch_ladd", phi, 0.0),
-                             row.at("ck"));
+      expect_matches_printed("hill_koch_ladd (Carman-Kozeny)" + at,
+                             eval("hill_koch_ladd", phi, 0.0), row.at("ck"), kDoubleRoundedUnits);
     }
   }
   // Documented deviation at phi = 0.01: MFiX's branch "phis <= 0.01 -> 1 + 3/8 Re_a" gives K = 1.
@@ -171,8 +181,12 @@ TEST(LawValues, RandomArrayStokesTable) {
 TEST(LawValues, RandomArrayFiniteReTable) {
   const CsvTable t = read_csv("random_array_finite_re_table.csv");
   const std::vector<std::pair<std::string, std::string>> columns = {
-      {"bvk07", "bvk2007"},  {"tang15", "tang2015"}, {"seed04", "vdh2004"},
-      {"tgs_eps", "tenneti2011"}, {"ergun", "ergun"},     {"wen_yu", "wen_yu"},
+      {"bvk07", "bvk2007"},
+      {"tang15", "tang2015"},
+      {"seed04", "vdh2004"},
+      {"tgs_eps", "tenneti2011"},
+      {"ergun", "ergun"},
+      {"wen_yu", "wen_yu"},
       {"hkl_mfix_eps", "hill_koch_ladd"}};
   int compared = 0;
   for (const auto& row : t.rows) {
@@ -180,9 +194,19 @@ TEST(LawValues, RandomArrayFiniteReTable) {
     for (const auto& column : columns) {
       const CsvCell& cell = row.at(column.first);
       if (cell.empty()) continue;
-      expect_matches_printed(column.second + " phi=" + row.at("phi").text +
-                                 " Re=" + row.at("Re").text,
-                             eval(column.second, phi, re), cell);
+      const std::string what =
+          column.second + " phi=" + row.at("phi").text + " Re=" + row.at("Re").text;
+      if (column.second == "wen_yu" && re == 1000.0) {
+        // Documented deviation: this table takes Schiller-Naumann's Newton arm at Re = 1000 (the
+        // seed's and OpenFOAM's "Re < 1000"); the law uses MFiX's Re <= 1000 (as does
+        // law_check_values.csv, 229.249 at phi = 0.5). The table is the value just above 1000.
+        const double above = std::nextafter(1000.0, 2000.0);
+        expect_matches_printed(what + " (Newton arm)", eval("wen_yu", phi, above), cell,
+                               kDoubleRoundedUnits);
+        EXPECT_GT(std::fabs(eval("wen_yu", phi, re) - cell.value()), 0.003 * cell.value());
+      } else {
+        expect_matches_printed(what, eval(column.second, phi, re), cell, kDoubleRoundedUnits);
+      }
       ++compared;
     }
   }
@@ -207,9 +231,9 @@ TEST(LawValues, IndependentPythonEvaluation) {
     ++per_law[law];
   }
   // Every law without values in the dossier's tables is covered here.
-  for (const char* law : {"schiller_naumann", "gidaspow", "gidaspow_blend", "syamlal_obrien",
-                          "di_felice", "rong2013", "hill_koch_ladd", "bvk2007_poly", "vdh2005",
-                          "tenneti2011", "wen_yu"}) {
+  for (const char* law :
+       {"schiller_naumann", "gidaspow", "gidaspow_blend", "syamlal_obrien", "di_felice", "rong2013",
+        "hill_koch_ladd", "bvk2007_poly", "vdh2005", "tenneti2011", "wen_yu"}) {
     EXPECT_GE(per_law[law], 5) << law;
   }
 }

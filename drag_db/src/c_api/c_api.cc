@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "codegen/export.h"
+#include "drag_db_version.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
-#include "drag_db_version.h"
 
 struct draglab_db {
   std::unique_ptr<draglab::Database> db;
@@ -111,9 +111,8 @@ void check_dimensional(const draglab::Law& law, double eps_g, double mu_g, doubl
                        double slip, double d_p) {
   auto positive = [&](double v, const char* name) {
     if (!std::isfinite(v) || !(v > 0.0)) {
-      throw Error(ErrorCode::kInvalidArgument,
-                  law.reference() + ": " + name + " = " + format_value(v) +
-                      " must be finite and > 0");
+      throw Error(ErrorCode::kInvalidArgument, law.reference() + ": " + name + " = " +
+                                                   format_value(v) + " must be finite and > 0");
     }
   };
   if (!std::isfinite(eps_g) || !(eps_g > 0.0) || eps_g > 1.0) {
@@ -124,8 +123,8 @@ void check_dimensional(const draglab::Law& law, double eps_g, double mu_g, doubl
   positive(rho_g, "rho_g");
   positive(d_p, "d_p");
   if (!std::isfinite(slip) || slip < 0.0) {
-    throw Error(ErrorCode::kInvalidArgument, law.reference() + ": slip = " + format_value(slip) +
-                                                 " must be finite and >= 0");
+    throw Error(ErrorCode::kInvalidArgument,
+                law.reference() + ": slip = " + format_value(slip) + " must be finite and >= 0");
   }
 }
 
@@ -165,7 +164,8 @@ void draglab_db_close(draglab_db* db) {
 }
 
 int draglab_law_load(draglab_db* db, const char* ref, draglab_law** law) {
-  if (db == nullptr || !db->db) return fail(DRAGLAB_INVALID_ARGUMENT, "draglab_law_load: db is NULL");
+  if (db == nullptr || !db->db)
+    return fail(DRAGLAB_INVALID_ARGUMENT, "draglab_law_load: db is NULL");
   if (ref == nullptr) return fail(DRAGLAB_INVALID_ARGUMENT, "draglab_law_load: ref is NULL");
   if (law == nullptr) return fail(DRAGLAB_INVALID_ARGUMENT, "draglab_law_load: law is NULL");
   std::string warning;
@@ -226,8 +226,8 @@ int draglab_law_num_extra(const draglab_law* law) {
   return law->law->num_extra_inputs();
 }
 
-int draglab_law_validity(const draglab_law* law, double* phi_min, double* phi_max,
-                         double* re_min, double* re_max) {
+int draglab_law_validity(const draglab_law* law, double* phi_min, double* phi_max, double* re_min,
+                         double* re_max) {
   return guarded([&] {
     const draglab::Law& l = law_of(law, "draglab_law_validity");
     require(phi_min != nullptr && phi_max != nullptr && re_min != nullptr && re_max != nullptr,
@@ -383,9 +383,9 @@ int draglab_law_export(const draglab_law* law, const char* format, char* buffer,
     if (buffer == nullptr && size == 0) return;  // length query
     require(buffer != nullptr, "draglab_law_export: buffer is NULL but size is not 0");
     if (size < text.size() + 1) {
-      throw Error(ErrorCode::kInvalidArgument,
-                  "draglab_law_export: buffer of " + std::to_string(size) + " bytes is too small, " +
-                      std::to_string(text.size() + 1) + " needed");
+      throw Error(ErrorCode::kInvalidArgument, "draglab_law_export: buffer of " +
+                                                   std::to_string(size) + " bytes is too small, " +
+                                                   std::to_string(text.size() + 1) + " needed");
     }
     std::memcpy(buffer, text.c_str(), text.size() + 1);
   });

@@ -20,9 +20,9 @@
 #include <vector>
 
 #include "codegen/expr.h"
+#include "drag_db_version.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law_form.h"
-#include "drag_db_version.h"
 
 namespace draglab {
 namespace {
@@ -185,8 +185,7 @@ std::vector<std::string> wrap_fortran(const std::string& base_indent,
 bool is_leaf(Op op) { return op == Op::kConstant || op == Op::kInput || op == Op::kParameter; }
 
 bool is_comparison(Op op) {
-  return op == Op::kLess || op == Op::kLessEqual || op == Op::kGreater ||
-         op == Op::kGreaterEqual;
+  return op == Op::kLess || op == Op::kLessEqual || op == Op::kGreater || op == Op::kGreaterEqual;
 }
 
 /// The trace of one formula, with the placement of every node in the if/else block structure.
@@ -474,24 +473,23 @@ LawTrace trace(const LawRecord& record) {
   t.form = &find_law_form(record.form);
   const auto& specs = t.form->description.parameters;
   if (record.parameters.size() != specs.size()) {
-    throw Error(ErrorCode::kInvalidArgument,
-                record.reference() + ": form '" + record.form + "' takes " +
-                    std::to_string(specs.size()) + " parameters, the record has " +
-                    std::to_string(record.parameters.size()));
+    throw Error(ErrorCode::kInvalidArgument, record.reference() + ": form '" + record.form +
+                                                 "' takes " + std::to_string(specs.size()) +
+                                                 " parameters, the record has " +
+                                                 std::to_string(record.parameters.size()));
   }
   t.num_extra = t.form->num_extra_inputs;
   if (record.validity.extra.size() != static_cast<std::size_t>(t.num_extra)) {
-    throw Error(ErrorCode::kInvalidArgument,
-                record.reference() + ": the validity box does not list the form's " +
-                    std::to_string(t.num_extra) + " extra input(s)");
+    throw Error(ErrorCode::kInvalidArgument, record.reference() +
+                                                 ": the validity box does not list the form's " +
+                                                 std::to_string(t.num_extra) + " extra input(s)");
   }
   std::set<std::string> taken;
   std::vector<Expr> params;
   for (std::size_t i = 0; i < record.parameters.size(); ++i) {
     if (!std::isfinite(record.parameters[i].value)) {
-      throw Error(ErrorCode::kInvalidArgument,
-                  record.reference() + ": parameter '" + record.parameters[i].name +
-                      "' is not finite");
+      throw Error(ErrorCode::kInvalidArgument, record.reference() + ": parameter '" +
+                                                   record.parameters[i].name + "' is not finite");
     }
     // Fortran is case-insensitive: names must differ in lower case.
     std::string name = "p_" + to_lower(sanitize_identifier(record.parameters[i].name));
@@ -523,14 +521,14 @@ std::vector<std::string> header_lines(const LawRecord& r, const LawTrace& t, Lan
                 "export " +
                 r.reference() + " --format " + (c ? "c" : "fortran"));
   h.push_back("");
-  add_field(h, "Law:          ", r.reference() + " (form " + r.form + ", status " +
-                                     to_string(r.status) + ")");
+  add_field(h, "Law:          ",
+            r.reference() + " (form " + r.form + ", status " + to_string(r.status) + ")");
   if (r.status == LawStatus::kRetracted) {
     add_field(h, "RETRACTED:    ", r.retraction_reason);
   }
   add_field(h, "Content hash: ", "sha256 " + r.content_hash);
-  add_field(h, "Citation:     ",
-            r.provenance.citation.empty() ? d.citation : r.provenance.citation);
+  add_field(h,
+            "Citation:     ", r.provenance.citation.empty() ? d.citation : r.provenance.citation);
   std::string provenance = r.provenance.kind;
   if (!r.provenance.dataset_id.empty()) provenance += "; dataset " + r.provenance.dataset_id;
   if (!r.provenance.data_hash.empty()) provenance += "; data hash " + r.provenance.data_hash;
@@ -549,35 +547,37 @@ std::vector<std::string> header_lines(const LawRecord& r, const LawTrace& t, Lan
     add_field(h, "  ", text);
   }
   h.push_back("");
-  h.push_back("Conventions (draglab canonical; the law's native convention is converted inside F):");
+  h.push_back(
+      "Conventions (draglab canonical; the law's native convention is converted inside F):");
   h.push_back("  phi  = solids volume fraction, eps = 1 - phi the gas volume fraction");
   h.push_back("  u    = |u_g - u_s| interstitial slip velocity (superficial velocity U = eps u)");
   h.push_back("  Re   = rho_g eps d_p u / mu_g (superficial, particle-diameter based)");
-  h.push_back("  F    = F_d / (3 pi mu_g d_p eps u): drag only, mean-pressure-gradient part "
-              "excluded");
-  h.push_back("  beta = 18 mu_g phi eps F / d_p^2 [kg m^-3 s^-1], momentum exchange per unit "
-              "volume");
+  h.push_back(
+      "  F    = F_d / (3 pi mu_g d_p eps u): drag only, mean-pressure-gradient part "
+      "excluded");
+  h.push_back(
+      "  beta = 18 mu_g phi eps F / d_p^2 [kg m^-3 s^-1], momentum exchange per unit "
+      "volume");
   h.push_back("  dga  = beta / phi = 18 mu_g eps F / d_p^2 [kg m^-3 s^-1] (MFiX's lDgA)");
   h.push_back("  (K = F / (1 - phi) would be the total force incl. the mean pressure gradient.)");
   add_field(h, "  Native convention: ",
             std::string("force ") + to_string(r.convention.force) + ", normalisation " +
-                to_string(r.convention.normalisation) + ", Re " +
-                to_string(r.convention.reynolds) + ", TFM model " +
-                to_string(r.convention.tfm_model));
+                to_string(r.convention.normalisation) + ", Re " + to_string(r.convention.reynolds) +
+                ", TFM model " + to_string(r.convention.tfm_model));
   for (int k = 0; k < t.num_extra; ++k) {
     const ExtraInputSpec& e = r.validity.extra[static_cast<std::size_t>(k)];
     add_field(h, "  ",
-              std::string("extra") + (c ? "[" + std::to_string(k) + "]"
-                                        : "(" + std::to_string(k + 1) + ")") +
-                  " = " + e.name + ": " + e.description);
+              std::string("extra") +
+                  (c ? "[" + std::to_string(k) + "]" : "(" + std::to_string(k + 1) + ")") + " = " +
+                  e.name + ": " + e.description);
   }
   h.push_back("");
-  std::string box = "Validity box: " + format_bound(r.validity.phi.min) + " <= phi <= " +
-                    format_bound(r.validity.phi.max) + ", " + format_bound(r.validity.re.min) +
+  std::string box = "Validity box: " + format_bound(r.validity.phi.min) +
+                    " <= phi <= " + format_bound(r.validity.phi.max) + ", " +
+                    format_bound(r.validity.re.min) +
                     " <= Re <= " + format_bound(r.validity.re.max);
   for (const ExtraInputSpec& e : r.validity.extra) {
-    box += ", " + format_bound(e.range.min) + " <= " + e.name + " <= " +
-           format_bound(e.range.max);
+    box += ", " + format_bound(e.range.min) + " <= " + e.name + " <= " + format_bound(e.range.max);
   }
   add_field(h, "", box);
   h.push_back("");
@@ -678,8 +678,8 @@ std::string export_c(const LawRecord& r) {
       o << "  x_extra[" << k << "] = extra[" << k << "];\n";
     }
   }
-  std::string outside = "phi < " + bl(box.phi.min) + " || phi > " + bl(box.phi.max) +
-                        " || re < " + bl(box.re.min) + " || re > " + bl(box.re.max);
+  std::string outside = "phi < " + bl(box.phi.min) + " || phi > " + bl(box.phi.max) + " || re < " +
+                        bl(box.re.min) + " || re > " + bl(box.re.max);
   for (int k = 0; k < t.num_extra; ++k) {
     const InputRange& e = box.extra[static_cast<std::size_t>(k)].range;
     const std::string x = "extra[" + std::to_string(k) + "]";
@@ -772,8 +772,9 @@ std::string export_fortran(const LawRecord& r) {
   }
   const std::string extra_call = has_extra ? ", y" : "";
   out.push_back("!");
-  out.push_back("!   SUBROUTINE DRAG_USR(IJK, M_NP, lDgA, EPg, Mug, ROg, VREL, DPM, ROs, lUg, "
-                "lVg, lWg)");
+  out.push_back(
+      "!   SUBROUTINE DRAG_USR(IJK, M_NP, lDgA, EPg, Mug, ROg, VREL, DPM, ROs, lUg, "
+      "lVg, lWg)");
   out.push_back("!     use error_manager");
   out.push_back("!     use " + module + ", only: " + id + "_dga_checked");
   out.push_back("!     ...  (declarations of the arguments as in the stub)");
@@ -854,10 +855,10 @@ std::string export_fortran(const LawRecord& r) {
               "phi * (1.0_c_double - phi) * " + id + "_F(phi, re" + extra_arg +
                   ") * 18.0_c_double * (mu_g / (d_p * d_p))",
               "Friction coefficient beta [kg m^-3 s^-1]; SI inputs, no input checks.");
-  dimensional("dga",
-              "eps_g * " + id + "_F(phi, re" + extra_arg +
-                  ") * 18.0_c_double * (mu_g / (d_p * d_p))",
-              "MFiX's lDgA = beta / phi [kg m^-3 s^-1]; SI inputs, no input checks.");
+  dimensional(
+      "dga",
+      "eps_g * " + id + "_F(phi, re" + extra_arg + ") * 18.0_c_double * (mu_g / (d_p * d_p))",
+      "MFiX's lDgA = beta / phi [kg m^-3 s^-1]; SI inputs, no input checks.");
 
   // F_checked
   const auto& box = r.validity;
@@ -866,7 +867,8 @@ std::string export_fortran(const LawRecord& r) {
          bl(hi) + "), " + x + " < " + bl(lo) + ")");
   };
   out.push_back("  ! F with input checks and a range policy (0 error, 1 clamp, 2 extrapolate).");
-  out.push_back("  ! stat: 0 ok, 1 invalid input, 2 outside the validity box, 8 non-finite result;");
+  out.push_back(
+      "  ! stat: 0 ok, 1 invalid input, 2 outside the validity box, 8 non-finite result;");
   out.push_back("  ! F is left untouched unless stat is 0, or 2 with range_policy 1 or 2.");
   emit("  pure subroutine " + id + "_F_checked(phi, re" + extra_arg + ", range_policy, F, stat)");
   emit("    real(c_double), intent(in) :: phi, re");
@@ -947,8 +949,8 @@ std::string export_fortran(const LawRecord& r) {
     emit("  end subroutine " + id + "_" + what + "_checked");
     out.push_back("");
   };
-  checked_dimensional("beta", "phi * (1.0_c_double - phi) * F * 18.0_c_double * (mu_g / (d_p * d_p))",
-                      "beta");
+  checked_dimensional(
+      "beta", "phi * (1.0_c_double - phi) * F * 18.0_c_double * (mu_g / (d_p * d_p))", "beta");
   checked_dimensional("dga", "eps_g * F * 18.0_c_double * (mu_g / (d_p * d_p))", "MFiX's lDgA");
 
   emit("end module " + module);
@@ -1011,11 +1013,10 @@ std::string export_json(const LawRecord& r) {
                      {"normalisation", to_string(r.convention.normalisation)},
                      {"reynolds", to_string(r.convention.reynolds)},
                      {"tfm_model", to_string(r.convention.tfm_model)}};
-  j["canonical"] = {
-      {"F", "F_d / (3 pi mu d eps u), drag only, u interstitial slip"},
-      {"Re", "rho eps d u / mu (superficial)"},
-      {"beta", "18 mu phi eps F / d^2 [kg m^-3 s^-1]"},
-      {"K", "F / (1 - phi), total force incl. mean pressure gradient"}};
+  j["canonical"] = {{"F", "F_d / (3 pi mu d eps u), drag only, u interstitial slip"},
+                    {"Re", "rho eps d u / mu (superficial)"},
+                    {"beta", "18 mu phi eps F / d^2 [kg m^-3 s^-1]"},
+                    {"K", "F / (1 - phi), total force incl. mean pressure gradient"}};
   nlohmann::ordered_json extra = nlohmann::ordered_json::array();
   for (const ExtraInputSpec& e : r.validity.extra) {
     extra.push_back({{"name", e.name},
@@ -1024,10 +1025,10 @@ std::string export_json(const LawRecord& r) {
                      {"max", number_or_null(e.range.max)}});
   }
   j["validity"] = {
-      {"phi", {{"min", number_or_null(r.validity.phi.min)},
-               {"max", number_or_null(r.validity.phi.max)}}},
-      {"re", {{"min", number_or_null(r.validity.re.min)},
-              {"max", number_or_null(r.validity.re.max)}}},
+      {"phi",
+       {{"min", number_or_null(r.validity.phi.min)}, {"max", number_or_null(r.validity.phi.max)}}},
+      {"re",
+       {{"min", number_or_null(r.validity.re.min)}, {"max", number_or_null(r.validity.re.max)}}},
       {"extra", extra}};
   j["provenance"] = {{"kind", r.provenance.kind},
                      {"citation", r.provenance.citation},

@@ -27,7 +27,7 @@ struct Bvk2007 {
   template <typename T>
   static T stokes_part(const T& phi, const T& a, const T& b) {
     const T eps = T(1.0) - phi;
-    return phi * a / (eps * eps) + eps * eps * (T(1.0) + sqrt(phi) * b);
+    return phi * a / (eps * eps) + eps * eps * (T(1.0) + sqrt_nonneg(phi) * b);
   }
 
   template <typename T>

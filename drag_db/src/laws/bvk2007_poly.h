@@ -1,7 +1,7 @@
 // bvk2007_poly: Beetstra, van der Hoef & Kuipers (2007), polydisperse (bidisperse-fitted) form.
 //
-//   F_i(phi, Re, y_i) = F_bvk2007(phi, Re) [(1 - phi) y_i + phi y_i^2 + g (1 - phi) y_i^3],  g = 0.064
-//   y_i = d_i/<d>, <d> = Sauter mean diameter of the mixture (1/<d> = sum_j (phi_j/phi)/d_j),
+//   F_i(phi, Re, y_i) = F_bvk2007(phi, Re) [(1 - phi) y_i + phi y_i^2 + g (1 - phi) y_i^3],  g =
+//   0.064 y_i = d_i/<d>, <d> = Sauter mean diameter of the mixture (1/<d> = sum_j (phi_j/phi)/d_j),
 //   phi = total solids fraction, Re = rho eps <d> u/mu based on the MEAN diameter <d>.
 //
 // Native convention: drag-only F_i normalised with the particle's own diameter, F_i = F_d,i/(3 pi
@@ -10,8 +10,8 @@
 // Parameters: the five bvk2007 coefficients and g.
 //
 // At y = 1 the factor is 1 + g (1 - phi): this form does NOT reduce to bvk2007 for a monodisperse
-// system but is 6.4 % (phi -> 0) to 2.6 % (phi = 0.6) higher -- a property of the published fit (the
-// y^3 term was fitted to finite-Re bidisperse data). So F(phi -> 0, Re -> 0) = 1.064 at y = 1.
+// system but is 6.4 % (phi -> 0) to 2.6 % (phi = 0.6) higher -- a property of the published fit
+// (the y^3 term was fitted to finite-Re bidisperse data). So F(phi -> 0, Re -> 0) = 1.064 at y = 1.
 // Known deviations, NOT implemented: MFiX DRAG_GS (BVK) drops the y^3 term for solids phase 1 and
 // uses F_cor = y_i for TFM model A, citing an erratum; Yin & Sundaresan's HYS form is different.
 // Validity: phi 0.1-0.6, Re <= 1000, diameter ratios up to 1:4 (abstract: "on average within 10 %

@@ -4,13 +4,14 @@
 //   chi = chi_0 - chi_1 exp[-(1.5 - log10 Re)^2 / 2],  chi_0 = 3.7, chi_1 = 0.65
 //   F   = (C_d Re / 24) eps^-chi,   Re = rho eps d u/mu (superficial)
 //
-// Native convention = canonical (drag-only F, superficial Re). Implemented with Dalla Valle's C_d as
-// in the original paper, CFDEM DiFeliceDrag, PhasicFlowPlus and Kratos. Known deviations, NOT
+// Native convention = canonical (drag-only F, superficial Re). Implemented with Dalla Valle's C_d
+// as in the original paper, CFDEM DiFeliceDrag, PhasicFlowPlus and Kratos. Known deviations, NOT
 // implemented: MFiX DRAG_DIFELICE and Grains3D use Schiller-Naumann's C_d; waLBerla dragForceFelice
 // computes chi = 3.7 - 0.65^(-(1.5 - log10 Re)^2/2) (a power instead of 0.65 exp, a bug).
 // Re -> 0: the exponential term vanishes (chi -> 3.7) and F -> 0.96 eps^-3.7; it is written with a
-// select so that Re = 0 needs no log10(0). F(phi -> 0, Re -> 0) = 4.8^2/24 = 0.96: Dalla Valle's C_d
-// is 4 % below Stokes drag. Validity (Di Felice's data base, indicative): eps 0.4-1, Re up to 1e4.
+// select so that Re = 0 needs no log10(0). F(phi -> 0, Re -> 0) = 4.8^2/24 = 0.96: Dalla Valle's
+// C_d is 4 % below Stokes drag. Validity (Di Felice's data base, indicative): eps 0.4-1, Re up to
+// 1e4.
 #pragma once
 
 #include "laws/law_math.h"

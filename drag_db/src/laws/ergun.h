@@ -21,10 +21,9 @@ namespace laws {
 struct Ergun {
   static constexpr int kNumParameters = 2;
   static constexpr int kNumExtraInputs = 0;
-  static constexpr NativeConvention kConvention{ForceKind::kDragOnly,
-                                                Normalisation::kBetaD2OverMuPhi,
-                                                ReynoldsDefinition::kInterstitialDiameter,
-                                                TfmModel::kModelA};
+  static constexpr NativeConvention kConvention{
+      ForceKind::kDragOnly, Normalisation::kBetaD2OverMuPhi,
+      ReynoldsDefinition::kInterstitialDiameter, TfmModel::kModelA};
   static LawFormDescription describe();
 
   /// beta d^2/(mu phi) = a phi/eps + b Re_p; `re_p` interstitial (rho d u/mu), p = {a, b}.

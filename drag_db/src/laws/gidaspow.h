@@ -21,10 +21,9 @@ namespace laws {
 struct Gidaspow {
   static constexpr int kNumParameters = 3;
   static constexpr int kNumExtraInputs = 0;
-  static constexpr NativeConvention kConvention{ForceKind::kDragOnly,
-                                                Normalisation::kBetaD2OverMuPhi,
-                                                ReynoldsDefinition::kSuperficialDiameter,
-                                                TfmModel::kModelA};
+  static constexpr NativeConvention kConvention{
+      ForceKind::kDragOnly, Normalisation::kBetaD2OverMuPhi,
+      ReynoldsDefinition::kSuperficialDiameter, TfmModel::kModelA};
   static LawFormDescription describe();
 
   /// Gas fraction at and below which the Ergun arm is used.
@@ -42,7 +41,8 @@ struct Gidaspow {
   template <typename T>
   static T native(const T& phi, const T& re, const T* /*extra*/, const T* p) {
     const T eps = T(1.0) - phi;
-    return select(eps <= kSwitchEps, ergun_arm(phi, re, p), WenYu::native<T>(phi, re, nullptr, p + 2));
+    return select(eps <= kSwitchEps, ergun_arm(phi, re, p),
+                  WenYu::native<T>(phi, re, nullptr, p + 2));
   }
 };
 

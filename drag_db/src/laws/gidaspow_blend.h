@@ -7,9 +7,10 @@
 // Native convention: beta d^2/(mu phi), superficial Re, TFM model A, as MFiX DRAG_GIDASPOW_BLEND
 // and MFiX-Exa ComputeDragGidaspow (whose "Gidaspow" is this blended law); Grains3D "Huilin" is the
 // same with 0.2 - phi. The blend slope 150 * 1.75 = 262.5 is a fixed constant of the published
-// switch function, not tied to the Ergun parameters a, b. Continuous in phi; the only switch left is
-// the Schiller-Naumann C_d switch at Re = 1000 inside the Wen-Yu arm. Note psi(eps = 1) = 0.99394,
-// not 1: the blend keeps 0.6 % Ergun at eps = 1, so F(phi -> 0, Re -> 0) = 0.99394 rather than 1.
+// switch function, not tied to the Ergun parameters a, b. Continuous in phi; the only switch left
+// is the Schiller-Naumann C_d switch at Re = 1000 inside the Wen-Yu arm. Note psi(eps = 1) =
+// 0.99394, not 1: the blend keeps 0.6 % Ergun at eps = 1, so F(phi -> 0, Re -> 0) = 0.99394 rather
+// than 1.
 #pragma once
 
 #include "laws/gidaspow.h"
@@ -21,10 +22,9 @@ namespace laws {
 struct GidaspowBlend {
   static constexpr int kNumParameters = 3;
   static constexpr int kNumExtraInputs = 0;
-  static constexpr NativeConvention kConvention{ForceKind::kDragOnly,
-                                                Normalisation::kBetaD2OverMuPhi,
-                                                ReynoldsDefinition::kSuperficialDiameter,
-                                                TfmModel::kModelA};
+  static constexpr NativeConvention kConvention{
+      ForceKind::kDragOnly, Normalisation::kBetaD2OverMuPhi,
+      ReynoldsDefinition::kSuperficialDiameter, TfmModel::kModelA};
   static LawFormDescription describe();
 
   /// Slope of the arctan switch function (150 * 1.75 in MFiX).

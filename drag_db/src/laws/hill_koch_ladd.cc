@@ -30,7 +30,8 @@ LawFormDescription HillKochLadd::describe() {
       "MFiX DRAG_KOCH_HILL: total-force K with the radius-based Re_a = Re/2, F = (1 - phi) K; F0 "
       "with 17.14 phi (CFDEM's 16.14 and its F0 + F3 Re_a-only form are not implemented), w "
       "blending towards Carman-Kozeny 10 phi/eps^3, F1/F2/F3 and the Re_t1/Re_t2 crossovers. "
-      "Discontinuous in phi at 0.01 (+28 % at Re = 0), and by ~1e-5 at 0.0953 and 0.1, as published.";
+      "Discontinuous in phi at 0.01 (+28 % at Re = 0), and by ~1e-5 at 0.0953 and 0.1, as "
+      "published.";
   d.parameters = {
       {"c0", 17.14, "1", "coefficient of phi in the numerator of the Stokes fit F0"},
       {"c2", 17.89, "1", "coefficient of phi in the numerator of the inertial fit F2"},
@@ -46,7 +47,8 @@ LawFormDescription HillKochLadd::describe() {
   oseen_phi.documented_at_other = 0.0;
 
   RegimeSwitch f3_phi;
-  f3_phi.description = "phi = 0.0953: F3 = 0.9351 phi + 0.03667 -> 0.0673 + 0.212 phi + 0.0232/eps^5";
+  f3_phi.description =
+      "phi = 0.0953: F3 = 0.9351 phi + 0.03667 -> 0.0673 + 0.212 phi + 0.0232/eps^5";
   f3_phi.axis = RegimeSwitch::Axis::kPhi;
   f3_phi.location = [](double, const double*) { return kF3Phi; };
   f3_phi.documented_relative_jump = 1.102e-5;  // the two F3 fits differ by 1.1e-5 at 0.0953

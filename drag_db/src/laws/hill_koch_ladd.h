@@ -58,8 +58,10 @@ struct HillKochLadd {
     const T dilute_head = T(1.0) + sqrt_nonneg(phi * 0.5) * 3.0 + x_log_x(phi) * (135.0 / 64.0);
     const T phi2 = phi * phi;
     const T phi3 = phi2 * phi;
-    const T f0_dilute = (dilute_head + p[0] * phi) / (T(1.0) + phi * 0.681 - phi2 * 8.48 + phi3 * 8.16);
-    const T f2_dilute = (dilute_head + p[1] * phi) / (T(1.0) + phi * 0.681 - phi2 * 11.03 + phi3 * 15.41);
+    const T f0_dilute =
+        (dilute_head + p[0] * phi) / (T(1.0) + phi * 0.681 - phi2 * 8.48 + phi3 * 8.16);
+    const T f2_dilute =
+        (dilute_head + p[1] * phi) / (T(1.0) + phi * 0.681 - phi2 * 11.03 + phi3 * 15.41);
     Coefficients<T> c;
     c.f0 = select(phi < kDensePhi, (T(1.0) - w) * f0_dilute + w * carman_kozeny, carman_kozeny);
     c.f2 = select(phi < kDensePhi, (T(1.0) - w) * f2_dilute + w * carman_kozeny, carman_kozeny);

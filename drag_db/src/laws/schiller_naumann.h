@@ -5,11 +5,11 @@
 //   Re_p = rho d u / mu with the interstitial slip u.
 //
 // Native convention: the published quantity is C_d (Normalisation::kDragCoefficient), but C_d =
-// (C_d Re_p)/Re_p is infinite at Re = 0, and the generic conversion C_d * Re_p / (24 eps) would then
-// evaluate inf * 0. So the form returns the same law already as a force, kForce with the
-// interstitial Reynolds number: F = F_d/(3 pi mu d eps u) = (C_d Re_p / 24) / eps, which is the drag
-// 3 pi mu d u (C_d Re_p/24) of an isolated sphere moving at the interstitial slip, normalised the
-// draglab way. At phi = 0 this is exactly the textbook C_d Re/24 (F = 1 in the Stokes limit).
+// (C_d Re_p)/Re_p is infinite at Re = 0, and the generic conversion C_d * Re_p / (24 eps) would
+// then evaluate inf * 0. So the form returns the same law already as a force, kForce with the
+// interstitial Reynolds number: F = F_d/(3 pi mu d eps u) = (C_d Re_p / 24) / eps, which is the
+// drag 3 pi mu d u (C_d Re_p/24) of an isolated sphere moving at the interstitial slip, normalised
+// the draglab way. At phi = 0 this is exactly the textbook C_d Re/24 (F = 1 in the Stokes limit).
 //
 // Switch inclusivity: MFiX (C_DS_SN, Wen-Yu) uses Re <= 1000, OpenFOAM and waLBerla use < 1000;
 // only the single point Re_p = 1000 differs (here: <=). The published law jumps there by 0.39 %

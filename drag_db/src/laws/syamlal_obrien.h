@@ -4,6 +4,7 @@
 //   Re_p = rho d u/mu (interstitial, no eps);  A = eps^4.14;
 //   B = C1 eps^1.28 (eps <= 0.85),  eps^D1 (eps > 0.85);   C1 = 0.8, D1 = 2.65
 //   V_r = [A - 0.06 Re_p + sqrt((0.06 Re_p)^2 + 0.12 Re_p (2B - A) + A^2)] / 2
+//       (evaluated without cancellation at large Re_p, see velocity_ratio)
 //   beta d^2/(mu phi) = (3/4) eps (0.63 sqrt(Re_p/V_r) + 4.8)^2 / V_r
 //
 // Native convention: beta d^2/(mu phi), interstitial Re, TFM model A, exactly as MFiX
@@ -25,22 +26,25 @@ namespace laws {
 struct SyamlalOBrien {
   static constexpr int kNumParameters = 2;
   static constexpr int kNumExtraInputs = 0;
-  static constexpr NativeConvention kConvention{ForceKind::kDragOnly,
-                                                Normalisation::kBetaD2OverMuPhi,
-                                                ReynoldsDefinition::kInterstitialDiameter,
-                                                TfmModel::kModelA};
+  static constexpr NativeConvention kConvention{
+      ForceKind::kDragOnly, Normalisation::kBetaD2OverMuPhi,
+      ReynoldsDefinition::kInterstitialDiameter, TfmModel::kModelA};
   static LawFormDescription describe();
 
   /// Gas fraction at and below which B = C1 eps^1.28.
   static constexpr double kSwitchEps = 0.85;
 
   /// Terminal-velocity ratio V_r(eps, Re_p) > 0; p = {C1, D1}.
+  /// With x = 0.06 Re_p and s the square root, A - x + s cancels once x >> A (at Re_p = 1e4 it is
+  /// 600 - 600 + 0.3: three digits lost). Since (s + (A - x)) (s - (A - x)) = 4 B x, the same value
+  /// is 4 B x/(s + x - A) there, which has no cancellation; both arms are equal where they meet.
   template <typename T>
   static T velocity_ratio(const T& eps, const T& re_p, const T* p) {
     const T a = pow(eps, 4.14);
     const T b = select(eps <= kSwitchEps, p[0] * pow(eps, 1.28), pow(eps, p[1]));
     const T x = re_p * 0.06;
-    return (a - x + sqrt(x * x + re_p * 0.12 * (b * 2.0 - a) + a * a)) * 0.5;
+    const T s = sqrt(x * x + x * 2.0 * (b * 2.0 - a) + a * a);
+    return select(x > a, b * x * 2.0 / (s + x - a), (a - x + s) * 0.5);
   }
 
   /// beta d^2/(mu phi); `re_p` interstitial, p = {C1, D1}.

@@ -14,9 +14,11 @@ LawFormDescription Tang2015::describe() {
       "new drag correlation from fully resolved simulations of flow past monodisperse static "
       "arrays of spheres, AIChE J. 61 (2015) 688-698, doi:10.1002/aic.14645";
   d.form_notes =
-      "Eq. (21): F = 10 phi/eps^2 + eps^2 (1 + 1.5 sqrt(phi)) + [0.11 phi (1 + phi) - 0.00456/eps^4 "
+      "Eq. (21): F = 10 phi/eps^2 + eps^2 (1 + 1.5 sqrt(phi)) + [0.11 phi (1 + phi) - "
+      "0.00456/eps^4 "
       "+ (0.169 eps + 0.0644/eps^4) Re^-0.343] Re, drag-only, Re superficial (MFiX DRAG_TPKKV, "
-      "waLBerla dragForceTang, MFiX-Exa 'BVK2'). Equal to bvk2007 and vdh2005 at Re = 0. The moving-"
+      "waLBerla dragForceTang, MFiX-Exa 'BVK2'). Equal to bvk2007 and vdh2005 at Re = 0. The "
+      "moving-"
       "particle (granular temperature) extension of Tang et al. 2016 is not included.";
   d.parameters = {
       {"a", 10.0, "1", "Carman-Kozeny coefficient of the Stokes term a phi/eps^2"},

@@ -11,7 +11,8 @@ LawFormDescription Tenneti2011::describe() {
   d.title = "Tenneti, Garg & Subramaniam (2011): PR-DNS of fixed random arrays (total force)";
   d.citation =
       "S. Tenneti, R. Garg, S. Subramaniam, Drag law for monodisperse gas-solid systems using "
-      "particle-resolved direct numerical simulation of flow past fixed assemblies of spheres, Int. "
+      "particle-resolved direct numerical simulation of flow past fixed assemblies of spheres, "
+      "Int. "
       "J. Multiphase Flow 37 (2011) 1072-1092, doi:10.1016/j.ijmultiphaseflow.2011.05.010";
   d.form_notes =
       "Stored as a total-force law: F_TGS = (1 + 0.15 Re^0.687)/eps^3 + 5.81 phi/eps^3 + 0.48 "

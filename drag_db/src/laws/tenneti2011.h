@@ -1,10 +1,9 @@
 // tenneti2011: Tenneti, Garg & Subramaniam (2011), particle-resolved DNS (PUReIBM) of fixed random
 // arrays.
 //
-//   F_TGS = F_isol(Re)/eps^3 + F_phi(phi) + F_phiRe(phi, Re)       (total force incl. mean pressure)
-//   F_isol  = 1 + 0.15 Re^0.687
-//   F_phi   = a1 phi/eps^3 + a2 phi^(1/3)/eps^4,                     a1 = 5.81, a2 = 0.48
-//   F_phiRe = phi^3 Re (b1 + b2 phi^3/eps^2),                       b1 = 0.95, b2 = 0.61
+//   F_TGS = F_isol(Re)/eps^3 + F_phi(phi) + F_phiRe(phi, Re)       (total force incl. mean
+//   pressure) F_isol  = 1 + 0.15 Re^0.687 F_phi   = a1 phi/eps^3 + a2 phi^(1/3)/eps^4, a1 = 5.81,
+//   a2 = 0.48 F_phiRe = phi^3 Re (b1 + b2 phi^3/eps^2),                       b1 = 0.95, b2 = 0.61
 //   normalised by 3 pi mu d eps |W| (W mean slip, so superficial), Re_m = eps rho d |W|/mu.
 //
 // Native convention: TOTAL force (ForceKind::kTotal), canonical F = (1 - phi) F_TGS -- the waLBerla
@@ -12,9 +11,9 @@
 // comment that the TGS correlation includes the mean pressure drag. phi^3 in the last bracket, as
 // OpenFOAM and waLBerla. Deviations, NOT implemented: MFiX-21.3.2 DRAG_TGS (phi^(1/3) in the last
 // bracket and F_TGS used as a drag-only F; its DRAG_GS even dispatches TGS to the Tang routine);
-// OpenFOAM Tenneti (isolated term F_isol/eps instead of F_isol/eps^2, i.e. smaller by eps). F_isol has
-// no Newton switch (as waLBerla; Re stays below 1000 in the validity box anyway).
-// Validity (not verified against the paper): phi 0.1-0.5, Re_m <= 300.
+// OpenFOAM Tenneti (isolated term F_isol/eps instead of F_isol/eps^2, i.e. smaller by eps). F_isol
+// has no Newton switch (as waLBerla; Re stays below 1000 in the validity box anyway). Validity (not
+// verified against the paper): phi 0.1-0.5, Re_m <= 300.
 #pragma once
 
 #include "laws/law_math.h"

@@ -28,10 +28,9 @@ namespace laws {
 struct Vdh2004 {
   static constexpr int kNumParameters = 8;
   static constexpr int kNumExtraInputs = 0;
-  static constexpr NativeConvention kConvention{ForceKind::kDragOnly,
-                                                Normalisation::kBetaD2OverMuPhi,
-                                                ReynoldsDefinition::kSuperficialDiameter,
-                                                TfmModel::kNotApplicable};
+  static constexpr NativeConvention kConvention{
+      ForceKind::kDragOnly, Normalisation::kBetaD2OverMuPhi,
+      ReynoldsDefinition::kSuperficialDiameter, TfmModel::kNotApplicable};
   static LawFormDescription describe();
 
   /// beta d^2/(mu phi); p = {A, B, k0, n0, k1, c10, c11, c12}, `re` superficial.

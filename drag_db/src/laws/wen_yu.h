@@ -20,10 +20,9 @@ namespace laws {
 struct WenYu {
   static constexpr int kNumParameters = 1;
   static constexpr int kNumExtraInputs = 0;
-  static constexpr NativeConvention kConvention{ForceKind::kDragOnly,
-                                                Normalisation::kBetaD2OverMuPhi,
-                                                ReynoldsDefinition::kSuperficialDiameter,
-                                                TfmModel::kModelA};
+  static constexpr NativeConvention kConvention{
+      ForceKind::kDragOnly, Normalisation::kBetaD2OverMuPhi,
+      ReynoldsDefinition::kSuperficialDiameter, TfmModel::kModelA};
   static LawFormDescription describe();
 
   /// beta d^2/(mu phi) = 0.75 (C_d Re) eps^-n; `re` superficial, p = {n}.
