@@ -17,4 +17,11 @@ cmake -S "$work/outside" -B "$work/outside/build" -DCMAKE_PREFIX_PATH="$work/pre
 cmake --build "$work/outside/build" >/dev/null
 LD_LIBRARY_PATH="$work/prefix/lib:$work/prefix/lib/x86_64-linux-gnu" \
   "$work/outside/build/outside_solver" "$work/b.db"
-echo "install: 2 passed, 0 failed"
+
+# A Fortran solver through the draglab-fortran pkg-config file (module draglab_mod).
+if command -v gfortran >/dev/null; then
+  gfortran "$src/outside_solver.f90" -o "$work/via_pkgconfig_f" \
+    $(pkg-config --cflags --libs draglab-fortran)
+  "$work/via_pkgconfig_f" "$work/c.db"
+fi
+echo "install: 3 passed, 0 failed"

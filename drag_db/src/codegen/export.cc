@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -664,7 +663,7 @@ std::string export_c(const LawRecord& r) {
   o << "/* F with input checks and a range policy (0 error, 1 clamp, 2 extrapolate); returns a\n"
        " * status (0 ok, 1 invalid input, 2 outside the validity box, 8 non-finite result). */\n";
   o << "int " << id << "_F_checked(double phi, double re" << extra_param
-    << ", int range_policy, double* F) {\n";
+    << ",\n    int range_policy, double* F) {\n";
   o << "  double x_phi = phi, x_re = re, value;\n";
   if (t.num_extra > 0) o << "  double x_extra[" << t.num_extra << "];\n";
   o << "  int status = 0;\n";
@@ -780,6 +779,7 @@ std::string export_fortran(const LawRecord& r) {
   out.push_back("!     ...  (declarations of the arguments as in the stub)");
   out.push_back("!     integer :: stat");
   if (has_extra) out.push_back("!     double precision :: y(" + std::to_string(t.num_extra) + ")");
+  if (has_extra) out.push_back("!     y = ...  ! the extra input(s) listed above, e.g. DPM / <d>");
   out.push_back("!     lDgA = 0.0d0");
   out.push_back("!     call " + id + "_dga_checked(EPg, Mug, ROg, VREL, DPM" + extra_call +
                 ", 1, lDgA, stat)  ! 1 = clamp");
