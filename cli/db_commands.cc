@@ -91,6 +91,7 @@ void run_migrate(const CliContext& ctx) {
 void add_db_commands(CLI::App& app, CliContext& ctx) {
   CLI::App* db = app.add_subcommand("db", "Database information, integrity check, migrations");
   db->require_subcommand(1);
+  db->footer("Examples:\n  draglab db info\n  draglab db check --json\n  draglab db migrate --db old.db");
   auto* info = db->add_subcommand("info", "Path, schema version, number of law versions");
   info->footer("Examples:\n  draglab db info\n  draglab db info --db other.db --json");
   info->callback([&ctx] { ctx.action = [&ctx] { run_info(ctx); }; });

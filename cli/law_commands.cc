@@ -21,38 +21,59 @@ nlohmann::json record_json(const LawRecord& r) {
   return nlohmann::json::parse(export_law(r, ExportFormat::kJson));
 }
 
-/// Values of one evaluation, as printed by `law eval`.
+/// Values of one evaluation, as printed by `law eval`. Under the clamp policy F is evaluated at
+/// the clamped point (phi_evaluated, re_evaluated); beta d^2/mu and K use the requested phi
+/// (law.h explains why).
 struct Evaluation {
   double phi, re, F, beta_d2_over_mu, K;
+  double phi_evaluated, re_evaluated;
   bool outside_validity;
 };
 
-bool inside(const ValidityBox& box, double phi, double re) {
-  return box.phi.contains(phi) && box.re.contains(re);
-}
-
 Evaluation evaluate(const Law& law, double phi, double re, const std::vector<double>& extra) {
-  const double* x = extra.empty() ? nullptr : extra.data();
+  const LawEvaluation v = law.evaluate(phi, re, extra.empty() ? nullptr : extra.data());
   Evaluation e;
   e.phi = phi;
   e.re = re;
-  e.F = law.F(phi, re, x);
+  e.F = v.F;
+  e.phi_evaluated = v.phi;
+  e.re_evaluated = v.re;
   e.beta_d2_over_mu = conventions::beta_d2_over_mu(phi, e.F);
   e.K = conventions::total_force_K(phi, e.F);
-  e.outside_validity = !inside(law.record().validity, phi, re);
+  e.outside_validity = v.out_of_validity;
   return e;
 }
 
 nlohmann::json evaluation_json(const Law& law, const Evaluation& e) {
-  return {{"law", law.record().name},
-          {"version", law.record().version},
-          {"hash", law.record().content_hash},
-          {"phi", e.phi},
-          {"re", e.re},
-          {"F", e.F},
-          {"beta_d2_over_mu", e.beta_d2_over_mu},
-          {"K", e.K},
-          {"outside_validity", e.outside_validity}};
+  nlohmann::json j = {{"law", law.record().name},
+                      {"version", law.record().version},
+                      {"hash", law.record().content_hash},
+                      {"phi", e.phi},
+                      {"re", e.re},
+                      {"F", e.F},
+                      {"beta_d2_over_mu", e.beta_d2_over_mu},
+                      {"K", e.K},
+                      {"outside_validity", e.outside_validity}};
+  if (e.phi_evaluated != e.phi || e.re_evaluated != e.re) {
+    j["F_evaluated_at"] = {{"phi", e.phi_evaluated}, {"re", e.re_evaluated}};
+  }
+  return j;
+}
+
+/// Physical range of the inputs, checked before anything is opened or printed.
+void check_physical_inputs(const std::vector<double>& phis, const std::vector<double>& res,
+                           const std::string& phi_field, const std::string& re_field) {
+  for (double phi : phis) {
+    if (!std::isfinite(phi) || phi < 0.0 || phi >= 1.0) {
+      throw UsageError(fmt::format("{} = {} is outside [0, 1) (phi is the solids fraction)",
+                                   phi_field, phi));
+    }
+  }
+  for (double re : res) {
+    if (!std::isfinite(re) || re < 0.0) {
+      throw UsageError(fmt::format("{} = {} must be finite and >= 0", re_field, re));
+    }
+  }
 }
 
 void print_law_header(const Law& law, const std::string& warning, const CliContext& ctx) {
@@ -154,12 +175,23 @@ struct EvalOptions {
   double re = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> extra;
   bool grid = false;
+  bool phi_given = false;
+  bool re_given = false;
   std::string phi_list = "0.1,0.2,0.3,0.4,0.5,0.6";
   std::string re_list = "0,1,10,100,1000";
   std::string policy = "error";
 };
 
 void run_eval(const CliContext& ctx, const EvalOptions& o) {
+  std::vector<double> phis, res;
+  if (o.grid) {
+    phis = parse_double_list(o.phi_list, "--phi-list");
+    res = parse_double_list(o.re_list, "--re-list");
+    check_physical_inputs(phis, res, "--phi-list", "--re-list");
+  } else {
+    if (!o.phi_given || !o.re_given) throw UsageError("--phi and --re are required (or use --grid)");
+    check_physical_inputs({o.phi}, {o.re}, "--phi", "--re");
+  }
   auto db = ctx.open_database();
   std::string warning;
   auto law = db->load(o.ref, range_policy_from_string(o.policy), &warning);
@@ -172,9 +204,6 @@ void run_eval(const CliContext& ctx, const EvalOptions& o) {
   print_law_header(*law, warning, ctx);
 
   if (!o.grid) {
-    if (std::isnan(o.phi) || std::isnan(o.re)) {
-      throw UsageError("--phi and --re are required (or use --grid)");
-    }
     const Evaluation e = evaluate(*law, o.phi, o.re, o.extra);
     if (ctx.json) {
       nlohmann::json j = evaluation_json(*law, e);
@@ -184,14 +213,17 @@ void run_eval(const CliContext& ctx, const EvalOptions& o) {
     }
     std::cout << fmt::format("phi = {}  Re = {}{}\n", format_number(e.phi), format_number(e.re),
                              e.outside_validity ? "  (outside validity box: " + o.policy + ")" : "");
+    if (e.phi_evaluated != e.phi || e.re_evaluated != e.re) {
+      std::cout << fmt::format("  F evaluated at the clamped point phi = {}, Re = {}; beta and K "
+                               "use the actual phi\n",
+                               format_number(e.phi_evaluated), format_number(e.re_evaluated));
+    }
     std::cout << fmt::format("  F              = {}\n", format_number(e.F, 10));
     std::cout << fmt::format("  beta d^2/mu    = {}\n", format_number(e.beta_d2_over_mu, 10));
     std::cout << fmt::format("  K = F/(1-phi)  = {}\n", format_number(e.K, 10));
     return;
   }
 
-  const std::vector<double> phis = parse_double_list(o.phi_list, "--phi-list");
-  const std::vector<double> res = parse_double_list(o.re_list, "--re-list");
   if (ctx.json) {
     nlohmann::json out = nlohmann::json::array();
     for (double phi : phis) {
@@ -211,23 +243,25 @@ void run_eval(const CliContext& ctx, const EvalOptions& o) {
     ctx.print_json(out);
     return;
   }
-  std::cout << fmt::format("F(phi, Re) of {}  ('-' outside the validity box with policy '{}')\n",
-                           law->reference(), o.policy);
-  std::cout << fmt::format("{:>8}", "phi\\Re");
-  for (double re : res) std::cout << fmt::format(" {:>11}", format_number(re));
-  std::cout << '\n';
+  std::string table =
+      fmt::format("F(phi, Re) of {}  ('-' outside the validity box with policy '{}')\n",
+                  law->reference(), o.policy);
+  table += fmt::format("{:>8}", "phi\\Re");
+  for (double re : res) table += fmt::format(" {:>11}", format_number(re));
+  table += '\n';
   for (double phi : phis) {
-    std::cout << fmt::format("{:>8}", format_number(phi));
+    table += fmt::format("{:>8}", format_number(phi));
     for (double re : res) {
       try {
-        std::cout << fmt::format(" {:>11}", format_number(evaluate(*law, phi, re, o.extra).F));
+        table += fmt::format(" {:>11}", format_number(evaluate(*law, phi, re, o.extra).F));
       } catch (const Error& e) {
         if (e.code() != ErrorCode::kOutOfValidity) throw;
-        std::cout << fmt::format(" {:>11}", "-");
+        table += fmt::format(" {:>11}", "-");
       }
     }
-    std::cout << '\n';
+    table += '\n';
   }
+  std::cout << table;  // printed only once complete: nothing half-written on an error
 }
 
 // ---- law diff -------------------------------------------------------------------------------
@@ -260,7 +294,7 @@ void run_diff(const CliContext& ctx, const std::string& ref_a, const std::string
     for (int i = 0; i < points - 1; ++i)
       res.push_back(lo * std::pow(re.max / lo, static_cast<double>(i) / (points - 2)));
   }
-  double max_rel = 0.0, sum_sq = 0.0, at_phi = phi.min, at_re = re.min, fa_at = 0, fb_at = 0;
+  double max_rel = -1.0, sum_sq = 0.0, at_phi = phi.min, at_re = re.min, fa_at = 0, fb_at = 0;
   std::size_t n = 0;
   for (double p : phis) {
     for (double r : res) {
@@ -314,13 +348,20 @@ void run_export(const CliContext& ctx, const std::string& ref, const std::string
   const std::string tmp = output + ".partial";
   {
     std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw UsageError("cannot write --output '" + output + "'");
+    if (!out) {
+      throw UsageError("--output '" + output + "': cannot create the file (does the directory "
+                       "exist and is it writable?)");
+    }
     out << text;
-    if (!out.flush()) throw UsageError("cannot write --output '" + output + "'");
+    if (!out.flush()) {
+      out.close();
+      std::remove(tmp.c_str());
+      throw std::runtime_error("--output '" + output + "': write failed (disk full?)");
+    }
   }
   if (std::rename(tmp.c_str(), output.c_str()) != 0) {
     std::remove(tmp.c_str());
-    throw UsageError("cannot write --output '" + output + "'");
+    throw std::runtime_error("--output '" + output + "': cannot move the file into place");
   }
   ctx.info(fmt::format("wrote {} ({} export of {})", output, format, r.reference()));
 }
@@ -328,6 +369,12 @@ void run_export(const CliContext& ctx, const std::string& ref, const std::string
 // ---- law retract ----------------------------------------------------------------------------
 void run_retract(const CliContext& ctx, const std::string& ref, const std::string& reason) {
   if (reason.size() < 3) throw UsageError("--reason is required (say why the law is retracted)");
+  const std::size_t at = ref.find('@');
+  if (at == std::string::npos || ref.find_first_not_of("0123456789", at + 1) != std::string::npos ||
+      at + 1 == ref.size()) {
+    throw UsageError("law retract needs an explicit NAME@VERSION (e.g. " +
+                     ref.substr(0, at) + "@1), got '" + ref + "'");
+  }
   auto db = ctx.open_database();
   const LawRecord r = db->resolve(ref);
   const LawRecord out = db->retract(r.name, r.version, reason);
@@ -340,9 +387,10 @@ void run_retract(const CliContext& ctx, const std::string& ref, const std::strin
 
 // ---- law compare (the default job of run.sh) ------------------------------------------------
 void run_compare(const CliContext& ctx, const std::string& phi_list, const std::string& re_list) {
-  auto db = ctx.open_database();
   const std::vector<double> phis = parse_double_list(phi_list, "--phi-list");
   const std::vector<double> res = parse_double_list(re_list, "--re-list");
+  check_physical_inputs(phis, res, "--phi-list", "--re-list");
+  auto db = ctx.open_database();
   std::vector<std::shared_ptr<Law>> laws;
   for (const LawRecord& r : db->list("", false)) {
     if (r.status != LawStatus::kPublished) continue;
@@ -356,32 +404,45 @@ void run_compare(const CliContext& ctx, const std::string& phi_list, const std::
     for (const auto& law : laws) {
       for (double re : res) {
         for (double phi : phis) {
-          nlohmann::json j = evaluation_json(*law, evaluate(*law, phi, re, {}));
-          out.push_back(j);
+          try {
+            out.push_back(evaluation_json(*law, evaluate(*law, phi, re, {})));
+          } catch (const Error& e) {
+            if (e.code() != ErrorCode::kOutOfValidity) throw;
+            out.push_back({{"law", law->record().name}, {"version", law->record().version},
+                           {"phi", phi}, {"re", re}, {"error", e.what()}});
+          }
         }
       }
     }
     ctx.print_json(out);
     return;
   }
-  std::cout << "Published drag laws side by side: canonical drag-only F = F_d/(3 pi mu d eps u),\n"
-               "Re = rho eps d u/mu (u interstitial slip). Values in parentheses lie outside the\n"
-               "law's validity box (extrapolated). Database: "
-            << db->path() << "\n";
+  std::string table =
+      "Published drag laws side by side: canonical drag-only F = F_d/(3 pi mu d eps u),\n"
+      "Re = rho eps d u/mu (u interstitial slip). Values in parentheses lie outside the\n"
+      "law's validity box (extrapolated). Database: " + db->path() + "\n";
   for (double re : res) {
-    std::cout << fmt::format("\nRe = {}\n{:<22}", format_number(re), "law \\ phi");
-    for (double phi : phis) std::cout << fmt::format(" {:>9}", format_number(phi));
-    std::cout << '\n';
+    table += fmt::format("\nRe = {}\n{:<22}", format_number(re), "law \\ phi");
+    for (double phi : phis) table += fmt::format(" {:>9}", format_number(phi));
+    table += '\n';
     for (const auto& law : laws) {
-      std::cout << fmt::format("{:<22}", law->reference());
+      table += fmt::format("{:<22}", law->reference());
       for (double phi : phis) {
-        const Evaluation e = evaluate(*law, phi, re, {});
-        const std::string v = format_number(e.F, 4);
-        std::cout << fmt::format(" {:>9}", e.outside_validity ? "(" + v + ")" : v);
+        std::string v;
+        try {
+          const Evaluation e = evaluate(*law, phi, re, {});
+          v = format_number(e.F, 4);
+          if (e.outside_validity) v = "(" + v + ")";
+        } catch (const Error& e) {
+          if (e.code() != ErrorCode::kOutOfValidity) throw;
+          v = "-";  // the formula is not finite this far outside its box
+        }
+        table += fmt::format(" {:>9}", v);
       }
-      std::cout << '\n';
+      table += '\n';
     }
   }
+  std::cout << table;
 }
 
 }  // namespace
@@ -389,6 +450,10 @@ void run_compare(const CliContext& ctx, const std::string& phi_list, const std::
 void add_law_commands(CLI::App& app, CliContext& ctx) {
   CLI::App* law = app.add_subcommand("law", "Inspect, evaluate, compare and export drag laws");
   law->require_subcommand(1);
+  law->footer(
+      "Examples:\n  draglab law list\n  draglab law show bvk2007\n"
+      "  draglab law eval bvk2007 --phi 0.3 --re 50 --json\n  draglab law diff bvk2007 tang2015\n"
+      "  draglab law export bvk2007@1 --format fortran -o bvk2007.f90\n  draglab law compare");
 
   {
     auto* cmd = law->add_subcommand("list", "List law versions (all statuses)");
@@ -413,8 +478,10 @@ void add_law_commands(CLI::App& app, CliContext& ctx) {
         "eval", "Evaluate F, beta d^2/mu and K = F/(1-phi) at (phi, Re) or on a grid");
     auto o = std::make_shared<EvalOptions>();
     cmd->add_option("law", o->ref, "NAME[@VERSION]")->required();
-    cmd->add_option("--phi", o->phi, "Solids volume fraction phi = 1 - eps, in [0, 1)");
-    cmd->add_option("--re", o->re, "Reynolds number rho eps d u/mu (u interstitial), >= 0");
+    cmd->add_option("--phi", o->phi, "Solids volume fraction phi = 1 - eps, in [0, 1)")
+        ->each([o](const std::string&) { o->phi_given = true; });
+    cmd->add_option("--re", o->re, "Reynolds number rho eps d u/mu (u interstitial), >= 0")
+        ->each([o](const std::string&) { o->re_given = true; });
     cmd->add_option("--y", o->extra,
                     "Extra inputs of polydisperse forms: size ratio y = d_i/<d> (Sauter mean)");
     cmd->add_flag("--grid", o->grid, "Evaluate on a phi x Re grid");

@@ -18,7 +18,9 @@ packages=(
   nlohmann-json3-dev                # JSON output and records
   libceres-dev libeigen3-dev        # automatic derivatives (Jet), fitting
   libcli11-dev libfmt-dev           # command line
+  libhdf5-dev hdf5-tools            # packing and field files (h5dump: format tests)
   libgtest-dev                      # test suite
+  python3-h5py                      # tests: packing files open in h5py
   python3                           # Python bindings test (Debian's /usr/bin/python3)
 )
 
@@ -31,8 +33,15 @@ done
 
 if ((${#missing[@]})); then
   echo "setup: installing missing Debian packages: ${missing[*]}" >&2
-  if [ "$(id -u)" -eq 0 ]; then sudo=(); else sudo=(sudo); fi
-  export DEBIAN_FRONTEND=noninteractive
+  if [ "$(id -u)" -eq 0 ]; then
+    sudo=(env DEBIAN_FRONTEND=noninteractive)
+  elif command -v sudo >/dev/null; then
+    sudo=(sudo env DEBIAN_FRONTEND=noninteractive)  # sudo resets the environment
+  else
+    echo "setup: missing packages (${missing[*]}) and neither root nor sudo: install them" \
+         "as an administrator (apt-get install ${missing[*]}) and run again" >&2
+    exit 1
+  fi
   "${sudo[@]}" apt-get update -qq
   "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi

@@ -153,15 +153,26 @@ namespace {
 constexpr int kMaxExtraInputs = 8;
 }
 
-double Law::F(double phi, double re, const double* extra) const {
+LawEvaluation Law::evaluate(double phi, double re, const double* extra) const {
   double extra_buf[kMaxExtraInputs];
-  prepare(phi, re, extra_buf, extra, 0, false);
-  const double F = form_->F(phi, re, extra_buf, params_.data());
-  if (!std::isfinite(F)) {
-    throw Error(ErrorCode::kInternal, reference() + ": non-finite F at phi = " + fmt_double(phi) +
-                                          ", Re = " + fmt_double(re));
+  LawEvaluation e;
+  e.phi = phi;
+  e.re = re;
+  const std::uint64_t before = out_of_range_.load(std::memory_order_relaxed);
+  prepare(e.phi, e.re, extra_buf, extra, 0, false);
+  e.out_of_validity = out_of_range_.load(std::memory_order_relaxed) != before ||
+                      !record_.validity.phi.contains(phi) || !record_.validity.re.contains(re);
+  e.F = form_->F(e.phi, e.re, extra_buf, params_.data());
+  if (!std::isfinite(e.F)) {
+    throw Error(ErrorCode::kOutOfValidity,
+                reference() + ": the formula gives a non-finite F at phi = " + fmt_double(e.phi) +
+                    ", Re = " + fmt_double(e.re) + " (far outside its validity box)");
   }
-  return F;
+  return e;
+}
+
+double Law::F(double phi, double re, const double* extra) const {
+  return evaluate(phi, re, extra).F;
 }
 
 void Law::F(std::size_t n, const double* phi, const double* re, double* out,
@@ -181,7 +192,7 @@ void Law::F(std::size_t n, const double* phi, const double* re, double* out,
   }
   if (all_inside && n_extra == 0) {
     form_->F_array(n, phi, re, nullptr, params_.data(), out);
-    return;
+    return;  // inside the validity box every form is finite (tested over each box)
   }
   // General path, in blocks: validate, apply the policy, evaluate.
   constexpr std::size_t kBlock = 256;
@@ -198,6 +209,14 @@ void Law::F(std::size_t n, const double* phi, const double* re, double* out,
     }
     form_->F_array(m, phi_buf, re_buf, n_extra > 0 ? extra_buf.data() : nullptr, params_.data(),
                    out + start);
+    for (std::size_t j = 0; j < m; ++j) {
+      if (!std::isfinite(out[start + j])) {
+        throw Error(ErrorCode::kOutOfValidity,
+                    reference() + ": the formula gives a non-finite F at index " +
+                        std::to_string(start + j) + " (phi = " + fmt_double(phi_buf[j]) +
+                        ", Re = " + fmt_double(re_buf[j]) + ", far outside its validity box)");
+      }
+    }
   }
 }
 
@@ -222,28 +241,45 @@ double Law::drag_coefficient(double phi, double re, const double* extra) const {
   return conventions::drag_coefficient(phi, re, F(phi, re, extra));
 }
 
-double Law::beta(double eps_g, double mu_g, double rho_g, double slip, double d_p,
-                 const double* extra) const {
+namespace {
+
+/// Checks the dimensional inputs of beta() and dga(); returns the canonical Re.
+double checked_reynolds(const std::string& ref, double eps_g, double mu_g, double rho_g,
+                        double slip, double d_p) {
   auto positive = [&](double v, const char* name) {
     if (!std::isfinite(v) || !(v > 0.0)) {
-      throw Error(ErrorCode::kInvalidArgument, reference() + ": " + name + " = " + fmt_double(v) +
-                                                   " must be finite and > 0");
+      throw Error(ErrorCode::kInvalidArgument,
+                  ref + ": " + name + " = " + fmt_double(v) + " must be finite and > 0");
     }
   };
   if (!std::isfinite(eps_g) || !(eps_g > 0.0) || eps_g > 1.0) {
     throw Error(ErrorCode::kInvalidArgument,
-                reference() + ": eps_g = " + fmt_double(eps_g) + " is outside (0, 1]");
+                ref + ": eps_g = " + fmt_double(eps_g) + " is outside (0, 1]");
   }
   positive(mu_g, "mu_g");
   positive(rho_g, "rho_g");
   positive(d_p, "d_p");
   if (!std::isfinite(slip) || slip < 0.0) {
     throw Error(ErrorCode::kInvalidArgument,
-                reference() + ": slip = " + fmt_double(slip) + " must be finite and >= 0");
+                ref + ": slip = " + fmt_double(slip) + " must be finite and >= 0");
   }
+  return conventions::reynolds(eps_g, mu_g, rho_g, slip, d_p);
+}
+
+}  // namespace
+
+double Law::beta(double eps_g, double mu_g, double rho_g, double slip, double d_p,
+                 const double* extra) const {
+  const double re = checked_reynolds(reference(), eps_g, mu_g, rho_g, slip, d_p);
   const double phi = 1.0 - eps_g;
-  const double re = conventions::reynolds(eps_g, mu_g, rho_g, slip, d_p);
   return conventions::beta(phi, F(phi, re, extra), mu_g, d_p);
+}
+
+double Law::dga(double eps_g, double mu_g, double rho_g, double slip, double d_p,
+                const double* extra) const {
+  const double re = checked_reynolds(reference(), eps_g, mu_g, rho_g, slip, d_p);
+  const double phi = 1.0 - eps_g;
+  return 18.0 * mu_g * eps_g * F(phi, re, extra) / (d_p * d_p);
 }
 
 }  // namespace draglab

@@ -82,7 +82,20 @@ enum class RangePolicy {
 const char* to_string(RangePolicy p);
 RangePolicy range_policy_from_string(const std::string& s);
 
+/// One evaluation with the point the formula actually saw (differs from the request only under
+/// RangePolicy::kClamp).
+struct LawEvaluation {
+  double phi = 0.0;            ///< phi evaluated (clamped into the validity box if so asked).
+  double re = 0.0;             ///< Re evaluated.
+  double F = 0.0;              ///< Canonical drag-only F at (phi, re).
+  bool out_of_validity = false;  ///< The requested point lay outside the validity box.
+};
+
 /// A loaded law version: immutable formula and parameters, thread-safe evaluation.
+///
+/// Under RangePolicy::kClamp only the closure F is evaluated at the clamped point; conversions
+/// that count particles (beta = 18 mu phi eps F / d^2, beta d^2/mu) or normalise by the gas
+/// fraction (K = F / eps) use the caller's actual phi, which is the physical state of the cell.
 /// The range policy and the out-of-range counter are atomics; set the policy before sharing.
 class Law {
  public:
@@ -105,11 +118,14 @@ class Law {
   /// Canonical drag-only F(phi, Re). `extra` holds num_extra_inputs() values (polydisperse
   /// forms: y_i = d_i/<d>), or may be null for forms without extra inputs.
   double F(double phi, double re, const double* extra = nullptr) const;
-  /// Array path: out[i] = F(phi[i], re[i], extra + i*num_extra_inputs()). On error nothing
-  /// beyond the checked prefix is meaningful and an Error names the first bad index.
+  /// F with the point actually evaluated (see LawEvaluation).
+  LawEvaluation evaluate(double phi, double re, const double* extra = nullptr) const;
+  /// Array path: out[i] = F(phi[i], re[i], extra + i*num_extra_inputs()). On error the contents
+  /// of out are unspecified and an Error names the first bad index (a non-finite result, which
+  /// only extrapolation far outside the validity box can produce, is an error too).
   void F(std::size_t n, const double* phi, const double* re, double* out,
          const double* extra = nullptr) const;
-  /// beta d^2/mu = 18 phi (1-phi) F.
+  /// beta d^2/mu = 18 phi (1-phi) F (actual phi; F possibly at the clamped point).
   double beta_d2_over_mu(double phi, double re, const double* extra = nullptr) const;
   /// K = F/(1-phi), the total force including the mean pressure gradient part.
   double K(double phi, double re, const double* extra = nullptr) const;
@@ -117,6 +133,10 @@ class Law {
   double drag_coefficient_times_re_p(double phi, double re, const double* extra = nullptr) const;
   /// C_d with the interstitial slip in the dynamic pressure; Re must be > 0.
   double drag_coefficient(double phi, double re, const double* extra = nullptr) const;
+  /// MFiX's DRAG_USR output lDgA = beta / phi = 18 mu_g eps_g F / d_p^2 [kg m^-3 s^-1]; same
+  /// arguments and checks as beta(); finite at eps_g = 1.
+  double dga(double eps_g, double mu_g, double rho_g, double slip, double d_p,
+             const double* extra = nullptr) const;
   /// Friction coefficient beta [kg m^-3 s^-1] from dimensional inputs (argument order of MFiX's
   /// usr_drag): gas fraction eps_g, gas viscosity mu_g [Pa s], gas density rho_g [kg/m^3],
   /// interstitial slip |u_g - u_s| [m/s], particle diameter d_p [m].
