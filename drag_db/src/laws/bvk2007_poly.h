@@ -1,8 +1,10 @@
 // bvk2007_poly: Beetstra, van der Hoef & Kuipers (2007), polydisperse (bidisperse-fitted) form.
 //
-//   F_i(phi, Re, y_i) = F_bvk2007(phi, Re) [(1 - phi) y_i + phi y_i^2 + g (1 - phi) y_i^3],  g =
-//   0.064 y_i = d_i/<d>, <d> = Sauter mean diameter of the mixture (1/<d> = sum_j (phi_j/phi)/d_j),
+// clang-format off
+//   F_i(phi, Re, y_i) = F_bvk2007(phi, Re) [(1 - phi) y_i + phi y_i^2 + g (1 - phi) y_i^3],  g = 0.064
+//   y_i = d_i/<d>, <d> = Sauter mean diameter of the mixture (1/<d> = sum_j (phi_j/phi)/d_j),
 //   phi = total solids fraction, Re = rho eps <d> u/mu based on the MEAN diameter <d>.
+// clang-format on
 //
 // Native convention: drag-only F_i normalised with the particle's own diameter, F_i = F_d,i/(3 pi
 // mu d_i eps u) (Beetstra et al.'s definition as recalled, not verified against the paper). The

@@ -14,8 +14,7 @@ LawFormDescription Ergun::describe() {
       "beta d^2/(mu phi) = 150 phi/eps + 1.75 Re_p with the interstitial Re_p = rho d u/mu, i.e. "
       "F = (150 phi + 1.75 Re)/(18 eps^2): the form of MFiX DRAG_GIDASPOW (dense branch), OpenFOAM "
       "Ergun and waLBerla, consistent with Ergun's dP/L in a model-A momentum balance. Variants "
-      "with "
-      "other eps powers (Grains3D) are not implemented. No isolated-sphere limit: F(0, 0) = 0.";
+      "with other eps powers (Grains3D) are not implemented. No isolated-sphere limit: F(0, 0) = 0.";
   d.parameters = {
       {"a", 150.0, "1", "viscous (Blake-Kozeny) coefficient of a phi/eps in beta d^2/(mu phi)"},
       {"b", 1.75, "1", "inertial (Burke-Plummer) coefficient of b Re_p"},

@@ -16,8 +16,7 @@ LawFormDescription SchillerNaumann::describe() {
       "C_d Re_p = 24 (1 + 0.15 Re_p^0.687) for Re_p <= 1000 (MFiX inclusivity; OpenFOAM and "
       "waLBerla use <), 0.44 Re_p above; Re_p = rho d u/mu interstitial. Returned as the force "
       "F = (C_d Re_p/24)/eps (normalisation 'force', interstitial Re) instead of C_d, so that Re = "
-      "0 "
-      "is finite (Stokes drag, F = 1 at phi = 0). No voidage function: meant for phi -> 0.";
+      "0 is finite (Stokes drag, F = 1 at phi = 0). No voidage function: meant for phi -> 0.";
   d.parameters = {};
   d.validity.phi = {0.0, 0.01};
   d.validity.re = {0.0, 2.0e5};

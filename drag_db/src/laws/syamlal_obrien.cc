@@ -14,8 +14,7 @@ LawFormDescription SyamlalOBrien::describe() {
       "Int. J. Multiphase Flow 14 (1988) 473-481";
   d.form_notes =
       "As MFiX DRAG_SYAM_OBRIEN: Re_p = rho d u/mu (interstitial), A = eps^4.14, B = C1 eps^1.28 "
-      "for "
-      "eps <= 0.85 else eps^D1, V_r = [A - 0.06 Re_p + sqrt((0.06 Re_p)^2 + 0.12 Re_p (2B - A) + "
+      "for eps <= 0.85 else eps^D1, V_r = [A - 0.06 Re_p + sqrt((0.06 Re_p)^2 + 0.12 Re_p (2B - A) + "
       "A^2)]/2, beta d^2/(mu phi) = 0.75 eps (0.63 sqrt(Re_p/V_r) + 4.8)^2/V_r. Dalla Valle C_d: "
       "F(0, 0) = 0.96. C1, D1 are the usual U_mf tuning parameters.";
   d.parameters = {

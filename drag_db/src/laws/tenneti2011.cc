@@ -12,8 +12,7 @@ LawFormDescription Tenneti2011::describe() {
   d.citation =
       "S. Tenneti, R. Garg, S. Subramaniam, Drag law for monodisperse gas-solid systems using "
       "particle-resolved direct numerical simulation of flow past fixed assemblies of spheres, "
-      "Int. "
-      "J. Multiphase Flow 37 (2011) 1072-1092, doi:10.1016/j.ijmultiphaseflow.2011.05.010";
+      "Int. J. Multiphase Flow 37 (2011) 1072-1092, doi:10.1016/j.ijmultiphaseflow.2011.05.010";
   d.form_notes =
       "Stored as a total-force law: F_TGS = (1 + 0.15 Re^0.687)/eps^3 + 5.81 phi/eps^3 + 0.48 "
       "phi^(1/3)/eps^4 + phi^3 Re (0.95 + 0.61 phi^3/eps^2), canonical F = (1 - phi) F_TGS "

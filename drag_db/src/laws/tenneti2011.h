@@ -1,9 +1,12 @@
 // tenneti2011: Tenneti, Garg & Subramaniam (2011), particle-resolved DNS (PUReIBM) of fixed random
 // arrays.
 //
-//   F_TGS = F_isol(Re)/eps^3 + F_phi(phi) + F_phiRe(phi, Re)       (total force incl. mean
-//   pressure) F_isol  = 1 + 0.15 Re^0.687 F_phi   = a1 phi/eps^3 + a2 phi^(1/3)/eps^4, a1 = 5.81,
-//   a2 = 0.48 F_phiRe = phi^3 Re (b1 + b2 phi^3/eps^2),                       b1 = 0.95, b2 = 0.61
+// clang-format off
+//   F_TGS   = F_isol(Re)/eps^3 + F_phi(phi) + F_phiRe(phi, Re)   (total force incl. mean pressure)
+//   F_isol  = 1 + 0.15 Re^0.687
+//   F_phi   = a1 phi/eps^3 + a2 phi^(1/3)/eps^4,                  a1 = 5.81, a2 = 0.48
+//   F_phiRe = phi^3 Re (b1 + b2 phi^3/eps^2),                     b1 = 0.95, b2 = 0.61
+// clang-format on
 //   normalised by 3 pi mu d eps |W| (W mean slip, so superficial), Re_m = eps rho d |W|/mu.
 //
 // Native convention: TOTAL force (ForceKind::kTotal), canonical F = (1 - phi) F_TGS -- the waLBerla

@@ -16,8 +16,7 @@ LawFormDescription WenYu::describe() {
   d.form_notes =
       "beta d^2/(mu phi) = 0.75 C_d Re eps^-2.65 with Re = rho eps d u/mu (superficial) and the "
       "Schiller-Naumann C_d switched to 0.44 above Re = 1000 (<=, as MFiX DRAG_WEN_YU; OpenFOAM "
-      "uses "
-      "<), i.e. F = (C_d Re/24) eps^-3.65. Grains3D's eps^-2.7 variant is not implemented.";
+      "uses <), i.e. F = (C_d Re/24) eps^-3.65. Grains3D's eps^-2.7 variant is not implemented.";
   d.parameters = {
       {"n", 2.65, "1", "voidage exponent: beta carries eps^-n (F carries eps^-(n+1))"},
   };
