@@ -18,11 +18,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "draglab/draglab.h"
+#include "draglab/drag_db/database.h"
 #include "draglab/drag_db/law.h"
 
 namespace {
@@ -78,12 +80,15 @@ int main(int argc, char** argv) {
   }
 
   // A throw-away database in the temp directory, seeded with the literature library.
-  char dir_template[] = "/tmp/draglab_bench_XXXXXX";
-  if (!mkdtemp(dir_template)) {
+  const char* tmpdir = std::getenv("TMPDIR");
+  std::string dir_template_s = std::string(tmpdir && *tmpdir ? tmpdir : "/tmp") + "/draglab_bench_XXXXXX";
+  std::vector<char> dir_template(dir_template_s.begin(), dir_template_s.end());
+  dir_template.push_back('\0');
+  if (!mkdtemp(dir_template.data())) {
     std::perror("mkdtemp");
     return 1;
   }
-  const std::string db_path = std::string(dir_template) + "/bench.db";
+  const std::string db_path = std::string(dir_template.data()) + "/bench.db";
   draglab_db* db = nullptr;
   draglab_law* c_law = nullptr;
   if (draglab_db_open(db_path.c_str(), &db) != 0 ||
@@ -91,7 +96,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: %s\n", draglab_last_error());
     return 1;
   }
-  draglab::Law law(draglab::literature_record(draglab::find_law_form(law_name)));
+  // The C++ path loads the same stored version through the C++ API.
+  draglab::Database cxx_db(db_path);
+  const std::shared_ptr<draglab::Law> loaded = cxx_db.load(law_name);
+  const draglab::Law& law = *loaded;
   const draglab::ValidityBox& box = law.record().validity;
 
   std::mt19937_64 rng(42);
@@ -142,6 +150,6 @@ int main(int argc, char** argv) {
   std::remove(db_path.c_str());
   std::remove((db_path + "-wal").c_str());
   std::remove((db_path + "-shm").c_str());
-  rmdir(dir_template);
+  rmdir(dir_template.data());
   return 0;
 }

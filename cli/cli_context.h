@@ -48,6 +48,8 @@ struct CliContext {
 
 /// Registers `draglab law ...` (law_commands.cc).
 void add_law_commands(CLI::App& app, CliContext& ctx);
+/// Registers `draglab pack ...` (pack_commands.cc).
+void add_pack_commands(CLI::App& app, CliContext& ctx);
 /// Registers `draglab db ...` (db_commands.cc).
 void add_db_commands(CLI::App& app, CliContext& ctx);
 

@@ -8,7 +8,7 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
-#include "codegen/export.h"
+#include "draglab/drag_db/export.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {

@@ -7,7 +7,11 @@
 //   draglab law diff bvk2007 tang2015
 //   draglab law export bvk2007@1 --format fortran -o bvk2007.f90
 //   draglab law compare
+//   draglab pack --phi 0.4 --n 1000 --seed 7 --out packing.h5
+//   draglab pack stats packing.h5 --json
 //   draglab db info --db my.db
+#include <unistd.h>
+
 #include <cstdio>
 #include <iostream>
 
@@ -21,10 +25,16 @@ namespace draglab {
 namespace cli {
 
 std::unique_ptr<Database> CliContext::open_database(bool read_only) const {
+  const std::string path = resolved_db_path();
+  // A shared, installed database the user cannot write: read it read-only rather than fail
+  // (commands that write then fail with a clear message from the database).
+  if (!read_only && ::access(path.c_str(), F_OK) == 0 && ::access(path.c_str(), W_OK) != 0) {
+    read_only = true;
+  }
   DatabaseOptions options;
   options.read_only = read_only;
   options.create_if_missing = !read_only;
-  return std::make_unique<Database>(resolved_db_path(), options);
+  return std::make_unique<Database>(path, options);
 }
 
 void CliContext::info(const std::string& message) const {
@@ -84,10 +94,12 @@ int main(int argc, char** argv) {
       "  draglab law list\n"
       "  draglab law eval bvk2007 --phi 0.3 --re 50\n"
       "  draglab law compare\n"
+      "  draglab pack --phi 0.4 --n 1000 --out packing.h5\n"
       "  draglab db info\n"
       "Exit codes: 0 success, 1 failure, 2 bad input.");
 
   draglab::cli::add_law_commands(app, ctx);
+  draglab::cli::add_pack_commands(app, ctx);
   draglab::cli::add_db_commands(app, ctx);
 
   try {

@@ -46,7 +46,7 @@ module draglab_mod
   end type draglab_law_t
 
   public :: draglab_version, draglab_last_error
-  public :: draglab_db_open, draglab_db_close
+  public :: draglab_db_open, draglab_db_open_readonly, draglab_db_close
   public :: draglab_law_load, draglab_law_free
   public :: draglab_law_name, draglab_law_version, draglab_law_form, draglab_law_hash
   public :: draglab_law_num_extra, draglab_law_validity
@@ -66,6 +66,13 @@ module draglab_mod
       type(c_ptr) :: s
     end function
     function c_draglab_db_open(path, db) bind(C, name='draglab_db_open') result(status)
+      import :: c_char, c_ptr, c_int
+      character(kind=c_char), intent(in) :: path(*)
+      type(c_ptr), intent(inout) :: db
+      integer(c_int) :: status
+    end function
+    function c_draglab_db_open_readonly(path, db) bind(C, name='draglab_db_open_readonly') &
+        result(status)
       import :: c_char, c_ptr, c_int
       character(kind=c_char), intent(in) :: path(*)
       type(c_ptr), intent(inout) :: db
@@ -265,6 +272,20 @@ contains
     status = c_draglab_db_open(to_c_string(path), handle)
     if (status == DRAGLAB_OK) db%handle = handle
   end function draglab_db_open
+
+  ! Opens an existing database read-only (a shared installation the solver cannot write): never
+  ! writes, creates, migrates or seeds it. In a directory without write permission the file is
+  ! read as immutable (changes made while it is open are not seen). A missing file gives
+  ! DRAGLAB_NOT_FOUND; path '' -> $DRAGLAB_DB, else ./draglab.db.
+  function draglab_db_open_readonly(path, db) result(status)
+    character(len=*), intent(in) :: path
+    type(draglab_db_t), intent(inout) :: db
+    integer(c_int) :: status
+    type(c_ptr) :: handle
+    handle = c_null_ptr
+    status = c_draglab_db_open_readonly(to_c_string(path), handle)
+    if (status == DRAGLAB_OK) db%handle = handle
+  end function draglab_db_open_readonly
 
   subroutine draglab_db_close(db)
     type(draglab_db_t), intent(inout) :: db

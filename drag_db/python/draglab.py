@@ -104,6 +104,8 @@ def _declare(name, restype, *argtypes):
 _version = _declare("draglab_version", ctypes.c_char_p)
 _last_error = _declare("draglab_last_error", ctypes.c_char_p)
 _db_open = _declare("draglab_db_open", ctypes.c_int, ctypes.c_char_p, ctypes.POINTER(_db_p))
+_db_open_readonly = _declare("draglab_db_open_readonly", ctypes.c_int, ctypes.c_char_p,
+                             ctypes.POINTER(_db_p))
 _db_close = _declare("draglab_db_close", None, _db_p)
 _law_load = _declare("draglab_law_load", ctypes.c_int, _db_p, ctypes.c_char_p,
                      ctypes.POINTER(_law_p))
@@ -190,12 +192,18 @@ class Database:
 
     Database(path=None) opens, creating and seeding the literature library if missing;
     path None or "" -> $DRAGLAB_DB, else ./draglab.db.
+    Database(path, read_only=True) opens an existing file read-only (draglab_db_open_readonly):
+    nothing is written, created, migrated or seeded, and a file and directory without write
+    permission can be read (in a directory without write permission the file is read as
+    immutable: changes made while it is open are not seen). A missing file raises NOT_FOUND.
     """
 
-    def __init__(self, path=None):
+    def __init__(self, path=None, read_only=False):
+        self._handle = None
         handle = _db_p()
         encoded = None if path is None else os.fsencode(path)
-        _check(_db_open(encoded, ctypes.byref(handle)))
+        opener = _db_open_readonly if read_only else _db_open
+        _check(opener(encoded, ctypes.byref(handle)))
         self._handle = handle
 
     def load(self, reference, range_policy=None):

@@ -279,7 +279,8 @@ double Law::dga(double eps_g, double mu_g, double rho_g, double slip, double d_p
                 const double* extra) const {
   const double re = checked_reynolds(reference(), eps_g, mu_g, rho_g, slip, d_p);
   const double phi = 1.0 - eps_g;
-  return 18.0 * mu_g * eps_g * F(phi, re, extra) / (d_p * d_p);
+  // Same operations, in the same order, as the exported _dga functions (codegen/export.cc).
+  return eps_g * F(phi, re, extra) * 18.0 * (mu_g / (d_p * d_p));
 }
 
 }  // namespace draglab

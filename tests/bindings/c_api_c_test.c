@@ -25,14 +25,16 @@ int main(int argc, char** argv) {
   double F = -1.0, values[3];
   const double phi[3] = {0.1, 0.4, 0.6};
   const double re[3] = {0.0, 100.0, 1000.0};
-  char wal[4096];
+  char wal[4096], shm[4096];
   if (argc != 2) {
     fprintf(stderr, "usage: c_api_c_test DATABASE_PATH\n");
     return 2;
   }
   remove(argv[1]);
   snprintf(wal, sizeof wal, "%s-wal", argv[1]);
+  snprintf(shm, sizeof shm, "%s-shm", argv[1]);
   remove(wal);
+  remove(shm);
   expect(draglab_db_open(argv[1], &db) == DRAGLAB_OK, "open a fresh database");
   if (db == NULL) return 1;
   expect(draglab_law_load(db, "bvk2007", &law) == DRAGLAB_OK, "load bvk2007 (latest)");
@@ -52,6 +54,23 @@ int main(int argc, char** argv) {
          "array value equals scalar value");
   draglab_law_free(law);
   draglab_db_close(db);
+  /* The same file read-only, as a solver reading a shared installation. */
+  db = NULL;
+  law = NULL;
+  expect(draglab_db_open_readonly(argv[1], &db) == DRAGLAB_OK, "open read-only");
+  expect(db != NULL && draglab_law_load(db, "bvk2007@1", &law) == DRAGLAB_OK,
+         "load bvk2007@1 read-only");
+  expect(law != NULL && draglab_law_F(law, 0.4, 100.0, &F) == DRAGLAB_OK &&
+             fabs(F - 30.7416) <= 1e-5 * 30.7416,
+         "F(0.4, 100) = 30.7416 read-only");
+  draglab_law_free(law);
+  draglab_db_close(db);
+  remove(argv[1]);
+  remove(wal);
+  remove(shm);
+  db = NULL;
+  expect(draglab_db_open_readonly(argv[1], &db) == DRAGLAB_NOT_FOUND && db == NULL,
+         "a missing file is not created by a read-only open");
   remove(argv[1]);
   if (failures > 0) return 1;
   printf("c_api_c_test: all checks passed\n");

@@ -1,5 +1,7 @@
 // The C ABI (draglab.h) seen from a C++ caller: statuses, messages, null pointers, range
-// policies, the array paths, the dimensional entry points and thread-local errors.
+// policies, the array paths, the dimensional entry points, thread-local errors, and read-only
+// opens of an installation the caller cannot write (file 0444 in a directory 0555; as root,
+// which ignores permissions, that check runs in a child dropped to uid/gid 65534).
 //
 // Set-up: a fresh database in a temporary folder, seeded with the literature library; the law
 // under test is bvk2007@1 (Beetstra, van der Hoef & Kuipers 2007, AIChE J. 53:489).
@@ -8,13 +10,20 @@
 // section 2.4 and its law_check_values.csv, 6 significant figures). Identities between F, K,
 // beta and lDgA are the canonical conversions of the brief (beta = 18 mu phi eps F / d^2,
 // K = F/(1 - phi), lDgA = beta/phi).
+#include <grp.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -217,6 +226,153 @@ TEST(CApiDatabase, ACorruptFileIsNotADatabase) {
   EXPECT_EQ(db, nullptr);
   EXPECT_GT(std::string(draglab_last_error()).size(), 0u);
   fs::remove_all(dir);
+}
+
+// ---- read-only opens: a solver reading a shared installation it cannot write ---------------
+
+constexpr uid_t kNobody = 65534;
+
+// Runs `check` ("" = passed, else what failed) as an unprivileged user: as root (which ignores
+// file permissions) in a forked child that drops to uid/gid 65534 without supplementary groups,
+// as `setpriv --reuid=65534 --regid=65534 --clear-groups` does; otherwise in this process.
+std::string run_unprivileged(const std::function<std::string()>& check) {
+  if (geteuid() != 0) return check();
+  int fds[2];
+  if (pipe(fds) != 0) return "pipe() failed";
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) return "fork() failed";
+  if (pid == 0) {
+    close(fds[0]);
+    const std::string result =
+        (setgroups(0, nullptr) != 0 || setresgid(kNobody, kNobody, kNobody) != 0 ||
+         setresuid(kNobody, kNobody, kNobody) != 0)
+            ? "cannot drop privileges to uid/gid 65534"
+            : check();
+    const ssize_t ignored = write(fds[1], result.data(), result.size());
+    (void)ignored;
+    _exit(result.empty() ? 0 : 1);  // no atexit handlers, no gtest output from the child
+  }
+  close(fds[1]);
+  std::string result;
+  char buffer[512];
+  ssize_t n;
+  while ((n = read(fds[0], buffer, sizeof buffer)) > 0) result.append(buffer, n);
+  close(fds[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  if (!WIFEXITED(status)) return "the unprivileged child did not exit normally: " + result;
+  if (WEXITSTATUS(status) != 0 && result.empty()) return "the unprivileged child failed";
+  return result;
+}
+
+// Size, modification time and bytes of a file: what "nothing was written" compares.
+std::string file_fingerprint(const fs::path& path) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) return "missing";
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return std::to_string(st.st_size) + " bytes, mtime " + std::to_string(st.st_mtim.tv_sec) + "." +
+         std::to_string(st.st_mtim.tv_nsec) + ", content hash " +
+         std::to_string(std::hash<std::string>()(bytes));
+}
+
+std::vector<std::string> directory_entries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A seeded database closed (its WAL folded into the file), then made read-only the way a shared
+// installation is: file 0444 in a directory 0555.
+class CApiReadOnly : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fresh_dir();
+    path_ = dir_ / "shared.db";
+    draglab_db* db = nullptr;
+    ASSERT_EQ(draglab_db_open(path_.c_str(), &db), DRAGLAB_OK) << draglab_last_error();
+    draglab_db_close(db);
+    ASSERT_FALSE(fs::exists(path_.string() + "-wal"));
+    ASSERT_EQ(chmod(path_.c_str(), 0444), 0);
+    ASSERT_EQ(chmod(dir_.c_str(), 0555), 0);
+    fingerprint_ = file_fingerprint(path_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir_, ec);
+  }
+
+  // Opens read-only, loads bvk2007@1 and checks F(0.4, 100); returns what failed.
+  std::string read_through_the_abi() const {
+    draglab_db* db = nullptr;
+    if (draglab_db_open_readonly(path_.c_str(), &db) != DRAGLAB_OK) {
+      return std::string("draglab_db_open_readonly: ") + draglab_last_error();
+    }
+    draglab_law* law = nullptr;
+    std::string failures;
+    if (draglab_law_load(db, "bvk2007@1", &law) != DRAGLAB_OK) {
+      failures = std::string("load: ") + draglab_last_error();
+    } else {
+      double F = kUntouched;
+      if (draglab_law_F(law, 0.4, 100.0, &F) != DRAGLAB_OK ||
+          !(std::fabs(F - 30.7416) <= kCheckValueTolerance * 30.7416)) {
+        failures = "F(0.4, 100) = " + std::to_string(F) + ", expected 30.7416";
+      }
+      draglab_law_free(law);
+    }
+    draglab_db_close(db);
+    return failures;
+  }
+
+  fs::path dir_;
+  fs::path path_;
+  std::string fingerprint_;
+};
+
+TEST_F(CApiReadOnly, ReadsWithoutWritingTheFile) {
+  EXPECT_EQ(read_through_the_abi(), "");
+  EXPECT_EQ(file_fingerprint(path_), fingerprint_);
+}
+
+TEST_F(CApiReadOnly, UnprivilegedSolverReadsAnInstallationItCannotWrite) {
+  const std::vector<std::string> entries = directory_entries(dir_);
+  const std::string failure = run_unprivileged([&]() -> std::string {
+    if (access(dir_.c_str(), W_OK) == 0) return "the 0555 directory is writable: no test";
+    std::string failures = read_through_the_abi();
+    if (directory_entries(dir_) != entries) failures += "; files were created next to it";
+    // The read-write open is refused with a clear status.
+    draglab_db* db = nullptr;
+    if (draglab_db_open(path_.c_str(), &db) != DRAGLAB_DATABASE_ERROR) {
+      failures += "; the read-write open was not refused";
+      draglab_db_close(db);
+    }
+    return failures;
+  });
+  EXPECT_EQ(failure, "");
+  EXPECT_EQ(file_fingerprint(path_), fingerprint_);
+}
+
+TEST_F(CApiReadOnly, BadPathsGiveTheirStatus) {
+  // A missing file is not created.
+  const fs::path absent = dir_ / "absent.db";
+  draglab_db* db = nullptr;
+  EXPECT_EQ(draglab_db_open_readonly(absent.c_str(), &db), DRAGLAB_NOT_FOUND);
+  EXPECT_NE(std::string(draglab_last_error()).find(absent.string()), std::string::npos)
+      << draglab_last_error();
+  EXPECT_EQ(db, nullptr);
+  EXPECT_FALSE(fs::exists(absent));
+  // A directory, or a directory that does not exist, is bad input.
+  EXPECT_EQ(draglab_db_open_readonly(dir_.c_str(), &db), DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(draglab_db_open_readonly((dir_ / "nowhere" / "x.db").c_str(), &db),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(draglab_last_error()).find("nowhere"), std::string::npos);
+  EXPECT_EQ(db, nullptr);
+  EXPECT_EQ(draglab_db_open_readonly(path_.c_str(), nullptr), DRAGLAB_INVALID_ARGUMENT);
 }
 
 TEST_F(CApi, LawOutlivesItsDatabase) {

@@ -32,7 +32,7 @@
 #include <string>
 #include <vector>
 
-#include "codegen/export.h"
+#include "draglab/drag_db/export.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/drag_db/law_form.h"

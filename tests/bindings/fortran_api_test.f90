@@ -9,7 +9,7 @@
 ! (tolerance 1e-13 relative: a few rounding errors in a different order of operations).
 ! Exits with status 1 if any check fails.
 program fortran_api_test
-  use, intrinsic :: iso_c_binding, only: c_double, c_int, c_long_long
+  use, intrinsic :: iso_c_binding, only: c_double, c_int, c_long_long, c_associated
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use draglab_mod
   implicit none
@@ -129,7 +129,19 @@ program fortran_api_test
                      'evaluation after closing the database')
   call expect_close(F, 30.7416_c_double, 1.0e-5_c_double, 'same value after closing')
   call draglab_law_free(law)
+
+  ! The same file read-only, as a solver reading a shared installation it cannot write.
+  call expect_status(draglab_db_open_readonly(trim(path), db), DRAGLAB_OK, 'open read-only')
+  call expect_status(draglab_law_load(db, 'bvk2007@1', law), DRAGLAB_OK, 'load read-only')
+  call expect_status(draglab_law_F(law, 0.4_c_double, 100.0_c_double, F), DRAGLAB_OK, &
+                     'F read-only')
+  call expect_close(F, 30.7416_c_double, 1.0e-5_c_double, 'F(0.4, 100) = 30.7416 read-only')
+  call draglab_law_free(law)
+  call draglab_db_close(db)
   call delete_file(trim(path))
+  call expect_status(draglab_db_open_readonly(trim(path), db), DRAGLAB_NOT_FOUND, &
+                     'a read-only open does not create a missing file')
+  call expect_true(.not. c_associated(db%handle), 'no handle for a missing file')
 
   if (failures > 0) then
     print '(I0, A)', failures, ' check(s) failed'

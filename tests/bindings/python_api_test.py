@@ -7,6 +7,10 @@ coefficients (reference dossier drag_laws.md section 2.4 and its law_check_value
 significant figures): tolerance 1e-5 relative covers that rounding. beta is checked against the
 canonical identity beta = 18 mu phi eps F / d^2 (1e-13 relative: a few rounding errors).
 
+Read-only opens: a database file 0444 in a directory 0555 is read without being written (size,
+modification time and bytes unchanged); run as root (which ignores permissions), the check is
+repeated as nobody through `setpriv --reuid=65534 --regid=65534 --clear-groups`.
+
 Environment: DRAGLAB_PYTHON_DIR (folder of draglab.py) and DRAGLAB_LIBRARY (path of libdraglab).
 Runs with the standard library only; numpy is exercised if it can be imported.
 """
@@ -14,6 +18,8 @@ Runs with the standard library only; numpy is exercised if it can be imported.
 import array
 import math
 import os
+import shutil
+import subprocess
 import sys
 import tempfile
 import threading
@@ -166,6 +172,78 @@ class PythonApiTest(unittest.TestCase):
         with self.assertRaises(draglab.DraglabError) as caught:
             draglab.Database(path)
         self.assertEqual(caught.exception.code, draglab.NOT_A_DATABASE)
+
+    def _read_only_installation(self):
+        """A closed database made read-only like a shared installation: file 0444 in a directory
+        0555 (inside a directory others may enter). Returns the database path."""
+        shared = os.path.join(self.tmp.name, "shared")
+        os.mkdir(shared)
+        path = os.path.join(shared, "shared.db")
+        draglab.Database(path).close()
+        os.chmod(path, 0o444)
+        os.chmod(shared, 0o555)
+        os.chmod(self.tmp.name, 0o755)
+        return path
+
+    @staticmethod
+    def _fingerprint(path):
+        """Size, modification time (ns) and bytes: what "nothing was written" compares."""
+        st = os.stat(path)
+        with open(path, "rb") as f:
+            return st.st_size, st.st_mtime_ns, f.read()
+
+    def test_read_only(self):
+        path = self._read_only_installation()
+        before = self._fingerprint(path)
+        with draglab.Database(path, read_only=True) as db:
+            with db.load("bvk2007@1") as law:
+                self.assertEqual(law.F(0.4, 100.0), self.law.F(0.4, 100.0))
+        self.assertEqual(self._fingerprint(path), before)
+        missing = os.path.join(self.tmp.name, "absent.db")
+        with self.assertRaises(draglab.DraglabError) as caught:
+            draglab.Database(missing, read_only=True)
+        self.assertEqual(caught.exception.code, draglab.NOT_FOUND)
+        self.assertIn(missing, caught.exception.message)
+        self.assertFalse(os.path.exists(missing))
+        with self.assertRaises(draglab.DraglabError) as caught:
+            draglab.Database(os.path.join(self.tmp.name, "nowhere", "x.db"), read_only=True)
+        self.assertEqual(caught.exception.code, draglab.INVALID_ARGUMENT)
+
+    @unittest.skipUnless(hasattr(os, "geteuid") and os.geteuid() == 0 and shutil.which("setpriv"),
+                         "needs root and setpriv to run a check as an unprivileged user")
+    def test_read_only_as_an_unprivileged_user(self):
+        # Root ignores file permissions: the solver's view is checked as nobody (uid/gid 65534).
+        path = self._read_only_installation()
+        before = self._fingerprint(path)
+        entries = sorted(os.listdir(os.path.dirname(path)))
+        script = (
+            "import os, sys\n"
+            "sys.path.insert(0, os.environ['DRAGLAB_TEST_MODULE_DIR'])\n"
+            "import draglab\n"
+            "path = sys.argv[1]\n"
+            "assert not os.access(os.path.dirname(path), os.W_OK), 'directory is writable'\n"
+            "with draglab.Database(path, read_only=True) as db:\n"
+            "    print(repr(db.load('bvk2007@1').F(0.4, 100.0)))\n"
+            "try:\n"
+            "    draglab.Database(path)\n"
+            "    print('read-write open was not refused')\n"
+            "except draglab.DraglabError as e:\n"
+            "    print('refused', e.code)\n")
+        env = dict(os.environ)
+        env["DRAGLAB_TEST_MODULE_DIR"] = os.path.dirname(os.path.abspath(draglab.__file__))
+        env["DRAGLAB_LIBRARY"] = draglab.library_path
+        result = subprocess.run(
+            ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", sys.executable,
+             "-c", script, path], env=env, cwd="/", stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT, universal_newlines=True)
+        if result.returncode != 0 and "cannot load libdraglab" in result.stdout:
+            self.skipTest("nobody cannot read the library: " + result.stdout)
+        self.assertEqual(result.returncode, 0, result.stdout)
+        lines = result.stdout.split()
+        self.assertEqual(float(lines[0]), self.law.F(0.4, 100.0), result.stdout)
+        self.assertEqual(lines[1:], ["refused", str(draglab.DATABASE_ERROR)], result.stdout)
+        self.assertEqual(self._fingerprint(path), before)
+        self.assertEqual(sorted(os.listdir(os.path.dirname(path))), entries)
 
     def test_threads_share_a_law(self):
         points = [(0.1 + 0.05 * (i % 10), 10.0 * i) for i in range(50)]

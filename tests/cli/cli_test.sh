@@ -88,6 +88,28 @@ check "not a database" 2 "$draglab" --db "$work/bad.db" law list
 grep -q "bad.db" "$work/err" || { echo "FAIL: corrupt db message does not name the file"; failures=$((failures + 1)); }
 check "db check" 0 "$draglab" db check
 
+# Packings: generation, statistics, bad input (exit 2, no file left behind).
+check "pack random" 0 "$draglab" pack --phi 0.3 --n 60 --seed 5 --sweeps 50 --out "$work/p.h5" --json
+json_check "pack json" "abs(j['phi'] - 0.3) < 1e-12 and j['n'] == 60 and j['overlapping_pairs'] == 0 and j['min_gap'] >= 0"
+check "pack stats" 0 "$draglab" pack stats "$work/p.h5" --json
+json_check "pack stats json" "set(('phi','n','min_gap','q6','g_contact')) <= set(j) and abs(j['phi'] - 0.3) < 1e-12"
+check "pack ordered fcc" 0 "$draglab" pack --ordered fcc --phi 0.5 --cells 2 --out "$work/f.h5" --json
+json_check "fcc q6 (Steinhardt FCC 0.5745)" "abs(j['q6'] - 0.57452) < 1e-4 and j['n'] == 32"
+check "pack voxelize" 0 "$draglab" pack voxelize "$work/p.h5" --resolution 8 --json
+json_check "voxelize json" "abs(j['phi_lattice'] - 0.3) < 0.05 and j['links'] > 0"
+check "pack ensemble" 0 "$draglab" pack ensemble --phi 0.2 --n 40 --sweeps 20 -R 2 --out-dir "$work/ens" --json
+json_check "ensemble json" "len(j) == 2 and j[0]['seed'] != j[1]['seed']"
+check "pack phi too high" 2 "$draglab" pack --phi 0.7 --n 100 --out "$work/bad1.h5"
+grep -q "0.64" "$work/err" || { echo "FAIL: random phi limit not named"; failures=$((failures + 1)); }
+check "pack sc above close packing" 2 "$draglab" pack --ordered sc --phi 0.6 --out "$work/bad2.h5"
+check "pack n < 1" 2 "$draglab" pack --phi 0.3 --n 0 --out "$work/bad3.h5"
+check "pack size ratio" 2 "$draglab" pack --phi 0.3 --n 50 --dist bi --size-ratio 6 --out "$work/bad4.h5"
+check "pack unwritable" 2 "$draglab" pack --phi 0.3 --n 50 --out "$work/no/such/dir/p.h5"
+check "pack stats missing file" 2 "$draglab" pack stats "$work/missing.h5"
+for f in bad1 bad2 bad3 bad4; do
+  ls "$work/$f.h5"* >/dev/null 2>&1 && { echo "FAIL: $f left a file"; failures=$((failures + 1)); }
+done
+
 # The main job.
 check "law compare" 0 "$draglab" law compare
 grep -q "bvk2007" "$work/out" || { echo "FAIL: compare table"; failures=$((failures + 1)); }

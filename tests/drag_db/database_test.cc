@@ -605,7 +605,8 @@ TEST(DatabaseOptionsAndPaths, ReadOnlyOpenReadsButRefusesWrites) {
   EXPECT_EQ(db.resolve("ro").version, 1);
   EXPECT_NO_THROW(db.load("ro@1"));
   EXPECT_EQ(code_of([&] { db.add_draft(bvk_record("ro")); }), ErrorCode::kDatabase);
-  EXPECT_EQ(code_of([&] { Database missing(dir.file("missing.db"), ro); }), ErrorCode::kDatabase);
+  EXPECT_EQ(code_of([&] { db.migrate(); }), ErrorCode::kDatabase);
+  EXPECT_EQ(code_of([&] { Database missing(dir.file("missing.db"), ro); }), ErrorCode::kNotFound);
   EXPECT_FALSE(fs::exists(dir.file("missing.db")));
 }
 

@@ -56,6 +56,12 @@ DRAGLAB_EXPORT const char* draglab_version(void);
 /* Opens (creating and seeding if missing) a database. path NULL or "" -> $DRAGLAB_DB, else
  * ./draglab.db. */
 DRAGLAB_EXPORT int draglab_db_open(const char* path, draglab_db** db);
+/* Opens an existing database read-only, for solvers reading a shared installation: never
+ * writes, creates, migrates or seeds it, and works on a file and directory the caller cannot
+ * write (in a directory it cannot write, the file is read as immutable: changes made while it is
+ * open are not seen). path NULL or "" as for draglab_db_open. A missing file gives
+ * DRAGLAB_NOT_FOUND, a missing directory or a directory as path DRAGLAB_INVALID_ARGUMENT. */
+DRAGLAB_EXPORT int draglab_db_open_readonly(const char* path, draglab_db** db);
 DRAGLAB_EXPORT void draglab_db_close(draglab_db* db);
 
 /* Loads "name", "name@3", "name@latest" or "name@<hash prefix>". A retracted (or draft) version

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "codegen/export.h"
+#include "draglab/drag_db/export.h"
 #include "drag_db_version.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
@@ -106,36 +106,18 @@ void check_rho_s(const draglab::Law& law, double rho_s) {
   }
 }
 
-/// The checks of Law::beta on the dimensional inputs (same messages).
-void check_dimensional(const draglab::Law& law, double eps_g, double mu_g, double rho_g,
-                       double slip, double d_p) {
-  auto positive = [&](double v, const char* name) {
-    if (!std::isfinite(v) || !(v > 0.0)) {
-      throw Error(ErrorCode::kInvalidArgument, law.reference() + ": " + name + " = " +
-                                                   format_value(v) + " must be finite and > 0");
-    }
-  };
-  if (!std::isfinite(eps_g) || !(eps_g > 0.0) || eps_g > 1.0) {
-    throw Error(ErrorCode::kInvalidArgument,
-                law.reference() + ": eps_g = " + format_value(eps_g) + " is outside (0, 1]");
-  }
-  positive(mu_g, "mu_g");
-  positive(rho_g, "rho_g");
-  positive(d_p, "d_p");
-  if (!std::isfinite(slip) || slip < 0.0) {
-    throw Error(ErrorCode::kInvalidArgument,
-                law.reference() + ": slip = " + format_value(slip) + " must be finite and >= 0");
-  }
-}
-
-/// MFiX's lDgA = beta / phi = 18 mu_g eps_g F / d_p^2, written without dividing by phi so that it
-/// is finite at phi = 0; the same operations as the exported _dga functions.
-double dga(const draglab::Law& law, double eps_g, double mu_g, double rho_g, double slip,
-           double d_p) {
-  check_dimensional(law, eps_g, mu_g, rho_g, slip, d_p);
-  const double phi = 1.0 - eps_g;
-  const double re = draglab::conventions::reynolds(eps_g, mu_g, rho_g, slip, d_p);
-  return eps_g * law.F(phi, re) * 18.0 * (mu_g / (d_p * d_p));
+/// Opens `path` ($DRAGLAB_DB or ./draglab.db if NULL or "") with `options` into *db.
+int open_database(const char* function, const char* path, const draglab::DatabaseOptions& options,
+                  draglab_db** db) {
+  return guarded([&] {
+    if (db == nullptr)
+      throw Error(ErrorCode::kInvalidArgument, std::string(function) + ": db is NULL");
+    const std::string file =
+        (path == nullptr || path[0] == '\0') ? draglab::Database::default_path() : path;
+    auto handle = std::make_unique<draglab_db>();
+    handle->db = std::make_unique<draglab::Database>(file, options);
+    *db = handle.release();
+  });
 }
 
 }  // namespace
@@ -145,14 +127,14 @@ extern "C" {
 const char* draglab_version(void) { return draglab::kDragDbVersion; }
 
 int draglab_db_open(const char* path, draglab_db** db) {
-  if (db == nullptr) return fail(DRAGLAB_INVALID_ARGUMENT, "draglab_db_open: db is NULL");
-  return guarded([&] {
-    const std::string file =
-        (path == nullptr || path[0] == '\0') ? draglab::Database::default_path() : path;
-    auto handle = std::make_unique<draglab_db>();
-    handle->db = std::make_unique<draglab::Database>(file);
-    *db = handle.release();
-  });
+  return open_database("draglab_db_open", path, draglab::DatabaseOptions(), db);
+}
+
+int draglab_db_open_readonly(const char* path, draglab_db** db) {
+  draglab::DatabaseOptions options;
+  options.read_only = true;
+  options.create_if_missing = false;
+  return open_database("draglab_db_open_readonly", path, options, db);
 }
 
 void draglab_db_close(draglab_db* db) {
@@ -349,7 +331,7 @@ int draglab_law_dga(const draglab_law* law, double eps_g, double mu_g, double rh
     const draglab::Law& l = law_of(law, "draglab_law_dga");
     require(dga_out != nullptr, "draglab_law_dga: dga is NULL");
     check_rho_s(l, rho_s);
-    *dga_out = dga(l, eps_g, mu_g, rho_g, slip, d_p);
+    *dga_out = l.dga(eps_g, mu_g, rho_g, slip, d_p);
   });
 }
 

@@ -6,7 +6,7 @@
 // exactly those of the library. A select(c, a, b) becomes an if/else block whose arms hold the
 // nodes only that arm needs (each node lives in the innermost block that encloses all its uses),
 // so an unselected arm is never evaluated.
-#include "codegen/export.h"
+#include "draglab/drag_db/export.h"
 
 #include <algorithm>
 #include <cmath>

@@ -470,11 +470,121 @@ void verify_content_hash(const LawRecord& r) {
 
 bool file_exists(const std::string& path, struct stat* st) { return ::stat(path.c_str(), st) == 0; }
 
+bool file_exists(const std::string& path) {
+  struct stat st {};
+  return file_exists(path, &st);
+}
+
+// True if `path` exists and holds at least one byte (a -wal or -journal file with content).
+bool file_has_content(const std::string& path) {
+  struct stat st {};
+  return file_exists(path, &st) && st.st_size > 0;
+}
+
 std::string parent_directory(const std::string& path) {
   const std::size_t slash = path.find_last_of('/');
   if (slash == std::string::npos) return ".";
   if (slash == 0) return "/";
   return path.substr(0, slash);
+}
+
+// `path` as an SQLite URI filename ("file:..."), with every byte outside [A-Za-z0-9/._~-]
+// percent-encoded so that '?', '#' and '%' in a file name are not read as URI syntax. An absolute
+// path gets an empty authority ("file:///abs"), so that one starting with "//" is not read as a
+// host name.
+std::string sqlite_uri(const std::string& path, const std::string& query) {
+  std::string out = path.empty() || path[0] != '/' ? "file:" : "file://";
+  for (const char ch : path) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (std::isalnum(c) != 0 || c == '/' || c == '.' || c == '_' || c == '~' || c == '-') {
+      out += ch;
+    } else {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", c);
+      out += hex;
+    }
+  }
+  return out + "?" + query;
+}
+
+// Checks `path` before SQLite sees it, so that the cases SQLite reports only as "unable to open
+// database file" get a message naming the path and the right ErrorCode.
+void check_database_path(const std::string& path, const DatabaseOptions& options) {
+  const bool read_only = options.read_only || options.immutable;
+  struct stat st {};
+  if (file_exists(path, &st)) {
+    if (S_ISDIR(st.st_mode)) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  in_quotes(path) + " is a directory, not a draglab database file");
+    }
+    if (!S_ISREG(st.st_mode)) {
+      throw Error(ErrorCode::kNotADatabase,
+                  in_quotes(path) + " is not a regular file, so not a draglab database");
+    }
+    if (!read_only && ::access(path.c_str(), W_OK) != 0) {
+      throw Error(ErrorCode::kDatabase, "database " + in_quotes(path) + " is not writable (" +
+                                            std::strerror(errno) +
+                                            "); open it read-only to read it");
+    }
+    return;
+  }
+  if (errno != ENOENT && errno != ENOTDIR) {
+    throw Error(ErrorCode::kDatabase,
+                "cannot access database " + in_quotes(path) + ": " + std::strerror(errno));
+  }
+  const std::string parent = parent_directory(path);
+  struct stat parent_st {};
+  if (!file_exists(parent, &parent_st)) {
+    if (errno != ENOENT && errno != ENOTDIR) {
+      throw Error(ErrorCode::kDatabase, "cannot open database " + in_quotes(path) +
+                                            ": cannot access directory " + in_quotes(parent) +
+                                            " (" + std::strerror(errno) + ")");
+    }
+    throw Error(ErrorCode::kInvalidArgument, "cannot open database " + in_quotes(path) +
+                                                 ": directory " + in_quotes(parent) +
+                                                 " does not exist");
+  }
+  if (!S_ISDIR(parent_st.st_mode)) {
+    throw Error(ErrorCode::kInvalidArgument, "cannot open database " + in_quotes(path) + ": " +
+                                                 in_quotes(parent) + " is not a directory");
+  }
+  if (read_only || !options.create_if_missing) {
+    throw Error(ErrorCode::kNotFound, "database file " + in_quotes(path) + " does not exist" +
+                                          (read_only ? " (a read-only open does not create it)"
+                                                     : " (create_if_missing is off)"));
+  }
+  if (::access(parent.c_str(), W_OK) != 0) {
+    throw Error(ErrorCode::kDatabase, "cannot create database " + in_quotes(path) + ": directory " +
+                                          in_quotes(parent) + " is not writable (" +
+                                          std::strerror(errno) + ")");
+  }
+}
+
+// Whether a read-only open of `path` must use SQLite's immutable=1. A read-only connection to a
+// WAL file uses the -wal file and the -shm index next to it, creating them if they are missing
+// (SQLite 3.22+). In a directory the caller cannot write, a missing one cannot be created and
+// the open fails; the file can then only be read immutable. That is safe exactly when no
+// write-ahead log or rollback journal holds content: nobody can be writing (a writer would need
+// to create one of them in that directory) and the file itself is complete. Otherwise throws
+// kDatabase saying what to do.
+bool needs_immutable_open(const std::string& path) {
+  const std::string parent = parent_directory(path);
+  if (::access(parent.c_str(), W_OK) == 0) return false;
+  if (file_exists(path + "-shm") && file_exists(path + "-wal")) return false;
+  const std::string log = file_has_content(path + "-wal")       ? path + "-wal"
+                          : file_has_content(path + "-journal") ? path + "-journal"
+                                                                : "";
+  if (!log.empty()) {
+    throw Error(ErrorCode::kDatabase,
+                "cannot open database " + in_quotes(path) + " read-only: " + in_quotes(log) +
+                    " holds changes not yet written into the database file, and SQLite cannot "
+                    "create the -wal/-shm files it needs to read them because directory " +
+                    in_quotes(parent) +
+                    " is not writable; ask its owner to open the database read-write once (which "
+                    "folds the changes into the file), or copy the database and that file to a "
+                    "writable directory");
+  }
+  return true;
 }
 
 }  // namespace
@@ -538,51 +648,20 @@ Database::Database(const std::string& path, const DatabaseOptions& options) : pa
                 "./draglab.db)");
   }
   const bool in_memory = path == ":memory:";
-  const bool read_only = options.read_only;
+  read_only_ = options.read_only || options.immutable;
+  if (!in_memory) check_database_path(path, options);
+  immutable_ = !in_memory && (options.immutable || (read_only_ && needs_immutable_open(path)));
 
-  // Clear messages for the cases SQLite reports only as "unable to open database file".
-  if (!in_memory) {
-    struct stat st {};
-    if (file_exists(path, &st)) {
-      if (S_ISDIR(st.st_mode)) {
-        throw Error(ErrorCode::kDatabase,
-                    in_quotes(path) + " is a directory, not a draglab database file");
-      }
-      if (!S_ISREG(st.st_mode)) {
-        throw Error(ErrorCode::kNotADatabase,
-                    in_quotes(path) + " is not a regular file, so not a draglab database");
-      }
-      if (!read_only && ::access(path.c_str(), W_OK) != 0) {
-        throw Error(ErrorCode::kDatabase, "database " + in_quotes(path) + " is not writable (" +
-                                              std::strerror(errno) +
-                                              "); open it read-only to read it");
-      }
-    } else if (errno == ENOENT) {
-      if (read_only || !options.create_if_missing) {
-        throw Error(ErrorCode::kDatabase, "database file " + in_quotes(path) + " does not exist" +
-                                              (read_only ? " (a read-only open does not create it)"
-                                                         : " (create_if_missing is off)"));
-      }
-      const std::string parent = parent_directory(path);
-      struct stat parent_st {};
-      if (!file_exists(parent, &parent_st) || !S_ISDIR(parent_st.st_mode)) {
-        throw Error(ErrorCode::kDatabase, "cannot create database " + in_quotes(path) +
-                                              ": directory " + in_quotes(parent) +
-                                              " does not exist");
-      }
-      if (::access(parent.c_str(), W_OK) != 0) {
-        throw Error(ErrorCode::kDatabase, "cannot create database " + in_quotes(path) +
-                                              ": directory " + in_quotes(parent) +
-                                              " is not writable (" + std::strerror(errno) + ")");
-      }
-    } else {
-      throw Error(ErrorCode::kDatabase,
-                  "cannot access database " + in_quotes(path) + ": " + std::strerror(errno));
-    }
-  }
-
-  const int flags = read_only ? SQLITE_OPEN_READONLY : (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
-  const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr);
+  // A file is opened through a URI so that mode=ro and immutable=1 can be given; ":memory:" is
+  // SQLite's special name and stays as it is.
+  const std::string name = in_memory    ? path
+                           : immutable_ ? sqlite_uri(path, "mode=ro&immutable=1")
+                           : read_only_ ? sqlite_uri(path, "mode=ro")
+                                        : sqlite_uri(path, "mode=rwc");
+  const int flags =
+      (read_only_ ? SQLITE_OPEN_READONLY : (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE)) |
+      SQLITE_OPEN_URI;
+  const int rc = sqlite3_open_v2(name.c_str(), &db_, flags, nullptr);
   if (rc != SQLITE_OK) {
     const std::string message = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);
     sqlite3_close(db_);
@@ -596,10 +675,20 @@ Database::Database(const std::string& path, const DatabaseOptions& options) : pa
     // Reading the schema is the first access to the file's content: a file that is not SQLite
     // or whose first page is corrupt fails here (kNotADatabase).
     int table_count = 0;
-    {
+    try {
       Statement s(db_, "SELECT count(*) FROM sqlite_schema");
       s.step();
       table_count = static_cast<int>(s.integer(0));
+    } catch (const Error& e) {
+      // A read-only connection to a WAL file also opens (or creates) the -wal and -shm files
+      // next to it; say so, since SQLite's own message ("unable to open database file",
+      // "attempt to write a readonly database") names neither.
+      if (!read_only_ || immutable_ || e.code() != ErrorCode::kDatabase) throw;
+      throw Error(ErrorCode::kDatabase,
+                  std::string(e.what()) + " (a read-only open of a WAL database also needs to " +
+                      "read or create " + in_quotes(path + "-wal") + " and " +
+                      in_quotes(path + "-shm") +
+                      "; check their permissions, or open it immutable if nothing writes to it)");
     }
     {
       Statement s(db_, "PRAGMA application_id");
@@ -628,7 +717,8 @@ Database::Database(const std::string& path, const DatabaseOptions& options) : pa
     }
 
     db::exec(db_, "PRAGMA foreign_keys = ON", "enabling foreign keys");
-    if (!read_only && !in_memory) {
+    // Read-only opens leave the journal mode alone: switching it writes the file header.
+    if (!read_only_ && !in_memory) {
       // WAL: readers keep a consistent snapshot and are never blocked by a committing writer.
       Statement s(db_, "PRAGMA journal_mode = WAL");
       s.step();
@@ -640,7 +730,7 @@ Database::Database(const std::string& path, const DatabaseOptions& options) : pa
       }
     }
 
-    if (!read_only && options.migrate && version < db::latest_schema_version()) {
+    if (!read_only_ && options.migrate && version < db::latest_schema_version()) {
       Transaction t(db_, Transaction::Kind::kWrite);
       // Re-read under the write lock: another process may have created or migrated the file.
       version = db::read_schema_version(db_);
@@ -665,13 +755,19 @@ int Database::schema_version() const { return db::read_schema_version(db_); }
 namespace {
 
 // Operations on laws need at least schema 1 (an empty file opened with migrate = false has 0).
+// Read-only opens read an older schema as it is (docs/database.md), so every read names the
+// schema version it needs.
 void require_schema(sqlite3* db, int minimum, const std::string& what) {
   const int version = db::read_schema_version(db);
   if (version < minimum) {
-    throw Error(ErrorCode::kDatabase, "database " + in_quotes(db::database_path(db)) +
-                                          " has schema version " + std::to_string(version) + ", " +
-                                          what + " needs version " + std::to_string(minimum) +
-                                          " or later: open it with migration enabled");
+    const bool read_only = sqlite3_db_readonly(db, "main") == 1;
+    throw Error(ErrorCode::kDatabase,
+                "database " + in_quotes(db::database_path(db)) + " has schema version " +
+                    std::to_string(version) + ", " + what + " needs version " +
+                    std::to_string(minimum) + " or later: " +
+                    (read_only ? "it is open read-only; run `draglab db migrate` on it (needs "
+                                 "write permission) to upgrade it"
+                               : "open it with migration enabled (`draglab db migrate`)"));
   }
 }
 

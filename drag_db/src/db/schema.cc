@@ -249,6 +249,54 @@ END;
 )sql";
 }
 
+// Version 3: no REPLACE conflict resolution against protected rows.
+//
+// INSERT OR REPLACE / UPDATE OR REPLACE (and REPLACE INTO) resolve a UNIQUE or PRIMARY KEY
+// conflict by deleting the row in the way, and SQLite fires no DELETE trigger for that deletion
+// unless PRAGMA recursive_triggers is on. Without these guards a published law could be swapped
+// for a draft copy (then edited and re-published) or silently deleted, and a history event
+// overwritten. Where REPLACE could reach a protected row:
+//   laws: id (INTEGER PRIMARY KEY, also written as rowid) and UNIQUE (name, version), by INSERT or
+//     by an UPDATE of a draft that moves its id, name or version onto a published/retracted row:
+//     laws_no_replace_insert and laws_no_replace_update below. The update guard has no column
+//     list on purpose: "UPDATE ... SET rowid = ..." changes id without naming it, and an
+//     UPDATE OF id trigger would not fire.
+//   law_parameters, law_covariance, law_extra_inputs: every key starts with law_id, so the row in
+//     the way has the new row's law_id, and the version-1 guards already refuse any INSERT or
+//     UPDATE whose NEW.law_id is not a draft, before the conflict is resolved.
+//   law_events: id (INTEGER PRIMARY KEY) by INSERT (updates are refused outright):
+//     law_events_no_replace_insert. The history triggers never give an id.
+//   schema_version: not protected by triggers at all (migrations are recorded by draglab only).
+// The guards fire for a plain INSERT that collides too (it would fail on the constraint anyway):
+// a trigger cannot see the conflict clause, so the message says what the statement would do.
+std::string migration_3() {
+  const std::string protected_collision =
+      "SELECT id FROM laws WHERE status <> 'draft' AND "
+      "(id = NEW.id OR (name = NEW.name AND version = NEW.version))";
+  std::string sql;
+  sql += "CREATE TRIGGER laws_no_replace_insert BEFORE INSERT ON laws\nWHEN EXISTS (" +
+         protected_collision + ")\nBEGIN\n  " +
+         abort_naming_law("(" + protected_collision + " LIMIT 1)",
+                          "a new row with its id or name and version would replace it") +
+         "END;\n";
+  sql +=
+      "CREATE TRIGGER laws_no_replace_update BEFORE UPDATE ON laws\nWHEN (NEW.id IS NOT OLD.id "
+      "OR NEW.name IS NOT OLD.name OR NEW.version IS NOT OLD.version) AND EXISTS (" +
+      protected_collision + " AND id IS NOT OLD.id)\nBEGIN\n  " +
+      abort_naming_law("(" + protected_collision + " AND id IS NOT OLD.id LIMIT 1)",
+                       "an UPDATE giving another row its id or name and version would replace "
+                       "it") +
+      "END;\n";
+  sql += R"sql(
+CREATE TRIGGER law_events_no_replace_insert BEFORE INSERT ON law_events
+WHEN EXISTS (SELECT 1 FROM law_events WHERE id = NEW.id)
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: law_events is an append-only history and cannot be changed (an INSERT with the id of an existing event would replace it)');
+END;
+)sql";
+  return sql;
+}
+
 }  // namespace
 
 const std::vector<Migration>& migrations() {
@@ -256,6 +304,8 @@ const std::vector<Migration>& migrations() {
       {1, "law versions, parameters, covariance, extra inputs; immutability triggers",
        migration_1()},
       {2, "law_events: append-only history of every law version", migration_2()},
+      {3, "no REPLACE conflict resolution against published, retracted or history rows",
+       migration_3()},
   };
   return all;
 }
@@ -309,6 +359,12 @@ std::vector<std::string> expected_triggers(int schema_version) {
          {"law_events_on_insert", "law_events_on_draft_update", "law_events_on_publish",
           "law_events_on_retract", "law_events_on_delete", "law_events_append_only_update",
           "law_events_append_only_delete"}) {
+      names.push_back(name);
+    }
+  }
+  if (schema_version >= 3) {
+    for (const char* name :
+         {"laws_no_replace_insert", "laws_no_replace_update", "law_events_no_replace_insert"}) {
       names.push_back(name);
     }
   }

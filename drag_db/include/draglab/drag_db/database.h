@@ -2,8 +2,10 @@
 //
 // Holds every law version with its provenance (law.h: LawRecord). Published versions are
 // immutable, enforced by SQL triggers as well as here: any change is a new version. Retracted
-// versions stay loadable with a warning. The file is opened in WAL mode so readers keep working
-// while a writer commits; every write is one transaction (nothing is ever half-written).
+// versions stay loadable with a warning. A read-write open puts the file in WAL mode so readers
+// keep working while a writer commits; every write is one transaction (nothing is ever
+// half-written). A read-only open never writes the file (DatabaseOptions::read_only), so a solver
+// can read a shared installation it has no write permission on.
 //
 // References: "name" or "name@latest" (latest published version), "name@3" (version 3),
 // "name@<hex>" (the version whose content hash starts with <hex>, at least 4 digits).
@@ -26,9 +28,22 @@ namespace draglab {
 struct DatabaseOptions {
   bool create_if_missing = true;  ///< Create (and seed) a new file if none exists.
   bool seed_literature = true;    ///< Seed the literature library into a newly created file.
-  bool read_only = false;         ///< Open read-only (no migration, no seeding).
-  bool migrate = true;            ///< Apply forward migrations to an older schema on open.
-  int busy_timeout_ms = 5000;     ///< How long a writer waits for a lock before failing.
+  /// Open read-only: SQLite mode=ro; never creates, migrates, seeds or changes the journal mode,
+  /// never writes the database file, and works on a file (and directory) the caller cannot
+  /// write. SQLite's reader of a WAL file uses the -wal and -shm files next to it and creates
+  /// them where the directory allows (they may stay after closing). In a directory the caller
+  /// cannot write, without both of them, the file is opened immutable (see `immutable`) if no
+  /// -wal or -journal file holds changes, else Error(kDatabase) says what to do. A schema older
+  /// than this build's is read as it is: each read checks the schema version it needs and
+  /// otherwise says to run `draglab db migrate`.
+  bool read_only = false;
+  /// Open with SQLite's immutable=1 (implies read_only): no locks, no -wal/-shm files, nothing
+  /// written anywhere. Only for files nothing writes to while they are open (read-only media,
+  /// snapshots, shared installations): changes made by another connection are not seen, and a
+  /// file changed under an immutable reader can give wrong results or kNotADatabase.
+  bool immutable = false;
+  bool migrate = true;         ///< Apply forward migrations to an older schema on open.
+  int busy_timeout_ms = 5000;  ///< How long a writer waits for a lock before failing.
   bool IsValid(std::string* error) const;
 };
 
@@ -62,14 +77,22 @@ class Database {
   /// Default path: $DRAGLAB_DB if set and non-empty, else "./draglab.db".
   static std::string default_path();
 
-  /// Opens (creating, migrating and seeding as the options say). Throws Error: kNotADatabase for
-  /// a corrupt or non-SQLite file, kSchemaTooNew for a newer schema, kDatabase for I/O errors.
+  /// Opens (creating, migrating and seeding as the options say). Throws Error naming the path:
+  /// kInvalidArgument for an empty path, a directory, or a path whose directory does not exist;
+  /// kNotFound for a missing file that is not to be created (read_only or !create_if_missing);
+  /// kNotADatabase for a corrupt or non-SQLite file; kSchemaTooNew for a newer schema; kDatabase
+  /// for I/O and permission errors (e.g. a read-write open of a file the caller cannot write).
   explicit Database(const std::string& path, const DatabaseOptions& options = DatabaseOptions());
   ~Database();
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;
 
   const std::string& path() const { return path_; }
+  /// True if opened read-only (DatabaseOptions::read_only or immutable).
+  bool is_read_only() const { return read_only_; }
+  /// True if opened with SQLite's immutable=1: asked for, or the read-only fallback for a
+  /// directory the caller cannot write (DatabaseOptions). Concurrent writers are not seen.
+  bool is_immutable() const { return immutable_; }
   int schema_version() const;
   /// Applies forward migrations up to `target` (default: current); returns the versions applied.
   std::vector<int> migrate(int target = -1);
@@ -117,6 +140,8 @@ class Database {
  private:
   std::string path_;
   sqlite3* db_ = nullptr;
+  bool read_only_ = false;
+  bool immutable_ = false;
 };
 
 }  // namespace draglab

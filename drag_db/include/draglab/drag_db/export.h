@@ -1,6 +1,5 @@
 // Code export: a stored law version as standalone source for solvers that cannot link libdraglab
-// (`draglab law export NAME@V --format c|fortran|json`). Private to drag_db (the CLI and the
-// tests use it through draglab::drag_db_internal).
+// (`draglab law export NAME@V --format c|fortran|json`; C ABI: draglab_law_export).
 //
 // C and Fortran are generated from the symbolic trace of the law's own template formula
 // (law_form.h: F_symbolic), so the exported code performs the same floating-point operations in

@@ -1,0 +1,218 @@
+// Packings in HDF5 through the HDF5 C API (Debian's libhdf5 1.10).
+#include "draglab/arrays/packing_io.h"
+
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "drag_db_version.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace arrays {
+namespace {
+
+/// Closes an HDF5 identifier on scope exit.
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  hid_t get() const { return id_; }
+  bool ok() const { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+/// HDF5 prints its own error stack by default; we report our own messages instead.
+void silence_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw Error(ErrorCode::kInvalidArgument, "packing file '" + path + "': " + what);
+}
+
+void write_dataset(hid_t group, const char* name, const std::vector<hsize_t>& dims,
+                   const double* data, const std::string& path) {
+  Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose);
+  Handle set(H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT,
+                        H5P_DEFAULT),
+             H5Dclose);
+  if (!space.ok() || !set.ok() ||
+      H5Dwrite(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+    fail(path, std::string("cannot write dataset ") + name);
+  }
+}
+
+void write_attribute(hid_t object, const char* name, hid_t file_type, hid_t mem_type,
+                     const void* value, const std::string& path) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  Handle attr(H5Acreate2(object, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+              H5Aclose);
+  if (!attr.ok() || H5Awrite(attr.get(), mem_type, value) < 0) {
+    fail(path, std::string("cannot write attribute ") + name);
+  }
+}
+
+void write_double(hid_t o, const char* name, double v, const std::string& path) {
+  write_attribute(o, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &v, path);
+}
+
+void write_string(hid_t o, const char* name, const std::string& value, const std::string& path) {
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.get(), H5T_VARIABLE);
+  H5Tset_cset(type.get(), H5T_CSET_UTF8);
+  const char* c = value.c_str();
+  write_attribute(o, name, type.get(), type.get(), &c, path);
+}
+
+std::vector<double> read_dataset(hid_t group, const char* name, std::vector<hsize_t>* dims,
+                                 const std::string& path) {
+  if (H5Lexists(group, name, H5P_DEFAULT) <= 0) fail(path, std::string("no dataset /packing/") + name);
+  Handle set(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
+  Handle space(H5Dget_space(set.get()), H5Sclose);
+  if (!set.ok() || !space.ok()) fail(path, std::string("cannot open dataset ") + name);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  if (rank < 1 || rank > 2) fail(path, std::string("dataset ") + name + " has rank " + std::to_string(rank));
+  dims->assign(static_cast<std::size_t>(rank), 0);
+  H5Sget_simple_extent_dims(space.get(), dims->data(), nullptr);
+  hsize_t count = 1;
+  for (hsize_t d : *dims) count *= d;
+  std::vector<double> data(count);
+  if (count > 0 &&
+      H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0) {
+    fail(path, std::string("cannot read dataset ") + name + " as double");
+  }
+  return data;
+}
+
+bool read_string(hid_t o, const char* name, std::string* out) {
+  if (H5Aexists(o, name) <= 0) return false;
+  Handle attr(H5Aopen(o, name, H5P_DEFAULT), H5Aclose);
+  Handle type(H5Aget_type(attr.get()), H5Tclose);
+  if (!attr.ok() || !type.ok() || H5Tget_class(type.get()) != H5T_STRING) return false;
+  if (H5Tis_variable_str(type.get()) > 0) {
+    char* value = nullptr;
+    Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
+    H5Tset_size(mem.get(), H5T_VARIABLE);
+    H5Tset_cset(mem.get(), H5Tget_cset(type.get()));
+    if (H5Aread(attr.get(), mem.get(), &value) < 0) return false;
+    *out = value ? value : "";
+    Handle space(H5Aget_space(attr.get()), H5Sclose);
+    H5Dvlen_reclaim(mem.get(), space.get(), H5P_DEFAULT, &value);
+    return true;
+  }
+  const std::size_t size = H5Tget_size(type.get());
+  std::string value(size, '\0');
+  if (H5Aread(attr.get(), type.get(), value.data()) < 0) return false;
+  value.resize(value.find('\0') == std::string::npos ? size : value.find('\0'));
+  *out = value;
+  return true;
+}
+
+bool read_number(hid_t o, const char* name, hid_t mem_type, void* out) {
+  if (H5Aexists(o, name) <= 0) return false;
+  Handle attr(H5Aopen(o, name, H5P_DEFAULT), H5Aclose);
+  return attr.ok() && H5Aread(attr.get(), mem_type, out) >= 0;
+}
+
+}  // namespace
+
+void write_packing_hdf5(const std::string& path, const Packing& packing,
+                        const PackingStatistics* statistics) {
+  silence_hdf5();
+  if (path.empty()) fail(path, "empty output path");
+  const std::string tmp = path + ".partial";
+  try {
+    {
+      Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+      if (!file.ok()) fail(path, "cannot create the file (is the directory writable?)");
+      Handle group(H5Gcreate2(file.get(), "packing", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+                   H5Gclose);
+      if (!group.ok()) fail(path, "cannot create group /packing");
+      const hsize_t n = packing.size();
+      write_dataset(group.get(), "centers", {n, 3},
+                    n ? packing.centers.front().data() : nullptr, path);
+      write_dataset(group.get(), "radii", {n}, packing.radii.data(), path);
+      write_dataset(group.get(), "box_length", {3}, packing.box_length.data(), path);
+      const long long count = static_cast<long long>(n);
+      const unsigned long long seed = packing.seed;
+      write_double(group.get(), "phi", packing.phi(), path);
+      write_attribute(group.get(), "n", H5T_STD_I64LE, H5T_NATIVE_LLONG, &count, path);
+      write_attribute(group.get(), "seed", H5T_STD_U64LE, H5T_NATIVE_ULLONG, &seed, path);
+      write_string(group.get(), "generator", packing.generator, path);
+      write_string(group.get(), "settings", packing.settings_json, path);
+      write_string(group.get(), "length_unit",
+                   "reference diameter d_ref (Sauter mean diameter; the diameter if monodisperse)",
+                   path);
+      write_string(group.get(), "draglab_version", kDragDbVersion, path);
+      if (statistics) {
+        write_double(group.get(), "min_gap", statistics->min_gap, path);
+        write_double(group.get(), "q6", statistics->q6, path);
+        write_double(group.get(), "g_contact", statistics->g_contact, path);
+        write_double(group.get(), "crystalline_fraction", statistics->crystalline_fraction, path);
+        write_double(group.get(), "mean_neighbours", statistics->mean_neighbours, path);
+      }
+      if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) fail(path, "cannot flush the file");
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+      fail(path, "cannot move the finished file into place");
+    }
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+}
+
+Packing read_packing_hdf5(const std::string& path) {
+  silence_hdf5();
+  if (access(path.c_str(), R_OK) != 0) fail(path, "does not exist or is not readable");
+  if (H5Fis_hdf5(path.c_str()) <= 0) fail(path, "is not an HDF5 file");
+  Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!file.ok()) fail(path, "cannot open");
+  if (H5Lexists(file.get(), "packing", H5P_DEFAULT) <= 0) fail(path, "no group /packing");
+  Handle group(H5Gopen2(file.get(), "packing", H5P_DEFAULT), H5Gclose);
+  if (!group.ok()) fail(path, "cannot open group /packing");
+
+  Packing p;
+  std::vector<hsize_t> dims;
+  const std::vector<double> centers = read_dataset(group.get(), "centers", &dims, path);
+  if (dims.size() != 2 || dims[1] != 3) fail(path, "centers must have shape [N, 3]");
+  const std::size_t n = dims[0];
+  const std::vector<double> radii = read_dataset(group.get(), "radii", &dims, path);
+  if (dims.size() != 1 || dims[0] != n) fail(path, "radii must have shape [N] with N = rows of centers");
+  const std::vector<double> box = read_dataset(group.get(), "box_length", &dims, path);
+  if (dims.size() != 1 || dims[0] != 3) fail(path, "box_length must have shape [3]");
+  if (n == 0) fail(path, "contains no spheres");
+  for (int a = 0; a < 3; ++a) {
+    if (!(box[a] > 0.0)) fail(path, "box_length must be positive");
+    p.box_length[a] = box[a];
+  }
+  p.centers.resize(n);
+  p.radii = radii;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(radii[i] > 0.0)) fail(path, "radius " + std::to_string(i) + " is not positive");
+    for (int a = 0; a < 3; ++a) {
+      const double x = centers[3 * i + a];
+      if (!(x >= 0.0 && x < box[a])) {
+        fail(path, "center " + std::to_string(i) + " lies outside [0, box_length)");
+      }
+      p.centers[i][a] = x;
+    }
+  }
+  read_string(group.get(), "generator", &p.generator);
+  read_string(group.get(), "settings", &p.settings_json);
+  unsigned long long seed = 0;
+  if (read_number(group.get(), "seed", H5T_NATIVE_ULLONG, &seed)) p.seed = seed;
+  return p;
+}
+
+}  // namespace arrays
+}  // namespace draglab

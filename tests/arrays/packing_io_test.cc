@@ -1,0 +1,172 @@
+// HDF5 packing files: exact round trip, the documented layout as seen by independent readers
+// (h5dump from hdf5-tools, h5py under Debian's /usr/bin/python3), clear errors on malformed or
+// missing files, and no partial file left behind on a failed write.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "draglab/arrays/packing.h"
+#include "draglab/arrays/packing_io.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace arrays {
+namespace {
+
+class TempDir {
+ public:
+  TempDir() {
+    char tmpl[] = "/tmp/draglab_io_XXXXXX";
+    path_ = mkdtemp(tmpl);
+  }
+  ~TempDir() { std::system(("rm -rf '" + path_ + "'").c_str()); }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+std::string run(const std::string& command, int* status) {
+  std::string out;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) {
+    *status = -1;
+    return out;
+  }
+  char buf[4096];
+  std::size_t got;
+  while ((got = fread(buf, 1, sizeof buf, pipe)) > 0) out.append(buf, got);
+  *status = pclose(pipe);
+  return out;
+}
+
+Packing small_packing() {
+  Packing p;
+  p.box_length = {3.0, 3.5, 4.0};
+  p.centers = {{0.5, 0.6, 0.7}, {1.9, 2.1, 2.6}, {2.5, 0.25, 3.9}};
+  p.radii = {0.5, 0.45, 0.3};
+  p.generator = "test";
+  p.settings_json = R"({"phi":0.1})";
+  p.seed = 1234567890123ULL;
+  return p;
+}
+
+TEST(PackingIo, RoundTripIsExact) {
+  TempDir dir;
+  const Packing p = small_packing();
+  PackingStatistics stats;
+  stats.min_gap = 0.125;
+  stats.q6 = 0.03;
+  write_packing_hdf5(dir.file("p.h5"), p, &stats);
+  const Packing q = read_packing_hdf5(dir.file("p.h5"));
+  EXPECT_EQ(q.box_length, p.box_length);
+  EXPECT_EQ(q.centers, p.centers);  // doubles stored as IEEE 754 binary64: bit-exact
+  EXPECT_EQ(q.radii, p.radii);
+  EXPECT_EQ(q.generator, p.generator);
+  EXPECT_EQ(q.settings_json, p.settings_json);
+  EXPECT_EQ(q.seed, p.seed);
+  EXPECT_DOUBLE_EQ(q.phi(), p.phi());
+}
+
+TEST(PackingIo, LayoutAsSeenByH5dump) {
+  TempDir dir;
+  write_packing_hdf5(dir.file("p.h5"), small_packing());
+  int status = 0;
+  const std::string out = run("h5dump -H '" + dir.file("p.h5") + "'", &status);
+  if (status != 0 && out.find("not found") != std::string::npos) GTEST_SKIP() << "no h5dump";
+  ASSERT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("GROUP \"packing\""), std::string::npos) << out;
+  EXPECT_NE(out.find("DATASET \"centers\""), std::string::npos);
+  EXPECT_NE(out.find("( 3, 3 )"), std::string::npos) << "centers must be [N,3]";
+  EXPECT_NE(out.find("DATASET \"radii\""), std::string::npos);
+  EXPECT_NE(out.find("DATASET \"box_length\""), std::string::npos);
+  EXPECT_NE(out.find("ATTRIBUTE \"phi\""), std::string::npos);
+  EXPECT_NE(out.find("ATTRIBUTE \"seed\""), std::string::npos);
+  EXPECT_NE(out.find("ATTRIBUTE \"generator\""), std::string::npos);
+}
+
+TEST(PackingIo, ReadableByH5py) {
+  TempDir dir;
+  const Packing p = small_packing();
+  write_packing_hdf5(dir.file("p.h5"), p);
+  int status = 0;
+  run("/usr/bin/python3 -c 'import h5py'", &status);
+  if (status != 0) GTEST_SKIP() << "h5py not importable by /usr/bin/python3";
+  const std::string script =
+      "import h5py, math\n"
+      "f = h5py.File('" + dir.file("p.h5") + "', 'r')\n"
+      "g = f['packing']\n"
+      "c, r, b = g['centers'][()], g['radii'][()], g['box_length'][()]\n"
+      "assert c.shape == (3, 3) and r.shape == (3,) and b.shape == (3,)\n"
+      "phi = sum(4/3*math.pi*x**3 for x in r) / (b[0]*b[1]*b[2])\n"
+      "assert abs(phi - g.attrs['phi']) < 1e-14, (phi, g.attrs['phi'])\n"
+      "assert g.attrs['generator'] == 'test', g.attrs['generator']\n"
+      "assert int(g.attrs['seed']) == 1234567890123\n"
+      "print('ok')\n";
+  std::ofstream(dir.file("check.py")) << script;
+  const std::string out = run("/usr/bin/python3 '" + dir.file("check.py") + "'", &status);
+  EXPECT_EQ(status, 0) << out;
+  EXPECT_NE(out.find("ok"), std::string::npos) << out;
+}
+
+TEST(PackingIo, UnwritablePathLeavesNothing) {
+  TempDir dir;
+  const std::string path = dir.file("missing_dir/p.h5");
+  try {
+    write_packing_hdf5(path, small_packing());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  EXPECT_NE(access(path.c_str(), F_OK), 0);
+  EXPECT_NE(access((path + ".partial").c_str(), F_OK), 0);
+}
+
+TEST(PackingIo, MalformedFilesGiveClearErrors) {
+  TempDir dir;
+  auto expect_error = [](const std::string& path, const std::string& needle) {
+    try {
+      read_packing_hdf5(path);
+      ADD_FAILURE() << "expected an error for " << path;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  expect_error(dir.file("none.h5"), "does not exist");
+  std::ofstream(dir.file("text.h5")) << "not hdf5";
+  expect_error(dir.file("text.h5"), "not an HDF5 file");
+  // An HDF5 file without the /packing group.
+  {
+    hid_t f = H5Fcreate(dir.file("empty.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    H5Fclose(f);
+  }
+  expect_error(dir.file("empty.h5"), "no group /packing");
+  // centers with the wrong shape.
+  {
+    hid_t f = H5Fcreate(dir.file("shape.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t g = H5Gcreate2(f, "packing", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hsize_t dims[2] = {2, 2};
+    double data[4] = {0, 0, 0, 0};
+    hid_t s = H5Screate_simple(2, dims, nullptr);
+    hid_t d = H5Dcreate2(g, "centers", H5T_IEEE_F64LE, s, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    H5Dclose(d);
+    H5Sclose(s);
+    H5Gclose(g);
+    H5Fclose(f);
+  }
+  expect_error(dir.file("shape.h5"), "[N, 3]");
+}
+
+}  // namespace
+}  // namespace arrays
+}  // namespace draglab
