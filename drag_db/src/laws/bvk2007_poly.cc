@@ -1,34 +1,25 @@
 #include "laws/bvk2007_poly.h"
 
+#include "laws/bvk2007.h"
+
 #include "law_registration.h"
 
 namespace draglab {
 namespace laws {
 
 LawFormDescription Bvk2007Poly::describe() {
-  LawFormDescription d;
+  // Same paper, coefficients and validity as the monodisperse form, plus the size factor.
+  LawFormDescription d = Bvk2007::describe();
   d.key = "bvk2007_poly";
   d.title = "Beetstra, van der Hoef & Kuipers (2007): polydisperse random arrays, finite Re";
-  d.citation =
-      "R. Beetstra, M. A. van der Hoef, J. A. M. Kuipers, Drag force of intermediate Reynolds "
-      "number flow past mono- and bidisperse arrays of spheres, AIChE J. 53 (2007) 489-501, "
-      "doi:10.1002/aic.11065";
   d.form_notes =
       "F_i = F_bvk2007(phi, Re) [(1-phi) y + phi y^2 + 0.064 (1-phi) y^3] with y = d_i/<d> (Sauter "
       "mean), phi the total solids fraction and Re = rho eps <d> u/mu based on <d>; F_i normalised "
       "by 3 pi mu d_i eps u. At y = 1 it is bvk2007 times 1 + 0.064 (1-phi), not bvk2007 itself, "
       "so F(0, 0) = 1.064 at y = 1. MFiX's per-phase variant (no y^3 term for phase 1, F_cor = y "
       "for model A) is not implemented.";
-  d.parameters = {
-      {"a", 10.0, "1", "Carman-Kozeny coefficient of the Stokes term a phi/eps^2"},
-      {"b", 1.5, "1", "coefficient of sqrt(phi) in the dilute Stokes term"},
-      {"c", 0.413, "1", "inertial prefactor (Turton-Levenspiel 0.413)"},
-      {"d", 8.4, "1", "coefficient of Re^-e in the inertial numerator"},
-      {"e", 0.343, "1", "exponent of Re in the inertial numerator"},
-      {"g", 0.064, "1", "coefficient of the (1-phi) y^3 term of the size factor"},
-  };
-  d.validity.phi = {0.1, 0.6};
-  d.validity.re = {0.0, 1000.0};
+  d.parameters.push_back(
+      {"g", 0.064, "1", "coefficient of the (1-phi) y^3 term of the size factor"});
   d.validity.extra = {{"y",
                        "d_i/<d>: particle diameter over the Sauter mean diameter of the mixture",
                        {0.25, 4.0}}};
