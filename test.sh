@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Set-up if needed, build (Release), then the whole test suite with ctest.
 #   ./test.sh                      # everything CI runs
-#   ./test.sh -L validation        # extra ctest arguments are passed through
+#   ./test.sh -L validation        # the long physics validations (extra ctest arguments are
+#                                  # passed through; without any, validations are left out)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 "$here/scripts/setup.sh"
 jobs="$(nproc 2>/dev/null || echo 2)"
+if [ "$#" -eq 0 ]; then set -- -LE validation; fi
 ctest --test-dir "${DRAGLAB_BUILD_DIR:-$here/build}" --output-on-failure -j "$jobs" "$@"

@@ -52,6 +52,8 @@ void add_law_commands(CLI::App& app, CliContext& ctx);
 void add_pack_commands(CLI::App& app, CliContext& ctx);
 /// Registers `draglab db ...` (db_commands.cc).
 void add_db_commands(CLI::App& app, CliContext& ctx);
+/// Registers `draglab lbm ...` (lbm_commands.cc).
+void add_lbm_commands(CLI::App& app, CliContext& ctx);
 
 /// Parses "a,b,c" into doubles; throws UsageError naming `field`.
 std::vector<double> parse_double_list(const std::string& text, const std::string& field);

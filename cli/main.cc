@@ -10,6 +10,7 @@
 //   draglab pack --phi 0.4 --n 1000 --seed 7 --out packing.h5
 //   draglab pack stats packing.h5 --json
 //   draglab db info --db my.db
+//   draglab lbm run --array sc --phi 0.125 --d 16 --re 0 --json
 #include <unistd.h>
 
 #include <cstdio>
@@ -96,11 +97,13 @@ int main(int argc, char** argv) {
       "  draglab law compare\n"
       "  draglab pack --phi 0.4 --n 1000 --out packing.h5\n"
       "  draglab db info\n"
+      "  draglab lbm run --array sc --phi 0.125 --d 16 --re 0\n"
       "Exit codes: 0 success, 1 failure, 2 bad input.");
 
   draglab::cli::add_law_commands(app, ctx);
   draglab::cli::add_pack_commands(app, ctx);
   draglab::cli::add_db_commands(app, ctx);
+  draglab::cli::add_lbm_commands(app, ctx);
 
   try {
     app.parse(argc, argv);

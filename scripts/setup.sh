@@ -21,6 +21,7 @@ packages=(
   libhdf5-dev hdf5-tools            # packing and field files (h5dump: format tests)
   libgtest-dev                      # test suite
   python3-h5py                      # tests: packing files open in h5py
+  gnuplot-nox                       # draglab lbm convergence --plot (PNG, no X11)
   python3                           # Python bindings test (Debian's /usr/bin/python3)
 )
 

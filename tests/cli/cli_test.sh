@@ -110,6 +110,55 @@ for f in bad1 bad2 bad3 bad4; do
   ls "$work/$f.h5"* >/dev/null 2>&1 && { echo "FAIL: $f left a file"; failures=$((failures + 1)); }
 done
 
+# LBM: tiny lattices only (d = 5-6, boxes of 10^3 nodes), a few seconds in all; one thread each
+# (OpenMP teams on lattices this small only add barrier cost, and ctest runs tests side by side).
+# Reference: Sangani-Acrivos series for SC arrays in Stokes flow (data/sangani_acrivos_sc_series.csv).
+check "lbm help" 0 "$draglab" lbm run --help
+grep -q "Examples" "$work/out" || { echo "FAIL: lbm run help without examples"; failures=$((failures + 1)); }
+check "lbm run sc" 0 "$draglab" lbm run --array sc --phi 0.125 --d 6 --re 0 --json --threads 1
+json_check "lbm run keys" "all(k in j for k in ('F','K','beta_d2_over_mu','re','phi','phi_lattice','converged','steps','wall_s','mflups','momentum_balance_rel','mach_max','error_estimate'))"
+json_check "lbm run converged" "j['converged'] is True and j['steps'] > 0 and j['wall_s'] > 0 and j['momentum_balance_rel'] < 1e-6"
+# Conventions: K = F/(1 - phi), beta d^2/mu = 18 phi (1 - phi) F (exact identities).
+json_check "lbm run conventions" "abs(j['K'] - j['F']/(1-j['phi'])) < 1e-9*j['K'] and abs(j['beta_d2_over_mu'] - 18*j['phi']*(1-j['phi'])*j['F']) < 1e-9*j['beta_d2_over_mu']"
+# Series F = (1 - 0.125) K(0.125) = 3.7555 (Zick & Homsy K = 4.292); d = 6 is coarse: 10 % band.
+json_check "lbm run near the series" "abs(j['F']/3.7555 - 1) < 0.10 and 'error' in j"
+check "lbm run fields" 0 "$draglab" lbm run --array sc --phi 0.125 --d 6 --re 0 --fields "$work/flow.h5" --json --threads 1
+[ -s "$work/flow.h5" ] && [ -s "$work/flow.xmf" ] || { echo "FAIL: lbm fields files missing"; failures=$((failures + 1)); }
+grep -q "flow.h5:/fields/velocity" "$work/flow.xmf" 2>/dev/null || { echo "FAIL: xmf does not reference flow.h5"; failures=$((failures + 1)); }
+check "lbm run table (bgk-bb)" 0 "$draglab" lbm run --array sc --phi 0.2 --d 6 --re 0 --collision bgk --boundary bb --threads 1
+grep -q "beta d^2/mu" "$work/out" || { echo "FAIL: lbm run table"; failures=$((failures + 1)); }
+check "lbm run Re = 1" 0 "$draglab" lbm run --array sc --phi 0.2 --d 6 --re 1 --json --threads 1
+# The engine adjusts the body force until the achieved Re is within 1 % of the target.
+json_check "lbm run achieved Re" "j['converged'] and abs(j['re'] - 1) <= 0.01 and j['re_target'] == 1"
+check "lbm calibrate" 0 "$draglab" lbm calibrate --d 5 --json --threads 1
+json_check "lbm calibrate keys" "0.8 < j['d_h_over_d'] < 1.2 and j['scheme'] == 'trt-bb' and j['calibration']['F_input'] > 0"
+check "lbm convergence" 0 "$draglab" lbm convergence --array sc --phi 0.125 --re 0 --d 5,6,7 --schemes trt-bb,trt-ibb --json --threads 1
+json_check "lbm convergence json" "j['reference_source'].startswith('Sangani') and len(j['schemes']) == 2 and all(len(s['points']) == 3 and all(p['converged'] and p['error'] is not None and p['wall_s'] > 0 for p in s['points']) for s in j['schemes'])"
+if command -v gnuplot >/dev/null 2>&1 || "$py" -c "import matplotlib" >/dev/null 2>&1; then
+  check "lbm convergence plot" 0 "$draglab" lbm convergence --array sc --phi 0.125 --re 0 --d 5,6 --schemes trt-ibb --plot "$work/wp.png" --threads 1
+  head -c 8 "$work/wp.png" 2>/dev/null | grep -q "PNG" || { echo "FAIL: convergence plot is not a PNG"; failures=$((failures + 1)); }
+fi
+# LBM bad input: exit 2, the field named, nothing written.
+check "lbm Re negative" 2 "$draglab" lbm run --array sc --phi 0.1 --d 8 --re -1
+grep -q -- "--re" "$work/err" || { echo "FAIL: Re message does not name --re"; failures=$((failures + 1)); }
+check "lbm Re too high" 2 "$draglab" lbm run --array sc --phi 0.1 --d 8 --re 1e5
+check "lbm phi above close packing" 2 "$draglab" lbm run --array sc --phi 0.6 --d 8 --re 0
+grep -q -- "--phi" "$work/err" || { echo "FAIL: phi message does not name --phi"; failures=$((failures + 1)); }
+check "lbm gap too small" 2 "$draglab" lbm run --array sc --phi 0.5 --d 8 --re 0
+grep -q "lattice units" "$work/err" || { echo "FAIL: gap message without the gap in lattice units"; failures=$((failures + 1)); }
+check "lbm unknown collision" 2 "$draglab" lbm run --array sc --phi 0.1 --d 8 --re 0 --collision mrt
+check "lbm unknown scheme" 2 "$draglab" lbm convergence --array sc --phi 0.1 --re 0 --d 6 --schemes foo-bb
+check "lbm missing packing" 2 "$draglab" lbm run --packing "$work/none.h5" --d 8 --re 0
+echo "not hdf5" >"$work/bad_packing.h5"
+check "lbm malformed packing" 2 "$draglab" lbm run --packing "$work/bad_packing.h5" --d 8 --re 0
+check "lbm both geometries" 2 "$draglab" lbm run --packing "$work/p.h5" --array sc --phi 0.1 --d 8 --re 0
+check "lbm no resolution" 2 "$draglab" lbm run --array sc --phi 0.1 --re 0
+check "lbm resolution out of range" 2 "$draglab" lbm run --array sc --phi 0.1 --d 2 --re 0
+check "lbm fields unwritable" 2 "$draglab" lbm run --array sc --phi 0.1 --d 6 --re 0 --fields "$work/no/such/f.h5"
+ls "$work/no" >/dev/null 2>&1 && { echo "FAIL: lbm left files"; failures=$((failures + 1)); }
+check "lbm calibrate d too small" 2 "$draglab" lbm calibrate --d 2
+check "lbm bench repeat" 2 "$draglab" lbm bench --repeat 0
+
 # The main job.
 check "law compare" 0 "$draglab" law compare
 grep -q "bvk2007" "$work/out" || { echo "FAIL: compare table"; failures=$((failures + 1)); }

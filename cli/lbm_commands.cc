@@ -1,0 +1,817 @@
+// `draglab lbm run|bench|convergence|calibrate`: the lattice-Boltzmann drag engine.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <memory>
+
+#include <fmt/core.h>
+
+#include "cli/cli_context.h"
+#include "cli/progress.h"
+#include "draglab/arrays/packing.h"
+#include "draglab/arrays/packing_io.h"
+#include "draglab/arrays/voxelization.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/lbm/calibration.h"
+#include "draglab/lbm/convergence.h"
+#include "draglab/lbm/fields_io.h"
+#include "draglab/lbm/lbm.h"
+
+namespace draglab {
+namespace cli {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kMaxRe = 1000.0;  // the range; beyond it the Mach budget needs d > 80
+constexpr double kMinResolution = 4.0, kMaxResolution = 512.0;
+
+/// Which geometry: a packing file or an ordered array.
+struct CaseOptions {
+  std::string packing_file;
+  std::string array;  // sc, bcc, fcc
+  double phi = kNaN;
+  int cells = 1;
+};
+
+/// Solver settings shared by run, convergence and calibrate.
+struct SolverOptions {
+  double re = kNaN;
+  std::string collision = "trt";
+  std::string boundary = "ibb";
+  std::string precision = "double";
+  double tau = 0.0;
+  double magic = 3.0 / 16.0;
+  std::int64_t max_steps = 200000;
+  double tolerance = 1e-6;
+  int threads = 0;
+};
+
+struct RunCommand {
+  CaseOptions case_options;
+  SolverOptions solver;
+  double d = kNaN;
+  std::string fields;
+  double d_hydro = 0.0;
+  bool calibrate = false;
+};
+
+struct ConvergenceCommand {
+  CaseOptions case_options;
+  SolverOptions solver;
+  std::string d_list = "8,12,16,24";
+  std::string schemes = "bgk-bb,trt-bb,trt-ibb";
+  std::string plot;
+  double reference = kNaN;
+};
+
+struct CalibrateCommand {
+  SolverOptions solver;
+  double d = kNaN;
+  double phi = 0.01;
+  double check_phi = 0.0;
+  int positions = 4;
+};
+
+struct BenchCommand {
+  int threads = 0;
+  int repeat = 5;
+};
+
+/// The geometry of a run, and how to describe it.
+struct Case {
+  arrays::Packing packing;
+  std::string description;
+};
+
+Case load_case(const CaseOptions& o) {
+  if (o.packing_file.empty() == o.array.empty()) {
+    throw UsageError("give exactly one of --packing FILE.h5 or --array sc|bcc|fcc (with --phi)");
+  }
+  Case c;
+  if (!o.packing_file.empty()) {
+    if (!std::isnan(o.phi)) {
+      throw UsageError("--phi goes with --array; a packing file has its own phi");
+    }
+    c.packing = arrays::read_packing_hdf5(o.packing_file);  // Error(kInvalidArgument): exit 2
+    c.description = fmt::format("{} ({} spheres, phi = {:.6g})", o.packing_file, c.packing.size(),
+                                c.packing.phi());
+    return c;
+  }
+  const arrays::Lattice lattice = arrays::lattice_from_string(o.array);
+  const double max_phi = arrays::close_packing_phi(lattice);
+  if (std::isnan(o.phi)) throw UsageError("--phi is required with --array");
+  if (!std::isfinite(o.phi) || o.phi <= 0.0 || o.phi >= max_phi) {
+    throw UsageError(fmt::format(
+        "--phi = {} is outside (0, {:.6f}) for --array {} (below close packing: touching spheres "
+        "leave no gap to resolve)",
+        o.phi, max_phi, o.array));
+  }
+  if (o.cells < 1 || o.cells > 16) throw UsageError("--cells must lie in [1, 16]");
+  arrays::OrderedPackingOptions oo;
+  oo.lattice = lattice;
+  oo.phi = o.phi;
+  oo.cells = o.cells;
+  c.packing = arrays::generate_ordered_packing(oo);
+  c.description = fmt::format("{} array, phi = {:.6g} ({} sphere{})", o.array, o.phi,
+                              c.packing.size(), c.packing.size() == 1 ? "" : "s");
+  return c;
+}
+
+/// Lattice nodes of the box at resolution d (the voxelizer's rounding).
+double node_count(const arrays::Packing& p, double d) {
+  const double nx = std::max(1.0, std::round(d * p.box_length[0]));
+  const double dx = p.box_length[0] / nx;
+  return nx * std::round(p.box_length[1] / dx) * std::round(p.box_length[2] / dx);
+}
+
+/// Resolution range, gaps resolved, memory available: all before any work.
+void check_resolution(const arrays::Packing& p, double d, const std::string& field,
+                      const lbm::RunOptions& run, const std::string& precision) {
+  if (!std::isfinite(d) || d < kMinResolution || d > kMaxResolution) {
+    throw UsageError(fmt::format("{} = {} is outside [{}, {}] lattice units per diameter", field, d,
+                                 kMinResolution, kMaxResolution));
+  }
+  const double gap = arrays::min_gap_lattice_units(p, d);
+  if (gap < run.min_gap_nodes) {
+    if (gap <= 0.0) {
+      throw UsageError(fmt::format(
+          "{} = {}: spheres touch or overlap (smallest gap {:.3g} lattice units): no resolution "
+          "resolves the gap; lower --phi",
+          field, d, gap));
+    }
+    const double needed = d * run.min_gap_nodes / gap;
+    throw UsageError(fmt::format(
+        "{} = {} is too low for the gaps: the smallest gap between spheres spans {:.3g} lattice "
+        "units (at least {} needed); use {} >= {}",
+        field, d, gap, run.min_gap_nodes, field, std::ceil(needed * 100.0) / 100.0));
+  }
+  // Populations (19 per node) plus flags, links and fields: generous per-node budget.
+  const double bytes_per_node = precision == "float" ? 110.0 : 200.0;
+  const double nodes = node_count(p, d);
+  const double memory =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  if (memory > 0 && nodes * bytes_per_node > 0.8 * memory) {
+    throw UsageError(fmt::format(
+        "{} = {} needs about {:.1f} GiB for {:.3g} lattice nodes, more than 80 % of this "
+        "machine's {:.1f} GiB; lower {} (or use --precision float)",
+        field, d, nodes * bytes_per_node / 1073741824.0, nodes, memory / 1073741824.0, field));
+  }
+}
+
+lbm::RunOptions run_options(const SolverOptions& s) {
+  lbm::RunOptions r;
+  if (std::isnan(s.re)) throw UsageError("--re is required (0 = Stokes flow)");
+  if (!std::isfinite(s.re) || s.re < 0.0 || s.re > kMaxRe) {
+    throw UsageError(fmt::format("--re = {} is outside [0, {}]", s.re, kMaxRe));
+  }
+  r.collision = lbm::collision_from_string(s.collision);
+  r.boundary = lbm::boundary_from_string(s.boundary);
+  r.precision = lbm::precision_from_string(s.precision);
+  r.re = s.re;
+  r.tau = s.tau;
+  r.magic = s.magic;
+  r.max_steps = s.max_steps;
+  r.tolerance = s.tolerance;
+  r.threads = s.threads;
+  if (s.max_steps < 1) throw UsageError("--max-steps must be >= 1");
+  if (s.threads < 0) throw UsageError("--threads must be >= 0 (0 = all)");
+  std::string error;
+  if (!r.IsValid(&error)) throw UsageError(error);
+  return r;
+}
+
+void ensure_writable_parent(const std::string& path, const std::string& field) {
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
+  const std::string d = dir.empty() ? "/" : dir;
+  struct stat st {};
+  if (::stat(d.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || access(d.c_str(), W_OK) != 0) {
+    throw UsageError(field + " '" + path + "': directory '" + dir +
+                     "' does not exist or is not writable");
+  }
+}
+
+/// Converged value or JSON null.
+nlohmann::json number_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
+nlohmann::json run_json(const lbm::RunResult& r, const lbm::RunOptions& o, double re_target,
+                        const arrays::VoxelGrid& grid, std::size_t spheres) {
+  nlohmann::json j = {{"F", number_or_null(r.F)},
+                      {"K", number_or_null(r.K)},
+                      {"beta_d2_over_mu", number_or_null(r.beta_d2_over_mu)},
+                      {"F_standard_error", number_or_null(r.F_standard_error)},
+                      {"re", number_or_null(r.re)},
+                      {"re_target", re_target},
+                      {"phi", r.phi},
+                      {"phi_lattice", r.phi_lattice},
+                      {"converged", r.converged},
+                      {"diagnosis", r.diagnosis},
+                      {"steps", r.steps},
+                      {"wall_s", r.wall_s},
+                      {"mflups", r.mflups},
+                      {"momentum_balance_rel", number_or_null(r.momentum_balance_rel)},
+                      {"mach_max", number_or_null(r.mach_max)},
+                      {"error_estimate", number_or_null(r.error_estimate)},
+                      {"d", r.d},
+                      {"resolution", grid.resolution()},
+                      {"dims", grid.dims},
+                      {"spheres", spheres},
+                      {"tau", r.tau},
+                      {"nu", r.nu},
+                      {"body_force", r.body_force},
+                      {"superficial_velocity", r.superficial_velocity},
+                      {"collision", lbm::to_string(o.collision)},
+                      {"boundary", lbm::to_string(o.boundary)},
+                      {"precision", lbm::to_string(o.precision)}};
+  if (o.collision == lbm::Collision::kTrt) j["magic"] = o.magic;
+  j["d_hydrodynamic"] = o.use_hydrodynamic_diameter ? nlohmann::json(o.hydrodynamic_diameter)
+                                                    : nlohmann::json(nullptr);
+  return j;
+}
+
+void run_lbm(const CliContext& ctx, const RunCommand& c) {
+  // Everything the user typed is checked before the (possibly long) run.
+  lbm::RunOptions options = run_options(c.solver);
+  if (std::isnan(c.d)) throw UsageError("--d is required (lattice units per sphere diameter)");
+  const Case the_case = load_case(c.case_options);
+  check_resolution(the_case.packing, c.d, "--d", options, c.solver.precision);
+  if (!c.fields.empty()) ensure_writable_parent(c.fields, "--fields");
+  if (c.d_hydro != 0.0 && c.calibrate) throw UsageError("give --d-hydro or --calibrate, not both");
+  if (c.d_hydro != 0.0) {
+    if (!std::isfinite(c.d_hydro) || c.d_hydro < 0.5 * c.d || c.d_hydro > 1.5 * c.d) {
+      throw UsageError(fmt::format("--d-hydro = {} is outside [0.5 d, 1.5 d] = [{}, {}]", c.d_hydro,
+                                   0.5 * c.d, 1.5 * c.d));
+    }
+  }
+  if (c.calibrate && options.re > 0.0 && options.tau == 0.0) {
+    throw UsageError(
+        "--calibrate at --re > 0 needs --tau: d_h depends on tau and the "
+        "calibration runs in Stokes flow");
+  }
+  if (c.calibrate && c.d > 128.0) throw UsageError("--calibrate works for --d up to 128");
+
+  ProgressLine progress(!ctx.quiet);
+  auto report = [&progress](const std::string& stage) {
+    return [&progress, stage](double f, const std::string&) { progress.update(f, stage); };
+  };
+  nlohmann::json calibration_json;
+  if (c.calibrate) {
+    lbm::CalibrationOptions co;
+    co.diameter = c.d;
+    co.run = options;
+    const lbm::CalibrationResult cal =
+        lbm::calibrate_hydrodynamic_diameter(co, report("lbm calibrate"));
+    progress.finish();
+    ctx.info(fmt::format("calibration: d_h/d = {:.5f} ({} at d = {:.4g}, {:.1f} s)", cal.ratio,
+                         lbm::Scheme{options.collision, options.boundary}.name(), cal.diameter,
+                         cal.wall_s));
+    calibration_json = {{"d_h_over_d", cal.ratio},
+                        {"phi", cal.calibration.phi},
+                        {"F_input", cal.calibration.F_input},
+                        {"F_series", cal.calibration.F_reference},
+                        {"positions", cal.calibration.positions},
+                        {"wall_s", cal.wall_s}};
+    options.use_hydrodynamic_diameter = true;
+    options.hydrodynamic_diameter = cal.ratio * c.d;
+  } else if (c.d_hydro != 0.0) {
+    options.use_hydrodynamic_diameter = true;
+    options.hydrodynamic_diameter = c.d_hydro;
+  }
+
+  arrays::VoxelizationOptions vo;
+  vo.resolution = c.d;
+  const arrays::VoxelGrid grid = arrays::voxelize(
+      the_case.packing, vo,
+      [&progress](double f, const std::string& stage) { progress.update(f, stage); });
+  if (options.use_hydrodynamic_diameter && c.calibrate) {
+    options.hydrodynamic_diameter *= grid.resolution() / c.d;  // the realised d
+  }
+  options.throw_on_failure = false;  // report a failed run with its diagnosis, then exit 1
+  lbm::Fields fields;
+  const double phi_exact = the_case.packing.phi();
+  const lbm::RunResult r =
+      c.fields.empty() ? lbm::run(grid, phi_exact, options, report("lbm run"))
+                       : lbm::run_with_fields(grid, phi_exact, options, &fields, report("lbm run"));
+  progress.finish();
+
+  nlohmann::json j = run_json(r, options, c.solver.re, grid, the_case.packing.size());
+  j["case"] = the_case.description;
+  if (!calibration_json.is_null()) j["calibration"] = calibration_json;
+  // The exact answer where one is known: the run's true error beside its own estimate. With a
+  // hydrodynamic diameter the spheres are taken to be of diameter d_h, so the array's solids
+  // fraction is (d_h/d)^3 phi and the series is evaluated there (drag_laws: vdH 2005 procedure).
+  double reference = lbm::analytical_reference_F(the_case.packing, options.re);
+  if (options.use_hydrodynamic_diameter) {
+    const double ratio = options.hydrodynamic_diameter / grid.resolution();
+    const double phi_h = r.phi * ratio * ratio * ratio;
+    j["phi_hydrodynamic"] = phi_h;
+    if (std::isfinite(reference)) {
+      reference = phi_h <= lbm::kSanganiAcrivosMaxPhi ? lbm::sangani_acrivos_sc_F(phi_h) : kNaN;
+    }
+  }
+  if (std::isfinite(reference)) {
+    j["reference_F"] = reference;
+    j["reference"] = options.use_hydrodynamic_diameter
+                         ? "Sangani-Acrivos series (SC, Stokes) at phi_hydrodynamic"
+                         : "Sangani-Acrivos series (SC, Stokes)";
+    j["error"] = number_or_null(r.F / reference - 1.0);
+  }
+  if (!c.fields.empty()) {
+    lbm::FieldsWriteOptions fo;
+    fo.dx = grid.dx;
+    fo.run_json = j.dump();
+    lbm::write_fields(c.fields, fields, fo);
+    j["fields"] = c.fields;
+    j["fields_xdmf"] = lbm::xdmf_path_for(c.fields);
+  }
+
+  if (ctx.json) {
+    ctx.print_json(j);
+  } else {
+    std::cout << fmt::format("case             {}\n", the_case.description);
+    std::cout << fmt::format("lattice          {} x {} x {} nodes, d = {:.4g} lattice units{}\n",
+                             grid.dims[0], grid.dims[1], grid.dims[2], grid.resolution(),
+                             options.use_hydrodynamic_diameter
+                                 ? fmt::format(" (d_h = {:.4g})", options.hydrodynamic_diameter)
+                                 : "");
+    std::cout << fmt::format("scheme           {} + {}, {}, tau = {:.4g}{}\n",
+                             lbm::to_string(options.collision), lbm::to_string(options.boundary),
+                             lbm::to_string(options.precision), r.tau,
+                             options.re == 0.0 ? " (Stokes mode)" : "");
+    std::cout << fmt::format(
+        "phi              {:.6f} exact, {:.6f} on the lattice{}\n", r.phi, r.phi_lattice,
+        j.contains("phi_hydrodynamic")
+            ? fmt::format(", {:.6f} with d_h", j["phi_hydrodynamic"].get<double>())
+            : "");
+    if (r.converged) {
+      std::cout << fmt::format("F                {} (estimated error {:.2g} %{})\n",
+                               format_number(r.F), 100.0 * r.error_estimate,
+                               j.contains("error") ? fmt::format("; vs the series {:+.3f} %",
+                                                                 100.0 * (r.F / reference - 1.0))
+                                                   : "");
+      std::cout << fmt::format("K                {}\n", format_number(r.K));
+      std::cout << fmt::format("beta d^2/mu      {}\n", format_number(r.beta_d2_over_mu));
+      std::cout << fmt::format("Re               {} (target {})\n", format_number(r.re, 4),
+                               format_number(c.solver.re, 4));
+      std::cout << fmt::format("momentum balance {:.2g} relative\n", r.momentum_balance_rel);
+    }
+    std::cout << fmt::format("Mach max         {:.3g}\n", r.mach_max);
+    std::cout << fmt::format("run              {}, {} steps, {:.2f} s, {:.1f} MFLUPS\n",
+                             r.converged ? "converged" : "NOT CONVERGED", r.steps, r.wall_s,
+                             r.mflups);
+    if (!c.fields.empty()) {
+      std::cout << fmt::format("fields           {} + {} (ParaView: XDMF Reader)\n", c.fields,
+                               lbm::xdmf_path_for(c.fields));
+    }
+  }
+  if (!r.converged) {
+    throw std::runtime_error("the run did not converge: " + r.diagnosis +
+                             " (no drag value reported)");
+  }
+}
+
+void run_bench(const CliContext& ctx, const BenchCommand& b) {
+  if (b.threads < 0) throw UsageError("--threads must be >= 0 (0 = all)");
+  if (b.repeat < 1 || b.repeat > 100) throw UsageError("--repeat must lie in [1, 100]");
+  ctx.info(
+      "lbm bench: 100^3 all-fluid box, phi = 0.4 packing, in-place bandwidth kernel "
+      "(about a minute)");
+  const lbm::BenchResult r = lbm::benchmark(b.threads, b.repeat);
+  if (ctx.json) {
+    ctx.print_json(
+        {{"mflups", r.mflups},
+         {"mflups_fluid_packing", r.mflups_fluid_packing},
+         {"bandwidth_gbs", r.bandwidth_gbs},
+         {"roofline_fraction", r.roofline_fraction},
+         {"packing_to_fluid_ratio", r.mflups > 0 ? r.mflups_fluid_packing / r.mflups : 0.0},
+         {"threads", r.threads}});
+    return;
+  }
+  std::cout << fmt::format("all-fluid 100^3   {:.1f} MLUPS (double, TRT, {} threads)\n", r.mflups,
+                           r.threads);
+  std::cout << fmt::format(
+      "phi = 0.4 packing {:.1f} MFLUPS (fluid nodes), {:.2f} x all-fluid "
+      "(goal >= 0.8)\n",
+      r.mflups_fluid_packing, r.mflups > 0 ? r.mflups_fluid_packing / r.mflups : 0.0);
+  std::cout << fmt::format("bandwidth         {:.1f} GB/s (in-place update kernel)\n",
+                           r.bandwidth_gbs);
+  std::cout << fmt::format(
+      "roofline          {:.2f} of bandwidth/304 B = {:.0f} MLUPS (goal >= "
+      "0.8)\n",
+      r.roofline_fraction, r.bandwidth_gbs * 1e3 / 304.0);
+}
+
+/// Quotes a path for the shell (single quotes; a quote inside is closed, escaped, reopened).
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char ch : s) {
+    if (ch == '\'') {
+      out += "'\\''";
+    } else {
+      out += ch;
+    }
+  }
+  return out + "'";
+}
+
+/// "gnuplot", "matplotlib" or "" (none available).
+std::string plot_tool() {
+  if (std::system("command -v gnuplot >/dev/null 2>&1") == 0) return "gnuplot";
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0) {
+    return "matplotlib";
+  }
+  return "";
+}
+
+/// Writes the error-vs-wall-time PNG (log-log, one line per scheme) atomically.
+void write_plot(const std::string& path, const std::string& tool,
+                const lbm::ConvergenceResult& result, const std::string& title) {
+  const char* tmp_root = std::getenv("TMPDIR");
+  std::string tmpl =
+      std::string(tmp_root && *tmp_root ? tmp_root : "/tmp") + "/draglab_plot_XXXXXX";
+  if (!mkdtemp(tmpl.data()))
+    throw std::runtime_error("--plot: cannot create a temporary directory");
+  const std::string dir = tmpl;
+  const std::string partial = path + ".partial.png";
+  std::string command;
+  if (tool == "gnuplot") {
+    std::ofstream s(dir + "/plot.gp");
+    auto escape = [](const std::string& t) {  // gnuplot single-quoted string: '' is a quote
+      std::string o;
+      for (char ch : t) o += ch == '\'' ? std::string("''") : std::string(1, ch);
+      return o;
+    };
+    s << "set terminal pngcairo size 960,640 noenhanced\n";
+    s << "set output '" << escape(partial) << "'\n";
+    s << "set logscale xy\nset grid\nset key outside right top\n";
+    s << "set xlabel 'wall time (s)'\nset ylabel '|F / F_ref - 1|'\n";
+    s << "set title '" << escape(title) << "'\n";
+    std::string plot = "plot ";
+    int blocks = 0;
+    for (const auto& sc : result.schemes) {
+      std::string data;
+      for (const auto& p : sc.points) {
+        if (p.converged && std::isfinite(p.error) && p.error != 0.0 && p.wall_s > 0.0) {
+          data += fmt::format("{:.6g} {:.6g} {:.4g}\n", p.wall_s, std::fabs(p.error), p.d);
+        }
+      }
+      if (data.empty()) continue;
+      s << "$s" << blocks << " << EOD\n" << data << "EOD\n";
+      plot += fmt::format(
+          "{}$s{} using 1:2 with linespoints lw 2 pt 7 title '{}', $s{} using "
+          "1:2:(sprintf('d=%.3g', "
+          "$3)) with labels offset char 0.5,0.7 font ',8' notitle",
+          blocks ? ", " : "", blocks, escape(sc.scheme.name()), blocks);
+      ++blocks;
+    }
+    if (blocks == 0) throw std::runtime_error("--plot: no converged point with a finite error");
+    s << plot << "\n";
+    s.close();
+    command = "gnuplot " + shell_quote(dir + "/plot.gp");
+  } else {
+    nlohmann::json data = nlohmann::json::array();
+    for (const auto& sc : result.schemes) {
+      nlohmann::json line = {{"name", sc.scheme.name()},
+                             {"t", nlohmann::json::array()},
+                             {"e", nlohmann::json::array()},
+                             {"d", nlohmann::json::array()}};
+      for (const auto& p : sc.points) {
+        if (p.converged && std::isfinite(p.error) && p.error != 0.0 && p.wall_s > 0.0) {
+          line["t"].push_back(p.wall_s);
+          line["e"].push_back(std::fabs(p.error));
+          line["d"].push_back(p.d);
+        }
+      }
+      if (!line["t"].empty()) data.push_back(line);
+    }
+    if (data.empty()) throw std::runtime_error("--plot: no converged point with a finite error");
+    std::ofstream(dir + "/data.json")
+        << nlohmann::json({{"lines", data}, {"title", title}, {"out", partial}}).dump();
+    std::ofstream(dir + "/plot.py")
+        << "import json, sys\n"
+           "import matplotlib\n"
+           "matplotlib.use('Agg')\n"
+           "import matplotlib.pyplot as plt\n"
+           "c = json.load(open(sys.argv[1]))\n"
+           "fig, ax = plt.subplots(figsize=(9.6, 6.4))\n"
+           "for l in c['lines']:\n"
+           "    ax.loglog(l['t'], l['e'], 'o-', label=l['name'])\n"
+           "    for t, e, d in zip(l['t'], l['e'], l['d']):\n"
+           "        ax.annotate('d=%.3g' % d, (t, e), fontsize=8, xytext=(4, 4),\n"
+           "                    textcoords='offset points')\n"
+           "ax.set_xlabel('wall time (s)'); ax.set_ylabel('|F / F_ref - 1|')\n"
+           "ax.set_title(c['title']); ax.grid(True, which='both', alpha=0.3); ax.legend()\n"
+           "fig.savefig(c['out'], dpi=100, format='png')\n";
+    command =
+        "/usr/bin/python3 " + shell_quote(dir + "/plot.py") + " " + shell_quote(dir + "/data.json");
+  }
+  const int status = std::system((command + " 2>" + shell_quote(dir + "/err.txt")).c_str());
+  std::string err;
+  {
+    std::ifstream e(dir + "/err.txt");
+    std::getline(e, err, '\0');
+  }
+  std::system(("rm -rf " + shell_quote(dir)).c_str());
+  if (status != 0 || std::rename(partial.c_str(), path.c_str()) != 0) {
+    std::remove(partial.c_str());
+    throw std::runtime_error("--plot: " + tool + " failed to write '" + path + "': " + err);
+  }
+}
+
+void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c) {
+  const lbm::RunOptions options = run_options(c.solver);
+  const Case the_case = load_case(c.case_options);
+  lbm::ConvergenceOptions co;
+  co.packing = the_case.packing;
+  co.run = options;
+  co.resolutions = parse_double_list(c.d_list, "--d");
+  co.schemes.clear();
+  {
+    std::size_t start = 0;
+    while (start <= c.schemes.size()) {
+      const std::size_t comma = c.schemes.find(',', start);
+      const std::string item =
+          c.schemes.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      co.schemes.push_back(lbm::scheme_from_string(item));  // Error(kInvalidArgument): exit 2
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+  }
+  if (!std::isnan(c.reference)) {
+    if (!std::isfinite(c.reference) || c.reference <= 0.0) {
+      throw UsageError("--reference must be a finite F > 0");
+    }
+    co.reference_F = c.reference;
+  }
+  for (double d : co.resolutions)
+    check_resolution(the_case.packing, d, "--d", options, c.solver.precision);
+  std::string error;
+  if (!co.IsValid(&error)) throw UsageError(error);
+  std::string tool;
+  if (!c.plot.empty()) {
+    ensure_writable_parent(c.plot, "--plot");
+    tool = plot_tool();
+    if (tool.empty()) {
+      throw std::runtime_error(
+          "--plot needs gnuplot (Debian package gnuplot-nox) or matplotlib for /usr/bin/python3 "
+          "(python3-matplotlib); neither was found");
+    }
+  }
+
+  ProgressLine progress(!ctx.quiet);
+  const lbm::ConvergenceResult r = lbm::run_convergence(
+      co, [&progress](double f, const std::string&) { progress.update(f, "lbm convergence"); });
+  progress.finish();
+
+  const std::string title = fmt::format("{}, Re = {}: error vs wall time (reference: {})",
+                                        the_case.description, c.solver.re, r.reference_source);
+  if (!c.plot.empty()) write_plot(c.plot, tool, r, title);
+
+  if (ctx.json) {
+    nlohmann::json schemes = nlohmann::json::array();
+    for (const auto& sc : r.schemes) {
+      nlohmann::json points = nlohmann::json::array();
+      for (const auto& p : sc.points) {
+        points.push_back({{"d_requested", p.d_requested},
+                          {"d", p.d},
+                          {"dims", p.dims},
+                          {"converged", p.converged},
+                          {"diagnosis", p.diagnosis},
+                          {"F", number_or_null(p.F)},
+                          {"error", number_or_null(p.error)},
+                          {"error_estimate", number_or_null(p.error_estimate)},
+                          {"wall_s", p.wall_s},
+                          {"steps", p.steps},
+                          {"mflups", p.mflups}});
+      }
+      schemes.push_back({{"scheme", sc.scheme.name()},
+                         {"order", number_or_null(sc.order)},
+                         {"richardson",
+                          {{"ok", sc.richardson.ok},
+                           {"F_inf", number_or_null(sc.richardson.F_inf)},
+                           {"order", number_or_null(sc.richardson.order)},
+                           {"note", sc.richardson.note}}},
+                         {"points", points}});
+    }
+    nlohmann::json j = {{"case", the_case.description},
+                        {"phi", r.phi},
+                        {"re", r.re},
+                        {"reference_F", number_or_null(r.reference_F)},
+                        {"reference_source", r.reference_source},
+                        {"reference_spread", number_or_null(r.reference_spread)},
+                        {"wall_s", r.wall_s},
+                        {"schemes", schemes}};
+    if (!c.plot.empty()) j["plot"] = c.plot;
+    ctx.print_json(j);
+  } else {
+    std::cout << the_case.description << "\n" << r.Table();
+    if (!c.plot.empty()) std::cout << fmt::format("plot: {} ({})\n", c.plot, tool);
+  }
+}
+
+void run_calibrate(const CliContext& ctx, const CalibrateCommand& c) {
+  SolverOptions s = c.solver;
+  s.re = 0.0;  // calibration is a Stokes measurement
+  lbm::CalibrationOptions co;
+  co.run = run_options(s);
+  if (std::isnan(c.d)) throw UsageError("--d is required (input sphere diameter, lattice units)");
+  co.diameter = c.d;
+  co.phi = c.phi;
+  co.check_phi = c.check_phi;
+  co.positions = c.positions;
+  std::string error;
+  if (!co.IsValid(&error)) throw UsageError(error);
+  ProgressLine progress(!ctx.quiet);
+  const lbm::CalibrationResult r = lbm::calibrate_hydrodynamic_diameter(
+      co, [&progress](double f, const std::string&) { progress.update(f, "lbm calibrate"); });
+  progress.finish();
+  const lbm::Scheme scheme{co.run.collision, co.run.boundary};
+  if (ctx.json) {
+    auto check_json = [](const lbm::CalibrationCheck& k) {
+      return nlohmann::json{{"phi", k.phi},
+                            {"phi_hydrodynamic", k.phi_hydrodynamic},
+                            {"F_input", k.F_input},
+                            {"F_hydrodynamic", k.F_hydrodynamic},
+                            {"F_series", k.F_reference},
+                            {"F_series_hydrodynamic", number_or_null(k.F_reference_hydrodynamic)},
+                            {"error_input", k.error_input},
+                            {"error_hydrodynamic", number_or_null(k.error_hydrodynamic)},
+                            {"positions", k.positions},
+                            {"F_position_spread", k.F_position_spread},
+                            {"steps", k.steps},
+                            {"wall_s", k.wall_s}};
+    };
+    nlohmann::json j = {{"d", r.diameter},
+                        {"d_h", r.hydrodynamic_diameter},
+                        {"d_h_over_d", r.ratio},
+                        {"box_nodes", r.box_nodes},
+                        {"scheme", scheme.name()},
+                        {"tau", r.calibration.run.tau},
+                        {"precision", lbm::to_string(co.run.precision)},
+                        {"newton_iterations", r.newton_iterations},
+                        {"calibration", check_json(r.calibration)},
+                        {"wall_s", r.wall_s}};
+    j["check"] = r.has_check ? check_json(r.check) : nlohmann::json(nullptr);
+    ctx.print_json(j);
+    return;
+  }
+  std::cout << fmt::format("scheme                {} ({}), tau = {:.4g}\n", scheme.name(),
+                           lbm::to_string(co.run.precision), r.calibration.run.tau);
+  std::cout << r.Report();
+  std::cout << fmt::format("use it                draglab lbm run ... --d {} --d-hydro {:.4f}\n",
+                           format_number(c.d), r.ratio * c.d);
+}
+
+void add_case_options(CLI::App* cmd, CaseOptions* o) {
+  cmd->add_option("--packing", o->packing_file, "Packing HDF5 file (draglab pack)");
+  cmd->add_option("--array", o->array, "Ordered array instead: sc, bcc or fcc")
+      ->check(CLI::IsMember({"sc", "bcc", "fcc"}));
+  cmd->add_option("--phi", o->phi, "Solids fraction of the array, (0, close packing)");
+  cmd->add_option("--cells", o->cells, "Unit cells per box edge of the array, [1, 16]")
+      ->capture_default_str();
+}
+
+void add_solver_options(CLI::App* cmd, SolverOptions* s, bool with_re) {
+  if (with_re) {
+    cmd->add_option("--re", s->re,
+                    "Target Reynolds number U d/nu (superficial), [0, 1000]; 0 = "
+                    "Stokes flow (linear equilibrium)");
+  }
+  cmd->add_option("--collision", s->collision,
+                  "Collision: bgk (seed baseline), trt, rr (regularized, robust at high Re)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"bgk", "trt", "rr"}));
+  cmd->add_option("--boundary", s->boundary,
+                  "Wall: bb (halfway bounce-back) or ibb (interpolated bounce-back with q)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"bb", "ibb"}));
+  cmd->add_option("--precision", s->precision, "double, or float (shifted populations)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"double", "float"}));
+  cmd->add_option("--tau", s->tau,
+                  "Relaxation time (> 1/2); 0 = choose from Re and the Mach "
+                  "budget")
+      ->capture_default_str();
+  cmd->add_option("--magic", s->magic, "TRT magic parameter Lambda")->capture_default_str();
+  cmd->add_option("--max-steps", s->max_steps, "Step limit (reaching it = not converged)")
+      ->capture_default_str();
+  cmd->add_option("--tolerance", s->tolerance,
+                  "Relative drag change per characteristic time at convergence")
+      ->capture_default_str();
+  cmd->add_option("--threads", s->threads, "OpenMP threads (0 = all)")->capture_default_str();
+}
+
+}  // namespace
+
+void add_lbm_commands(CLI::App& app, CliContext& ctx) {
+  CLI::App* lbm = app.add_subcommand(
+      "lbm", "Lattice-Boltzmann drag on fixed sphere arrays: run, bench, convergence, calibrate");
+  lbm->require_subcommand(1);
+  lbm->footer(
+      "Examples:\n"
+      "  draglab lbm run --array sc --phi 0.125 --d 16 --re 0\n"
+      "  draglab lbm run --packing p.h5 --d 24 --re 10 --fields flow.h5 --json\n"
+      "  draglab lbm bench --json\n"
+      "  draglab lbm convergence --array sc --phi 0.125 --re 0 --d 8,12,16,24 --plot wp.png\n"
+      "  draglab lbm calibrate --d 12 --collision trt --boundary bb");
+
+  auto rc = std::make_shared<RunCommand>();
+  auto* run = lbm->add_subcommand(
+      "run", "Steady flow through a packing or array; drag F, K, beta with an error estimate");
+  add_case_options(run, &rc->case_options);
+  run->add_option("--d", rc->d,
+                  "Resolution: lattice units per (reference) sphere diameter, "
+                  "[4, 512]");
+  add_solver_options(run, &rc->solver, true);
+  run->add_option("--fields", rc->fields,
+                  "Write velocity, density and solid mask to this HDF5 file, plus a .xmf file "
+                  "for ParaView");
+  run->add_option("--d-hydro", rc->d_hydro,
+                  "Normalise with this hydrodynamic diameter (lattice units; draglab lbm "
+                  "calibrate)");
+  run->add_flag("--calibrate", rc->calibrate,
+                "Calibrate d_h first (dilute SC array, same d, scheme and tau) and normalise "
+                "with it");
+  run->footer(
+      "Output: F = F_d/(3 pi mu d U) drag only, K = F/(1 - phi), beta d^2/mu, Re = U d/nu\n"
+      "(U superficial), the achieved Re, momentum balance, max Mach number, an error\n"
+      "estimate, wall time and MFLUPS. A run that does not converge exits 1 without a drag.\n"
+      "Examples:\n"
+      "  draglab lbm run --array sc --phi 0.125 --d 16 --re 0 --json\n"
+      "  draglab lbm run --packing p.h5 --d 20 --re 50 --collision trt --boundary ibb\n"
+      "  draglab lbm run --array fcc --phi 0.5 --d 24 --re 100 --collision rr\n"
+      "  draglab lbm run --array sc --phi 0.2 --d 12 --re 0 --boundary bb --calibrate\n"
+      "  draglab lbm run --array sc --phi 0.1 --d 16 --re 0 --fields flow.h5");
+  run->callback([&ctx, rc] { ctx.action = [&ctx, rc] { run_lbm(ctx, *rc); }; });
+
+  auto bc = std::make_shared<BenchCommand>();
+  auto* bench = lbm->add_subcommand(
+      "bench", "MLUPS (100^3 fluid box), MFLUPS (phi = 0.4 packing), bandwidth, roofline fraction");
+  bench->add_option("--threads", bc->threads, "OpenMP threads (0 = all)")->capture_default_str();
+  bench->add_option("--repeat", bc->repeat, "Repetitions (median)")->capture_default_str();
+  bench->footer(
+      "roofline_fraction = MLUPS / (bandwidth / 304 bytes): 1 is the in-place D3Q19 double\n"
+      "limit of this machine's memory.\n"
+      "Example:\n  draglab lbm bench --json");
+  bench->callback([&ctx, bc] { ctx.action = [&ctx, bc] { run_bench(ctx, *bc); }; });
+
+  auto cc = std::make_shared<ConvergenceCommand>();
+  auto* conv = lbm->add_subcommand("convergence",
+                                   "Resolution sweep: error against wall time for several schemes");
+  add_case_options(conv, &cc->case_options);
+  add_solver_options(conv, &cc->solver, true);
+  conv->add_option("--d", cc->d_list, "Resolutions, comma-separated, each in [4, 256]")
+      ->capture_default_str();
+  conv->add_option("--schemes", cc->schemes,
+                   "Schemes COLLISION-BOUNDARY, comma-separated (bgk|trt|rr)-(bb|ibb)")
+      ->capture_default_str();
+  conv->add_option("--reference", cc->reference,
+                   "Reference F (default: Sangani-Acrivos for SC Stokes, else Richardson)");
+  conv->add_option("--plot", cc->plot, "PNG of error vs wall time (gnuplot or matplotlib)");
+  conv->footer(
+      "Reference: the Sangani-Acrivos series for an SC array in Stokes flow (phi <= 0.22),\n"
+      "otherwise Richardson extrapolation d -> infinity with its measured order.\n"
+      "Examples:\n"
+      "  draglab lbm convergence --array sc --phi 0.125 --re 0 --d 8,12,16,24 --plot wp.png\n"
+      "  draglab lbm convergence --packing p.h5 --re 10 --d 12,16,24 --schemes trt-bb,trt-ibb "
+      "--json");
+  conv->callback([&ctx, cc] { ctx.action = [&ctx, cc] { run_convergence_command(ctx, *cc); }; });
+
+  auto kc = std::make_shared<CalibrateCommand>();
+  auto* cal = lbm->add_subcommand(
+      "calibrate",
+      "Hydrodynamic diameter d_h of a scheme at a resolution (dilute SC array vs "
+      "Sangani-Acrivos)");
+  cal->add_option("--d", kc->d, "Input sphere diameter, lattice units, [4, 128]");
+  kc->solver.boundary = "bb";  // the calibration is meant for halfway bounce-back
+  add_solver_options(cal, &kc->solver, false);
+  cal->add_option("--phi", kc->phi, "Solids fraction of the dilute SC array, [0.001, 0.05]")
+      ->capture_default_str();
+  cal->add_option("--positions", kc->positions,
+                  "Sub-grid sphere positions averaged over, [1, 64] (bounce-back drag depends on "
+                  "them)")
+      ->capture_default_str();
+  cal->add_option("--check-phi", kc->check_phi,
+                  "Also run an SC array at this phi (<= 0.22) and compare with d and d_h")
+      ->capture_default_str();
+  cal->footer(
+      "d_h is the diameter for which the Sangani-Acrivos series reproduces the measured Stokes\n"
+      "drag of a dilute SC array; it depends on d, tau and the scheme. Use it with\n"
+      "draglab lbm run --d-hydro, or let run --calibrate do both.\n"
+      "Examples:\n"
+      "  draglab lbm calibrate --d 12\n"
+      "  draglab lbm calibrate --d 16 --collision bgk --tau 1 --check-phi 0.125 --json");
+  cal->callback([&ctx, kc] { ctx.action = [&ctx, kc] { run_calibrate(ctx, *kc); }; });
+}
+
+}  // namespace cli
+}  // namespace draglab

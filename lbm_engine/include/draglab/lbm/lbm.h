@@ -1,0 +1,203 @@
+// draglab/lbm/lbm.h: D3Q19 lattice-Boltzmann flow through fixed sphere arrays, drag by momentum
+// exchange.
+//
+// Set-up: a periodic box of fixed solid bodies (arrays::VoxelGrid: solid flags and per-body
+// boundary links with wall fractions q), flow driven by a uniform body force (Guo forcing) on the
+// fluid: the mean pressure gradient of a fixed bed. Lattice units: dx = dt = 1, rho0 = 1,
+// nu = (tau - 1/2)/3. Steady state: sum over bodies of the momentum-exchange force equals the body
+// force times the fluid volume (reported as momentum_balance_rel).
+//
+// Outputs use the canonical drag convention (drag_db/conventions.h): with U the superficial
+// velocity (sum of fluid velocities / box volume), u = U/eps the interstitial one,
+//   Re = U d / nu,  F = <F_d> / (3 pi nu rho d U)  (mean over bodies of the drag-only force),
+//   K = F / (1 - phi),  beta d^2/mu = 18 phi (1 - phi) F.
+// d is the reference diameter in lattice units (VoxelGrid::resolution(), or the calibrated
+// hydrodynamic diameter when RunOptions::use_hydrodynamic_diameter is set).
+//
+// Limits: Mach number max|u| sqrt(3) < mach_limit (default 0.3 stops the run; 0.1 warns), tau >
+// 1/2 strictly (tau - 1/2 < 1e-3 is refused for BGK and TRT), resolution such that the smallest
+// gap between spheres spans at least min_gap_nodes lattice units. A run that diverges or does not
+// converge within max_steps reports converged = false and a diagnosis, and never a drag value
+// (F etc. are NaN and run() throws draglab::Error unless RunOptions::throw_on_failure is false).
+//
+// Errors: invalid options, a malformed grid or packing, no bodies, a resolution too low for the
+// gaps, or a lattice too large for memory throw Error(kInvalidArgument) always (bad input). A
+// run that stops at a stability limit (tau too close to 1/2, Mach limit, NaN, density <= 0) or
+// does not converge within max_steps throws Error(kOutOfValidity) with the diagnosis as message,
+// unless throw_on_failure is false.
+//
+// Numerics (lbm_engine/src): D3Q19, populations stored shifted by their weight (f - w_i), fluid
+// nodes only (plus a one-node ghost layer of solid boundary nodes), AA-pattern in-place
+// streaming, SIMD collision. Guo forcing with the second-order velocity u = (sum f c + G/2)/rho.
+// TRT: tau+ from nu, tau- = 1/2 + Lambda/(tau+ - 1/2). Stokes mode: linear equilibrium (no u.u
+// terms; u = j). Interpolated bounce-back: Ginzburg's central linear interpolation (CLI),
+//   f_ib(x, t+1) = f*_i(x) + kappa (f*_i(x - c_i) - f*_ib(x)),  kappa = (1 - 2q)/(1 + 2q),
+// falling back to halfway bounce-back on links whose node x - c_i is solid; its net mass leak is
+// fed back through the rest populations of the wall nodes (no momentum change). Momentum
+// exchange per link (f*_i + f_ib(t+1)) c_i (Ladd; Mei et al. 2002 with the interpolated value),
+// averaged over the two steps of an AA pair. Precision::kFloat stores the shifted populations
+// in float and collides in float (16 SIMD lanes instead of 8); moments, forces and the link pass
+// arithmetic are accumulated in double. Shifting keeps the O(Ma) deviations at float's 7 digits
+// (F agrees with double to ~1e-6 on the simple-cubic cases); the momentum balance then has a
+// noise floor of ~1e-5, so the float convergence test accepts a balance up to max(tolerance,
+// 1e-4).
+//
+// Automatic choices (RunOptions::tau == 0): Re = 0 -> tau = 1.5 for TRT (its steady state does
+// not depend on tau at fixed Lambda, and a larger viscosity converges faster), 1 otherwise;
+// Re > 0 -> U from the Mach budget U = 0.1 (1 - phi)/2.5 (pore speeds reach ~2.5 U/(1 - phi)),
+// tau = min(tau_Stokes, 1/2 + 3 U d / Re). The body force starts from the force balance with the
+// BVK 2007 drag and is rescaled until Re is within re_tolerance of the target.
+//
+// Convergence: characteristic time T = d^2 / (nu (1 + Re)) steps (momentum crossing a diameter by
+// diffusion, or by advection at higher Re); checks every T/10; converged when the relative
+// change of F over the last T (and of U, with the full equilibrium) is below `tolerance`, the
+// momentum balance is below `tolerance` too (1e-4 in float), and Re is within its band.
+// error_estimate = convergence_residual (the last relative change per T) +
+// discretisation_error: the hydrodynamic-radius model S 2 delta / d, S = 1 + 3 phi d ln F/d phi
+// (van der Hoef 2005), with the wall offset delta = 0.15 (bounce-back) or 0.2/d (interpolated)
+// lattice units, fitted with a safety factor ~1.5 to the engine's simple-cubic Stokes errors
+// against Sangani-Acrivos (phi 0.027 - 0.216, d 8 - 24), plus 0.35 sqrt|Lambda - 3/16| for the
+// viscosity-dependent wall of BGK (Lambda = (tau - 1/2)^2), regularized ((tau - 1/2)/2) or TRT
+// with another Lambda, and a heuristic sqrt(1 + Re/10) growth at finite Re (src/error_model.cc).
+// It is an a-priori scale for one run; campaigns should still extrapolate in d.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "draglab/arrays/packing.h"
+#include "draglab/arrays/voxelization.h"
+
+namespace draglab {
+namespace lbm {
+
+enum class Collision {
+  kBgk,          ///< Single relaxation time (the seed's baseline).
+  kTrt,          ///< Two relaxation times, magic parameter Lambda (default 3/16).
+  kRegularized,  ///< Regularized BGK (non-equilibrium projected on 2nd-order Hermite): robust at
+                 ///< high Re / tau -> 1/2.
+};
+const char* to_string(Collision c);
+Collision collision_from_string(const std::string& s);  ///< "bgk", "trt", "rr"
+
+enum class Boundary {
+  kHalfwayBounceBack,  ///< Ladd's link bounce-back, wall at q = 1/2 regardless of geometry.
+  kInterpolated,       ///< Interpolated bounce-back using q (second order for curved walls).
+};
+const char* to_string(Boundary b);
+Boundary boundary_from_string(const std::string& s);  ///< "bb", "ibb"
+
+enum class Precision { kDouble, kFloat };
+const char* to_string(Precision p);
+Precision precision_from_string(const std::string& s);  ///< "double", "float"
+
+/// Largest target Reynolds number RunOptions accepts.
+constexpr double kMaxReynolds = 1e4;
+
+/// Progress: fraction in [0, 1] (of max_steps or of convergence), and a status line.
+using ProgressCallback = std::function<void(double fraction, const std::string& status)>;
+
+struct RunOptions {
+  Collision collision = Collision::kTrt;
+  double magic = 3.0 / 16.0;  ///< TRT Lambda = (tau+ - 1/2)(tau- - 1/2).
+  Boundary boundary = Boundary::kInterpolated;
+  Precision precision = Precision::kDouble;
+  double re = 0.0;   ///< Target Reynolds number U d / nu, >= 0; 0 = Stokes flow.
+  double tau = 0.0;  ///< Relaxation time; 0 = choose from Re and the Mach budget.
+  /// Stokes mode (linear equilibrium, no u.u terms). Default: on exactly when re == 0.
+  enum class StokesMode { kAuto, kOn, kOff } stokes_mode = StokesMode::kAuto;
+  double re_tolerance = 0.01;  ///< Achieved Re within this relative band of the target.
+  double tolerance = 1e-6;     ///< Relative drag change per characteristic time at convergence.
+  std::int64_t max_steps = 200000;
+  double mach_limit = 0.3;     ///< max |u| sqrt(3) above this stops the run.
+  double min_gap_nodes = 1.0;  ///< Smallest sphere gap must span this many lattice units.
+  bool use_hydrodynamic_diameter = false;  ///< Normalise with a calibrated d_h (bounce-back).
+  double hydrodynamic_diameter = 0.0;      ///< d_h in lattice units when the above is set.
+  int threads = 0;                         ///< OpenMP threads; 0 = all.
+  bool throw_on_failure = true;  ///< Throw draglab::Error on divergence / non-convergence.
+  bool IsValid(std::string* error) const;
+};
+
+/// One convergence check.
+struct HistoryPoint {
+  std::int64_t step;
+  double F;
+  double re;
+  double relative_change;
+};
+
+struct RunResult {
+  bool converged = false;
+  std::string diagnosis;  ///< Why the run stopped if not converged (limit, where, remedy).
+  std::int64_t steps = 0;
+  double wall_s = 0.0;
+  double mflups = 0.0;  ///< Million fluid-node updates per second.
+  // Drag (NaN unless converged).
+  double F = 0.0, K = 0.0, beta_d2_over_mu = 0.0;
+  double F_standard_error = 0.0;  ///< Over the bodies (spread of per-sphere drag / sqrt(N)).
+  std::vector<double> body_F;     ///< Per-body drag-only F along the flow (x) direction.
+  // State.
+  double re = 0.0;   ///< Achieved Re.
+  double phi = 0.0;  ///< Exact solids fraction of the packing (or lattice, without one).
+  double phi_lattice = 0.0;
+  double d = 0.0;  ///< Diameter used in the normalisation (lattice units).
+  double tau = 0.0, nu = 0.0, body_force = 0.0, superficial_velocity = 0.0;
+  double momentum_balance_rel = 0.0;  ///< |sum F_bodies - g rho V_fluid| / (g rho V_fluid).
+  double mach_max = 0.0;
+  double error_estimate = 0.0;  ///< Estimated relative discretisation + convergence error of F.
+  std::vector<HistoryPoint> history;
+  // Additions (engine diagnostics).
+  std::vector<std::string> warnings;  ///< Non-fatal findings (Mach above 0.1, boundary fallbacks).
+  std::int64_t fluid_nodes = 0;       ///< Fluid nodes updated per step.
+  std::int64_t boundary_links = 0;    ///< Links of all bodies.
+  /// Interpolated links that fell back to halfway bounce-back (second node solid).
+  std::int64_t fallback_links = 0;
+  double tau_minus = 0.0;             ///< TRT odd relaxation time (= tau for BGK / regularized).
+  bool stokes_mode = false;           ///< Linear equilibrium used.
+  double mass_change_rel = 0.0;       ///< (fluid mass at end - at start) / start.
+  double convergence_residual = 0.0;  ///< Last relative change of F per characteristic time.
+  double discretisation_error = 0.0;  ///< The discretisation part of error_estimate.
+  std::int64_t characteristic_steps = 0;  ///< Steps per characteristic time (see run()).
+  std::size_t memory_bytes = 0;           ///< Populations plus lattice tables.
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+/// Runs to steady state on a voxelized geometry (flow along +x). `phi_exact` is the exact solids
+/// fraction (Packing::phi()) or <= 0 to use the lattice one.
+RunResult run(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
+              const ProgressCallback& progress = nullptr);
+
+/// Convenience: voxelize `packing` at `resolution` (checking the gap resolution) and run.
+RunResult run(const arrays::Packing& packing, double resolution, const RunOptions& options,
+              const ProgressCallback& progress = nullptr);
+
+/// Velocity, density and solid mask of the last run's final state, for HDF5/XDMF output.
+struct Fields {
+  std::array<std::int64_t, 3> dims{0, 0, 0};
+  std::vector<float> velocity;  ///< 3 components per node (zero in solids), z-y-x node order.
+  std::vector<float> density;
+  std::vector<std::uint8_t> solid;
+};
+/// Same as run() but also returns the final fields.
+RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
+                          const RunOptions& options, Fields* fields,
+                          const ProgressCallback& progress = nullptr);
+
+/// Performance measurement (`draglab lbm bench`).
+struct BenchResult {
+  double mflups = 0.0;                   ///< 100^3 all-fluid periodic box, double, TRT.
+  double mflups_fluid_packing = 0.0;     ///< Fluid-node updates/s on a phi = 0.4 random packing
+                                         ///< (TRT, interpolated bounce-back: the default scheme).
+  double mflups_fluid_packing_bb = 0.0;  ///< Same packing, halfway bounce-back (no link pass).
+  double bandwidth_gbs = 0.0;            ///< STREAM-like in-place update kernel.
+  double roofline_fraction = 0.0;        ///< mflups / (bandwidth / 304 bytes).
+  int threads = 0;
+};
+BenchResult benchmark(int threads = 0, int repeat = 5);
+
+}  // namespace lbm
+}  // namespace draglab

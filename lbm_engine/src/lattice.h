@@ -1,0 +1,184 @@
+// lattice.h: fluid-only (sparse) storage of the D3Q19 populations with in-place AA streaming.
+//
+// Storage. Stored nodes are the fluid nodes plus a one-node "ghost" layer: the solid nodes that
+// are D3Q19 neighbours of a fluid node (about one surface shell per sphere). Deeper solid nodes
+// cost neither memory nor time. Stored nodes are numbered row by row (an x-row is the nodes
+// (*, j, k); rows in the order r = j + ny k, x fastest), and the populations are 19 padded
+// structure-of-arrays rows of length `stride` in one buffer: population i of stored node n lives
+// at flat offset i * stride + n. The row stride is padded so that consecutive rows start 192
+// bytes apart modulo 4 KiB (unpadded rows at multiples of 4 KiB alias in the caches and the TLB:
+// a 10x loss on this kind of machine). Ghost nodes are never collided; they only keep the
+// neighbour offsets of a fluid x-run contiguous (every neighbour of a fluid node is stored, so
+// the neighbour row of a run is stored without gaps).
+//
+// Blocks. The x-rows are grouped into slabs of kSlabPlanes z-planes; a slab's stored nodes,
+// segments and links are contiguous and every neighbour of a slab lies in the slab or the two
+// adjacent ones, so a slab is a self-contained unit of work: an MPI decomposition along z would
+// give each rank a range of slabs and route the offsets that leave it (the ones that point into
+// the first or last plane of a neighbouring range) through halo planes. No MPI is done here:
+// OpenMP threads get contiguous, fluid-node-balanced ranges of x-rows (static schedule), and
+// the same ranges first-touch the memory.
+//
+// AA pattern (Bailey et al. 2009), one buffer, no write-allocate traffic:
+//  - even step: node n reads f_i from row i at n, collides, and writes the post-collision f*_i to
+//    row opp(i) at n (no neighbour access);
+//  - odd step: node x reads f_i from row opp(i) at x - c_i (the f*_i its neighbour wrote in the
+//    even step), collides, and writes f*_i to row i at x + c_i. Halfway bounce-back: if x - c_i
+//    is solid, f_i is read from row i at x instead, and if x + c_i is solid, f*_i is written to
+//    row opp(i) at x as well (the copy written to the ghost is never read). The kernel selects
+//    these with the node's 18-bit solid-neighbour mask, only in segments that touch a wall.
+// After either step the post-collision population leaving x along a boundary link i (x + c_i
+// solid) sits at row opp(i), node x: that is where the momentum exchange reads it and where
+// interpolated bounce-back overwrites the value coming back.
+//
+// Segments (run-length coded neighbour table): a Segment is a run of consecutive fluid nodes of
+// one x-row (split at x = 0 and x = nx - 1, where the periodic wrap breaks the contiguity). Its
+// 18 neighbour offsets advance by one per node, so one offset per direction serves the whole run
+// and the inner loop is a unit-stride SIMD loop. The read offset of direction i is the write
+// offset of opp(i). Runs without a wall node take the plain kernel, the others the masked one.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "d3q19.h"
+#include "draglab/arrays/voxelization.h"
+
+namespace draglab {
+namespace lbm {
+
+/// A run of consecutive fluid nodes of one x-row (see the file comment).
+struct Segment {
+  std::int64_t first = 0;  ///< Stored index of the first node.
+  std::int64_t length = 0;
+  /// Flat offset of row i at the neighbour x + c_i of node `first` (fluid or ghost); write[0] is
+  /// the node itself (row 0).
+  std::int64_t write[d3q19::kQ] = {};
+  bool wall = false;  ///< Some node of the run has a solid neighbour (use the masked kernel).
+};
+
+/// Boundary links in the form the link pass needs (see solver.h), sorted by fluid node so that
+/// a node's links are contiguous (its mass correction is then race-free and deterministic) and
+/// the pass sweeps memory in order.
+struct LinkTable {
+  std::vector<std::int64_t> self;  ///< Row opp(i), node r: f*_i(r); receives the reflected value.
+  std::vector<std::int64_t> a;     ///< Row opp(i), node r - c_i.
+  std::vector<std::int64_t> b;     ///< Row i, node r.
+  std::vector<double> kappa;       ///< Interpolation weight; 0 = plain halfway bounce-back.
+  std::vector<std::int32_t> node;  ///< Fluid index r (row 0 at r holds its rest population).
+  std::vector<std::int32_t> body;  ///< Body (sphere) the link belongs to.
+  std::vector<std::uint8_t> direction;
+  std::size_t bodies = 0;
+  std::int64_t fallback_links = 0;  ///< Interpolated links that fell back to bounce-back.
+  /// Links of x-row r (of the lattice that built the table): [row_begin[r], row_begin[r+1]).
+  std::vector<std::int64_t> row_begin;
+  std::size_t size() const { return self.size(); }
+  std::size_t num_bodies() const { return bodies; }
+  /// Splits the links into `parts` contiguous chunks of about equal size that never split the
+  /// links of one node: chunk p is [result[p], result[p+1]).
+  std::vector<std::int64_t> chunks(int parts) const;
+  std::size_t memory_bytes() const {
+    return size() * (3 * sizeof(std::int64_t) + sizeof(double) + 2 * sizeof(std::int32_t) + 1);
+  }
+};
+
+class SparseLattice {
+ public:
+  /// z-planes per slab (the unit an MPI decomposition would distribute).
+  static constexpr std::int64_t kSlabPlanes = 4;
+
+  /// Builds the stored-node list, segments and thread ranges. `threads` >= 1 is the number of
+  /// work ranges (one per OpenMP thread); `element_bytes` (4 or 8) the population storage size,
+  /// which sets the padded row stride the offsets use. Throws Error(kInvalidArgument) if the
+  /// lattice has no fluid node or more than 2^31 - 1 stored nodes.
+  SparseLattice(const arrays::VoxelGrid& grid, int threads, std::size_t element_bytes);
+
+  const std::array<std::int64_t, 3>& dims() const { return dims_; }
+  std::int64_t num_nodes() const { return dims_[0] * dims_[1] * dims_[2]; }
+  std::int64_t num_fluid() const { return num_fluid_; }
+  /// Fluid plus ghost nodes.
+  std::int64_t num_stored() const { return static_cast<std::int64_t>(node_.size()); }
+  /// Row length of the population buffer (>= num_stored(), padded).
+  std::int64_t stride() const { return stride_; }
+  /// Stride for storage of element size `bytes` (4 or 8).
+  static std::int64_t padded_stride(std::int64_t num_stored, std::size_t bytes);
+  /// Dense (voxel) index of stored node n.
+  std::int64_t node(std::int64_t n) const { return node_[static_cast<std::size_t>(n)]; }
+  /// Stored index of a dense node, -1 if not stored.
+  std::int32_t stored_index(std::int64_t dense) const {
+    return stored_index_[static_cast<std::size_t>(dense)];
+  }
+  /// Bit i set: the neighbour x + c_i of stored fluid node n is solid (0 for ghosts).
+  std::uint32_t solid_mask(std::int64_t n) const { return mask_[static_cast<std::size_t>(n)]; }
+  const std::uint32_t* solid_masks() const { return mask_.data(); }
+  std::array<std::int64_t, 3> coordinates(std::int64_t n) const;
+
+  /// x-rows (ny nz of them); row r = j + ny k.
+  std::int64_t num_rows() const { return dims_[1] * dims_[2]; }
+  /// Segments of row r: [row_segment_begin(r), row_segment_begin(r+1)).
+  std::int64_t row_segment_begin(std::int64_t r) const {
+    return row_segment_begin_[static_cast<std::size_t>(r)];
+  }
+  /// First stored index of row r (num_stored() for r = num_rows()).
+  std::int64_t row_storage_begin(std::int64_t r) const {
+    return row_storage_begin_[static_cast<std::size_t>(r)];
+  }
+  const std::vector<Segment>& segments() const { return segments_; }
+  int num_ranges() const { return static_cast<int>(range_row_begin_.size()) - 1; }
+  /// Rows [range_row_begin(t), range_row_begin(t+1)) belong to work range t.
+  std::int64_t range_row_begin(int t) const {
+    return range_row_begin_[static_cast<std::size_t>(t)];
+  }
+  std::int64_t range_segment_begin(int t) const { return row_segment_begin(range_row_begin(t)); }
+  std::int64_t range_storage_begin(int t) const { return row_storage_begin(range_row_begin(t)); }
+  std::int64_t num_slabs() const { return (dims_[2] + kSlabPlanes - 1) / kSlabPlanes; }
+  /// Fluid nodes with a solid neighbour.
+  std::int64_t num_wall() const { return num_wall_; }
+  /// Mean segment length (fluid nodes per run of the neighbour table).
+  double mean_segment_length() const;
+
+  /// Link table for this lattice's offsets; kappa from q when `interpolated`, else all 0.
+  LinkTable build_links(const arrays::VoxelGrid& grid, bool interpolated) const;
+
+  /// Bytes held by the topology (node maps, masks, segments); the populations are extra.
+  std::size_t memory_bytes() const;
+
+ private:
+  std::array<std::int64_t, 3> dims_{0, 0, 0};
+  std::int64_t stride_ = 0;
+  std::int64_t num_fluid_ = 0;
+  std::int64_t num_wall_ = 0;
+  std::vector<std::int64_t> node_;
+  std::vector<std::int32_t> stored_index_;
+  std::vector<std::uint32_t> mask_;
+  std::vector<Segment> segments_;
+  std::vector<std::int64_t> row_segment_begin_;
+  std::vector<std::int64_t> row_storage_begin_;
+  std::vector<std::int64_t> range_row_begin_;
+};
+
+/// The population buffer: 19 rows of `stride` elements of T, 64-byte aligned, transparent huge
+/// pages requested, zero-initialised (the rest state, populations being shifted by w_i) by the
+/// threads of the work ranges that will update them (first touch).
+template <typename T>
+class Populations {
+ public:
+  Populations(const SparseLattice& lattice, int threads);
+  T* data() { return data_.get(); }
+  const T* data() const { return data_.get(); }
+  std::int64_t stride() const { return stride_; }
+  std::size_t bytes() const { return bytes_; }
+
+ private:
+  struct Free {
+    void operator()(T* p) const;
+  };
+  std::unique_ptr<T, Free> data_;
+  std::int64_t stride_ = 0;
+  std::size_t bytes_ = 0;
+};
+
+}  // namespace lbm
+}  // namespace draglab

@@ -1,0 +1,184 @@
+// options.cc: enum names, option validation and the text reports of a run.
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include "draglab/drag_db/error.h"
+#include "draglab/lbm/lbm.h"
+
+namespace draglab {
+namespace lbm {
+namespace {
+
+std::string format(const char* fmt, double x) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, fmt, x);
+  return buffer;
+}
+
+}  // namespace
+
+const char* to_string(Collision c) {
+  switch (c) {
+    case Collision::kBgk:
+      return "bgk";
+    case Collision::kTrt:
+      return "trt";
+    case Collision::kRegularized:
+      return "rr";
+  }
+  return "?";
+}
+
+Collision collision_from_string(const std::string& s) {
+  if (s == "bgk") return Collision::kBgk;
+  if (s == "trt") return Collision::kTrt;
+  if (s == "rr" || s == "regularized") return Collision::kRegularized;
+  throw Error(ErrorCode::kInvalidArgument,
+              "unknown collision model '" + s + "' (allowed: bgk, trt, rr)");
+}
+
+const char* to_string(Boundary b) {
+  switch (b) {
+    case Boundary::kHalfwayBounceBack:
+      return "bb";
+    case Boundary::kInterpolated:
+      return "ibb";
+  }
+  return "?";
+}
+
+Boundary boundary_from_string(const std::string& s) {
+  if (s == "bb") return Boundary::kHalfwayBounceBack;
+  if (s == "ibb") return Boundary::kInterpolated;
+  throw Error(ErrorCode::kInvalidArgument,
+              "unknown boundary scheme '" + s + "' (allowed: bb, ibb)");
+}
+
+const char* to_string(Precision p) {
+  switch (p) {
+    case Precision::kDouble:
+      return "double";
+    case Precision::kFloat:
+      return "float";
+  }
+  return "?";
+}
+
+Precision precision_from_string(const std::string& s) {
+  if (s == "double") return Precision::kDouble;
+  if (s == "float") return Precision::kFloat;
+  throw Error(ErrorCode::kInvalidArgument,
+              "unknown precision '" + s + "' (allowed: double, float)");
+}
+
+bool RunOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& message) {
+    if (error != nullptr) *error = message;
+    return false;
+  };
+  if (collision != Collision::kBgk && collision != Collision::kTrt &&
+      collision != Collision::kRegularized) {
+    return fail("collision: unknown model (allowed: bgk, trt, rr)");
+  }
+  if (boundary != Boundary::kHalfwayBounceBack && boundary != Boundary::kInterpolated) {
+    return fail("boundary: unknown scheme (allowed: bb, ibb)");
+  }
+  if (precision != Precision::kDouble && precision != Precision::kFloat) {
+    return fail("precision: unknown (allowed: double, float)");
+  }
+  if (!(std::isfinite(magic) && magic > 0.0 && magic <= 10.0)) {
+    return fail("magic: TRT Lambda must be in (0, 10], got " + format("%g", magic));
+  }
+  if (!(std::isfinite(re) && re >= 0.0 && re <= kMaxReynolds)) {
+    return fail("re: must be in [0, " + format("%g", kMaxReynolds) + "], got " + format("%g", re));
+  }
+  if (!(std::isfinite(tau) && (tau == 0.0 || (tau > 0.5 && tau <= 100.0)))) {
+    return fail("tau: must be 0 (automatic) or in (0.5, 100], got " + format("%g", tau));
+  }
+  if (stokes_mode != StokesMode::kAuto && stokes_mode != StokesMode::kOn &&
+      stokes_mode != StokesMode::kOff) {
+    return fail("stokes_mode: unknown value");
+  }
+  if (!(std::isfinite(re_tolerance) && re_tolerance > 0.0 && re_tolerance <= 0.5)) {
+    return fail("re_tolerance: must be in (0, 0.5], got " + format("%g", re_tolerance));
+  }
+  if (!(std::isfinite(tolerance) && tolerance >= 1e-12 && tolerance <= 0.1)) {
+    return fail("tolerance: must be in [1e-12, 0.1], got " + format("%g", tolerance));
+  }
+  if (max_steps < 2) return fail("max_steps: must be >= 2");
+  if (!(std::isfinite(mach_limit) && mach_limit > 0.0 && mach_limit <= 1.0)) {
+    return fail("mach_limit: must be in (0, 1], got " + format("%g", mach_limit));
+  }
+  if (!(std::isfinite(min_gap_nodes) && min_gap_nodes >= 0.0 && min_gap_nodes <= 100.0)) {
+    return fail("min_gap_nodes: must be in [0, 100], got " + format("%g", min_gap_nodes));
+  }
+  if (use_hydrodynamic_diameter &&
+      !(std::isfinite(hydrodynamic_diameter) && hydrodynamic_diameter > 0.0)) {
+    return fail("hydrodynamic_diameter: must be > 0 (lattice units) when it is used, got " +
+                format("%g", hydrodynamic_diameter));
+  }
+  if (threads < 0 || threads > 4096) return fail("threads: must be in [0, 4096] (0 = all)");
+  return true;
+}
+
+std::string RunResult::BriefReport() const {
+  std::ostringstream out;
+  if (converged) {
+    out << "F = " << format("%.6g", F) << " (K = " << format("%.6g", K)
+        << ", beta d^2/mu = " << format("%.6g", beta_d2_over_mu) << ") +- "
+        << format("%.2g", error_estimate * 100.0) << " % at Re = " << format("%.4g", re)
+        << ", phi = " << format("%.4g", phi) << ", d = " << format("%.4g", d) << "; " << steps
+        << " steps, " << format("%.3g", wall_s) << " s, " << format("%.4g", mflups) << " MFLUPS";
+  } else {
+    out << "not converged after " << steps << " steps (" << format("%.3g", wall_s)
+        << " s): " << diagnosis;
+  }
+  return out.str();
+}
+
+std::string RunResult::FullReport() const {
+  std::ostringstream out;
+  out << "converged            " << (converged ? "yes" : "no") << "\n";
+  if (!diagnosis.empty()) out << "diagnosis            " << diagnosis << "\n";
+  out << "F (drag only)        " << format("%.8g", F) << " +- " << format("%.3g", F_standard_error)
+      << " (spread over " << body_F.size() << " bodies)\n"
+      << "K = F/(1-phi)        " << format("%.8g", K) << "\n"
+      << "beta d^2/mu          " << format("%.8g", beta_d2_over_mu) << "\n"
+      << "error estimate       " << format("%.3g", error_estimate) << " (convergence "
+      << format("%.3g", convergence_residual) << ", discretisation "
+      << format("%.3g", discretisation_error) << ")\n"
+      << "Re (achieved)        " << format("%.6g", re) << (stokes_mode ? "  [Stokes mode]" : "")
+      << "\n"
+      << "phi / phi_lattice    " << format("%.6g", phi) << " / " << format("%.6g", phi_lattice)
+      << "\n"
+      << "d (lattice units)    " << format("%.6g", d) << "\n"
+      << "tau+ / tau-          " << format("%.6g", tau) << " / " << format("%.6g", tau_minus)
+      << "  (nu = " << format("%.6g", nu) << ")\n"
+      << "body force           " << format("%.6g", body_force) << "\n"
+      << "superficial U        " << format("%.6g", superficial_velocity) << "\n"
+      << "Mach (max)           " << format("%.4g", mach_max) << "\n"
+      << "momentum balance     " << format("%.3g", momentum_balance_rel) << " (relative)\n"
+      << "mass change          " << format("%.3g", mass_change_rel) << " (relative)\n"
+      << "fluid nodes / links  " << fluid_nodes << " / " << boundary_links << " (" << fallback_links
+      << " interpolation fallbacks)\n"
+      << "steps                " << steps << " (characteristic time " << characteristic_steps
+      << " steps)\n"
+      << "wall time            " << format("%.4g", wall_s) << " s, " << format("%.4g", mflups)
+      << " MFLUPS, " << format("%.4g", static_cast<double>(memory_bytes) / 1048576.0) << " MiB\n";
+  for (const std::string& w : warnings) out << "warning              " << w << "\n";
+  if (!history.empty()) {
+    out << "history (last points): step, F, Re, relative change per characteristic time\n";
+    const std::size_t first = history.size() > 10 ? history.size() - 10 : 0;
+    for (std::size_t i = first; i < history.size(); ++i) {
+      out << "  " << history[i].step << "  " << format("%.10g", history[i].F) << "  "
+          << format("%.6g", history[i].re) << "  " << format("%.3g", history[i].relative_change)
+          << "\n";
+    }
+  }
+  return out.str();
+}
+
+}  // namespace lbm
+}  // namespace draglab

@@ -1,0 +1,597 @@
+// solver.cc: the AA sweeps (SIMD over nodes), the link pass and the moment sweep.
+#include "solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
+
+namespace draglab {
+namespace lbm {
+namespace {
+
+using d3q19::kC;
+using d3q19::kOpposite;
+using d3q19::kQ;
+
+inline int thread_id() {
+#if defined(_OPENMP)
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+inline int team_size() {
+#if defined(_OPENMP)
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+
+// The sweeps name their 19 row pointers one by one: with an array of pointers GCC 12 reloads
+// them inside the loop and does not vectorize it. Written out, each loop over nodes is a plain
+// unit-stride SIMD loop over 19 streams (checked with -fopt-info-vec: 64-byte vectors).
+
+/// Even step over fluid segments [first, last): read row i, write row opp(i), same node.
+template <typename T, CollisionKernel K, bool kStokes>
+void even_sweep(T* base, std::int64_t stride, const Segment* first, const Segment* last,
+                const KernelParams<T>& p) {
+  const KernelParams<T> params = p;
+  for (const Segment* s = first; s != last; ++s) {
+    T* const r0 = base + 0 * stride + s->first;
+    T* const r1 = base + 1 * stride + s->first;
+    T* const r2 = base + 2 * stride + s->first;
+    T* const r3 = base + 3 * stride + s->first;
+    T* const r4 = base + 4 * stride + s->first;
+    T* const r5 = base + 5 * stride + s->first;
+    T* const r6 = base + 6 * stride + s->first;
+    T* const r7 = base + 7 * stride + s->first;
+    T* const r8 = base + 8 * stride + s->first;
+    T* const r9 = base + 9 * stride + s->first;
+    T* const r10 = base + 10 * stride + s->first;
+    T* const r11 = base + 11 * stride + s->first;
+    T* const r12 = base + 12 * stride + s->first;
+    T* const r13 = base + 13 * stride + s->first;
+    T* const r14 = base + 14 * stride + s->first;
+    T* const r15 = base + 15 * stride + s->first;
+    T* const r16 = base + 16 * stride + s->first;
+    T* const r17 = base + 17 * stride + s->first;
+    T* const r18 = base + 18 * stride + s->first;
+    const std::int64_t length = s->length;
+#pragma GCC ivdep
+    for (std::int64_t k = 0; k < length; ++k) {
+      T g[kQ], o[kQ];
+      g[0] = r0[k];
+      g[1] = r1[k];
+      g[2] = r2[k];
+      g[3] = r3[k];
+      g[4] = r4[k];
+      g[5] = r5[k];
+      g[6] = r6[k];
+      g[7] = r7[k];
+      g[8] = r8[k];
+      g[9] = r9[k];
+      g[10] = r10[k];
+      g[11] = r11[k];
+      g[12] = r12[k];
+      g[13] = r13[k];
+      g[14] = r14[k];
+      g[15] = r15[k];
+      g[16] = r16[k];
+      g[17] = r17[k];
+      g[18] = r18[k];
+      collide_node<T, K, kStokes>(g, o, params);
+      r0[k] = o[0];
+      r2[k] = o[1];
+      r1[k] = o[2];
+      r4[k] = o[3];
+      r3[k] = o[4];
+      r6[k] = o[5];
+      r5[k] = o[6];
+      r8[k] = o[7];
+      r7[k] = o[8];
+      r10[k] = o[9];
+      r9[k] = o[10];
+      r12[k] = o[11];
+      r11[k] = o[12];
+      r14[k] = o[13];
+      r13[k] = o[14];
+      r16[k] = o[15];
+      r15[k] = o[16];
+      r18[k] = o[17];
+      r17[k] = o[18];
+    }
+  }
+}
+
+/// Odd step over the segments [first, last): read row opp(i) at x - c_i (= the write location
+/// of opp(i)), write row i at x + c_i. Segments touching a wall take the masked variant: a solid
+/// x - c_i makes the read come from row i at x, and a solid x + c_i adds a write of f*_i to row
+/// opp(i) at x (halfway bounce-back; the write to the ghost is harmless).
+template <typename T, CollisionKernel K, bool kStokes>
+void odd_sweep(T* base, std::int64_t stride, const std::uint32_t* masks, const Segment* first,
+               const Segment* last, const KernelParams<T>& p) {
+  const KernelParams<T> params = p;
+  for (const Segment* s = first; s != last; ++s) {
+    T* const w0 = base + s->write[0];
+    T* const w1 = base + s->write[1];
+    T* const w2 = base + s->write[2];
+    T* const w3 = base + s->write[3];
+    T* const w4 = base + s->write[4];
+    T* const w5 = base + s->write[5];
+    T* const w6 = base + s->write[6];
+    T* const w7 = base + s->write[7];
+    T* const w8 = base + s->write[8];
+    T* const w9 = base + s->write[9];
+    T* const w10 = base + s->write[10];
+    T* const w11 = base + s->write[11];
+    T* const w12 = base + s->write[12];
+    T* const w13 = base + s->write[13];
+    T* const w14 = base + s->write[14];
+    T* const w15 = base + s->write[15];
+    T* const w16 = base + s->write[16];
+    T* const w17 = base + s->write[17];
+    T* const w18 = base + s->write[18];
+    const std::int64_t length = s->length;
+    if (!s->wall) {
+#pragma GCC ivdep
+      for (std::int64_t k = 0; k < length; ++k) {
+        T g[kQ], o[kQ];
+        g[0] = w0[k];
+        g[1] = w2[k];
+        g[2] = w1[k];
+        g[3] = w4[k];
+        g[4] = w3[k];
+        g[5] = w6[k];
+        g[6] = w5[k];
+        g[7] = w8[k];
+        g[8] = w7[k];
+        g[9] = w10[k];
+        g[10] = w9[k];
+        g[11] = w12[k];
+        g[12] = w11[k];
+        g[13] = w14[k];
+        g[14] = w13[k];
+        g[15] = w16[k];
+        g[16] = w15[k];
+        g[17] = w18[k];
+        g[18] = w17[k];
+        collide_node<T, K, kStokes>(g, o, params);
+        w0[k] = o[0];
+        w1[k] = o[1];
+        w2[k] = o[2];
+        w3[k] = o[3];
+        w4[k] = o[4];
+        w5[k] = o[5];
+        w6[k] = o[6];
+        w7[k] = o[7];
+        w8[k] = o[8];
+        w9[k] = o[9];
+        w10[k] = o[10];
+        w11[k] = o[11];
+        w12[k] = o[12];
+        w13[k] = o[13];
+        w14[k] = o[14];
+        w15[k] = o[15];
+        w16[k] = o[16];
+        w17[k] = o[17];
+        w18[k] = o[18];
+      }
+      continue;
+    }
+    T* const h1 = base + 1 * stride + s->first;
+    T* const h2 = base + 2 * stride + s->first;
+    T* const h3 = base + 3 * stride + s->first;
+    T* const h4 = base + 4 * stride + s->first;
+    T* const h5 = base + 5 * stride + s->first;
+    T* const h6 = base + 6 * stride + s->first;
+    T* const h7 = base + 7 * stride + s->first;
+    T* const h8 = base + 8 * stride + s->first;
+    T* const h9 = base + 9 * stride + s->first;
+    T* const h10 = base + 10 * stride + s->first;
+    T* const h11 = base + 11 * stride + s->first;
+    T* const h12 = base + 12 * stride + s->first;
+    T* const h13 = base + 13 * stride + s->first;
+    T* const h14 = base + 14 * stride + s->first;
+    T* const h15 = base + 15 * stride + s->first;
+    T* const h16 = base + 16 * stride + s->first;
+    T* const h17 = base + 17 * stride + s->first;
+    T* const h18 = base + 18 * stride + s->first;
+    const std::uint32_t* mask = masks + s->first;
+#pragma GCC ivdep
+    for (std::int64_t k = 0; k < length; ++k) {
+      T g[kQ], o[kQ];
+      const std::uint32_t m = mask[k];
+      g[0] = w0[k];
+      g[1] = (m >> 2) & 1u ? h1[k] : w2[k];
+      g[2] = (m >> 1) & 1u ? h2[k] : w1[k];
+      g[3] = (m >> 4) & 1u ? h3[k] : w4[k];
+      g[4] = (m >> 3) & 1u ? h4[k] : w3[k];
+      g[5] = (m >> 6) & 1u ? h5[k] : w6[k];
+      g[6] = (m >> 5) & 1u ? h6[k] : w5[k];
+      g[7] = (m >> 8) & 1u ? h7[k] : w8[k];
+      g[8] = (m >> 7) & 1u ? h8[k] : w7[k];
+      g[9] = (m >> 10) & 1u ? h9[k] : w10[k];
+      g[10] = (m >> 9) & 1u ? h10[k] : w9[k];
+      g[11] = (m >> 12) & 1u ? h11[k] : w12[k];
+      g[12] = (m >> 11) & 1u ? h12[k] : w11[k];
+      g[13] = (m >> 14) & 1u ? h13[k] : w14[k];
+      g[14] = (m >> 13) & 1u ? h14[k] : w13[k];
+      g[15] = (m >> 16) & 1u ? h15[k] : w16[k];
+      g[16] = (m >> 15) & 1u ? h16[k] : w15[k];
+      g[17] = (m >> 18) & 1u ? h17[k] : w18[k];
+      g[18] = (m >> 17) & 1u ? h18[k] : w17[k];
+      collide_node<T, K, kStokes>(g, o, params);
+      w0[k] = o[0];
+      w1[k] = o[1];
+      w2[k] = o[2];
+      w3[k] = o[3];
+      w4[k] = o[4];
+      w5[k] = o[5];
+      w6[k] = o[6];
+      w7[k] = o[7];
+      w8[k] = o[8];
+      w9[k] = o[9];
+      w10[k] = o[10];
+      w11[k] = o[11];
+      w12[k] = o[12];
+      w13[k] = o[13];
+      w14[k] = o[14];
+      w15[k] = o[15];
+      w16[k] = o[16];
+      w17[k] = o[17];
+      w18[k] = o[18];
+      if ((m >> 1) & 1u) h2[k] = o[1];
+      if ((m >> 2) & 1u) h1[k] = o[2];
+      if ((m >> 3) & 1u) h4[k] = o[3];
+      if ((m >> 4) & 1u) h3[k] = o[4];
+      if ((m >> 5) & 1u) h6[k] = o[5];
+      if ((m >> 6) & 1u) h5[k] = o[6];
+      if ((m >> 7) & 1u) h8[k] = o[7];
+      if ((m >> 8) & 1u) h7[k] = o[8];
+      if ((m >> 9) & 1u) h10[k] = o[9];
+      if ((m >> 10) & 1u) h9[k] = o[10];
+      if ((m >> 11) & 1u) h12[k] = o[11];
+      if ((m >> 12) & 1u) h11[k] = o[12];
+      if ((m >> 13) & 1u) h14[k] = o[13];
+      if ((m >> 14) & 1u) h13[k] = o[14];
+      if ((m >> 15) & 1u) h16[k] = o[15];
+      if ((m >> 16) & 1u) h15[k] = o[16];
+      if ((m >> 17) & 1u) h18[k] = o[17];
+      if ((m >> 18) & 1u) h17[k] = o[18];
+    }
+  }
+}
+
+template <typename T>
+class Solver final : public SolverBase {
+ public:
+  Solver(const SparseLattice& lattice, const LinkTable& links, const SolverSettings& settings,
+         int threads)
+      : lattice_(lattice),
+        links_(links),
+        settings_(settings),
+        threads_(std::max(1, threads)),
+        populations_(lattice, threads_) {
+    // Small lattices: below ~32k fluid nodes per thread a step takes well under a millisecond
+    // and the parallel region costs more than it saves (and much more when other processes
+    // share the cores: a descheduled thread stalls the barrier).
+    threads_ = static_cast<int>(std::clamp<std::int64_t>(lattice.num_fluid() / 32768, 1, threads_));
+    const int ranges = lattice.num_ranges();
+    partial_force_.resize(static_cast<std::size_t>(ranges));
+    partial_defect_.assign(static_cast<std::size_t>(ranges), 0.0);
+    for (std::size_t l = 0; l < links.size(); ++l) {
+      if (l == 0 || links.node[l] != links.node[l - 1]) ++boundary_nodes_;
+    }
+    boundary_nodes_ = std::max<std::int64_t>(1, boundary_nodes_);
+    set_force(settings.force_x);
+  }
+
+  void set_force(double force_x) override {
+    settings_.force_x = force_x;
+    params_.omega_plus = static_cast<T>(settings_.omega_plus);
+    params_.omega_minus = static_cast<T>(settings_.omega_minus);
+    params_.force_x = static_cast<T>(force_x);
+    params_.force_even = static_cast<T>((1.0 - 0.5 * settings_.omega_plus) * force_x);
+    params_.force_odd = static_cast<T>((1.0 - 0.5 * settings_.omega_minus) * force_x);
+  }
+
+  void advance_pair(std::vector<double>* body_force) override {
+    step(0, body_force != nullptr ? &even_force_ : nullptr);
+    step(1, body_force);
+    if (body_force != nullptr) {
+      // Mean over the pair: the steady state of the AA pair map may carry a period-2
+      // (checkerboard) component, whose momentum exchange cancels only over two steps.
+      for (std::size_t k = 0; k < body_force->size(); ++k) {
+        (*body_force)[k] = 0.5 * ((*body_force)[k] + even_force_[k]);
+      }
+    }
+  }
+
+  MomentSummary moments() const override {
+    const int ranges = lattice_.num_ranges();
+    std::vector<MomentSummary> partial(static_cast<std::size_t>(ranges));
+    const T* base = populations_.data();
+    const std::int64_t stride = populations_.stride();
+    const bool stokes = settings_.stokes;
+    const double half_force = 0.5 * settings_.force_x;
+    const auto& segments = lattice_.segments();
+#pragma omp parallel num_threads(threads_)
+    {
+      for (int r = thread_id(); r < ranges; r += team_size()) {
+        MomentSummary m;
+        double sum_drho = 0.0, sx = 0.0, sy = 0.0, sz = 0.0;
+        for (std::int64_t seg = lattice_.range_segment_begin(r);
+             seg < lattice_.range_segment_begin(r + 1); ++seg) {
+          const Segment& sg = segments[static_cast<std::size_t>(seg)];
+          for (std::int64_t n = sg.first; n < sg.first + sg.length; ++n) {
+            double drho = 0.0, jx = half_force, jy = 0.0, jz = 0.0;
+            bool finite = true;
+            for (int i = 0; i < kQ; ++i) {
+              const double g = base[i * stride + n];
+              finite = finite && std::isfinite(g);
+              drho += g;
+              jx += g * kC[i][0];
+              jy += g * kC[i][1];
+              jz += g * kC[i][2];
+            }
+            if (!finite) {
+              if (m.nonfinite_node < 0) m.nonfinite_node = n;
+              continue;
+            }
+            const double rho = 1.0 + drho;
+            const double inv = stokes ? 1.0 : 1.0 / rho;
+            const double ux = jx * inv, uy = jy * inv, uz = jz * inv;
+            sx += ux;
+            sy += uy;
+            sz += uz;
+            sum_drho += drho;
+            const double speed2 = ux * ux + uy * uy + uz * uz;
+            if (speed2 > m.max_speed2 || m.max_speed_node < 0) {
+              m.max_speed2 = speed2;
+              m.max_speed_node = n;
+            }
+            if (rho < m.min_rho || m.min_rho_node < 0) {
+              m.min_rho = rho;
+              m.min_rho_node = n;
+            }
+          }
+        }
+        m.sum_u[0] = sx;
+        m.sum_u[1] = sy;
+        m.sum_u[2] = sz;
+        m.sum_drho = sum_drho;
+        partial[static_cast<std::size_t>(r)] = m;
+      }
+    }
+    MomentSummary total;
+    for (const MomentSummary& m : partial) {
+      for (int c = 0; c < 3; ++c) total.sum_u[c] += m.sum_u[c];
+      total.sum_drho += m.sum_drho;
+      if (m.nonfinite_node >= 0 && total.nonfinite_node < 0)
+        total.nonfinite_node = m.nonfinite_node;
+      if (m.max_speed_node >= 0 && (total.max_speed_node < 0 || m.max_speed2 > total.max_speed2)) {
+        total.max_speed2 = m.max_speed2;
+        total.max_speed_node = m.max_speed_node;
+      }
+      if (m.min_rho_node >= 0 && (total.min_rho_node < 0 || m.min_rho < total.min_rho)) {
+        total.min_rho = m.min_rho;
+        total.min_rho_node = m.min_rho_node;
+      }
+    }
+    return total;
+  }
+
+  void scale_deviations(double factor) override {
+    T* base = populations_.data();
+    const std::int64_t stride = populations_.stride();
+    const T f = static_cast<T>(factor);
+    const int ranges = lattice_.num_ranges();
+#pragma omp parallel num_threads(threads_)
+    {
+      for (int r = thread_id(); r < ranges; r += team_size()) {
+        const std::int64_t begin = lattice_.range_storage_begin(r);
+        const std::int64_t end = lattice_.range_storage_begin(r + 1);
+        for (int i = 0; i < kQ; ++i) {
+          T* row = base + i * stride;
+#pragma omp simd
+          for (std::int64_t n = begin; n < end; ++n) row[n] *= f;
+        }
+      }
+    }
+    pending_defect_ *= factor;  // the leak is linear in the deviations too
+  }
+
+  void fill_fields(Fields* fields) const override {
+    const std::int64_t total = lattice_.num_nodes();
+    fields->dims = lattice_.dims();
+    fields->velocity.assign(static_cast<std::size_t>(3 * total), 0.0f);
+    fields->density.assign(static_cast<std::size_t>(total), 0.0f);
+    fields->solid.assign(static_cast<std::size_t>(total), 1);
+    const T* base = populations_.data();
+    const std::int64_t stride = populations_.stride();
+    const double half_force = 0.5 * settings_.force_x;
+    for (const Segment& sg : lattice_.segments()) {
+      for (std::int64_t n = sg.first; n < sg.first + sg.length; ++n) {
+        const std::size_t d = static_cast<std::size_t>(lattice_.node(n));
+        double drho = 0.0, j[3] = {half_force, 0.0, 0.0};
+        for (int i = 0; i < kQ; ++i) {
+          const double g = base[i * stride + n];
+          drho += g;
+          for (int c = 0; c < 3; ++c) j[c] += g * kC[i][c];
+        }
+        const double inv = settings_.stokes ? 1.0 : 1.0 / (1.0 + drho);
+        for (int c = 0; c < 3; ++c) fields->velocity[3 * d + c] = static_cast<float>(j[c] * inv);
+        fields->density[d] = static_cast<float>(1.0 + drho);
+        fields->solid[d] = 0;
+      }
+    }
+  }
+
+  std::size_t bytes() const override { return populations_.bytes(); }
+  double deviation(int i, std::int64_t n) const override {
+    return populations_.data()[i * populations_.stride() + n];
+  }
+  void set_deviation(int i, std::int64_t n, double value) override {
+    populations_.data()[i * populations_.stride() + n] = static_cast<T>(value);
+  }
+
+ private:
+  /// One time step in one parallel region: the collision sweep of the given parity, a barrier,
+  /// and, when interpolating or when body_force != nullptr, the link pass, each thread over the
+  /// links of its own x-rows. (Interleaving the link pass with the sweep, a few planes behind
+  /// it so that its values are still cached, measured no faster on this machine: the pass is
+  /// bound by the latency of its scattered accesses, not by bandwidth.)
+  void step(int parity, std::vector<double>* body_force) {
+    switch (settings_.kernel) {
+      case CollisionKernel::kTrt:
+        settings_.stokes ? step_with<CollisionKernel::kTrt, true>(parity, body_force)
+                         : step_with<CollisionKernel::kTrt, false>(parity, body_force);
+        break;
+      case CollisionKernel::kRegularized:
+        settings_.stokes ? step_with<CollisionKernel::kRegularized, true>(parity, body_force)
+                         : step_with<CollisionKernel::kRegularized, false>(parity, body_force);
+        break;
+    }
+  }
+
+  template <CollisionKernel K, bool kStokes>
+  void step_with(int parity, std::vector<double>* body_force) {
+    T* base = populations_.data();
+    const std::int64_t stride = populations_.stride();
+    const KernelParams<T> p = params_;
+    const int ranges = lattice_.num_ranges();
+    const Segment* segments = lattice_.segments().data();
+    const std::uint32_t* masks = lattice_.solid_masks();
+    const bool update = settings_.interpolated;
+    const bool links = update || body_force != nullptr;
+    const std::size_t bodies = links_.num_bodies();
+    if (body_force != nullptr) {
+      for (auto& partial : partial_force_) partial.assign(3 * bodies, 0.0);
+    }
+    for (auto& d : partial_defect_) d = 0.0;
+    // Net mass the interpolation added in the previous step, returned evenly through the rest
+    // populations of the boundary nodes (c_0 = 0: no momentum change). Only the net leak is
+    // corrected (local defects largely cancel, exactly so for a symmetric body in Stokes flow,
+    // and correcting them locally would perturb the second-order wall), so the total mass stays
+    // constant to within one step's leak.
+    const double correction = settings_.mass_correction && update
+                                  ? pending_defect_ / static_cast<double>(boundary_nodes_)
+                                  : 0.0;
+#pragma omp parallel num_threads(threads_)
+    {
+      for (int t = thread_id(); t < ranges; t += team_size()) {
+        const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
+        for (std::int64_t r = r0; r < r1; ++r) {
+          const Segment* first = segments + lattice_.row_segment_begin(r);
+          const Segment* last = segments + lattice_.row_segment_begin(r + 1);
+          if (parity == 0) {
+            even_sweep<T, K, kStokes>(base, stride, first, last, p);
+          } else {
+            odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p);
+          }
+        }
+      }
+      if (links) {
+        // Every post-collision value of this step must be in place before any link reads it.
+#pragma omp barrier
+        for (int t = thread_id(); t < ranges; t += team_size()) {
+          const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
+          for (std::int64_t r = r0; r < r1; ++r) {
+            link_row(t, r, parity, update, body_force != nullptr, correction);
+          }
+        }
+      }
+    }
+    if (update) {
+      pending_defect_ = 0.0;
+      for (double d : partial_defect_) pending_defect_ += d;
+    }
+    if (body_force != nullptr) {
+      // Fixed summation order: the same result whatever the thread timing.
+      body_force->assign(3 * bodies, 0.0);
+      for (const auto& partial : partial_force_) {
+        for (std::size_t k = 0; k < partial.size(); ++k) (*body_force)[k] += partial[k];
+      }
+    }
+  }
+
+  /// The links of x-row `row` (see solver.h): interpolated bounce-back with the mass
+  /// correction when `update`, momentum exchange per body into range t's partial sums when
+  /// `forces`. The reflected value is computed from the same post-collision values either way,
+  /// so the force is that of the populations the fluid receives.
+  void link_row(int t, std::int64_t row, int parity, bool update, bool forces, double correction) {
+    T* base = populations_.data();
+    const LinkTable& L = links_;
+    const std::int64_t begin = L.row_begin[static_cast<std::size_t>(row)];
+    const std::int64_t end = L.row_begin[static_cast<std::size_t>(row) + 1];
+    if (begin == end) return;
+    const bool interpolate = settings_.interpolated;
+    // Even parity: f*_i(r - c_i) at a, f*_ib(r) at b; odd parity: the other way round.
+    const std::int64_t* first = parity == 0 ? L.a.data() : L.b.data();
+    const std::int64_t* second = parity == 0 ? L.b.data() : L.a.data();
+    const std::int64_t* self = L.self.data();
+    const std::int32_t* node = L.node.data();
+    const double* kappa = L.kappa.data();
+    double* force = forces ? partial_force_[static_cast<std::size_t>(t)].data() : nullptr;
+    double defect = 0.0;
+    for (std::int64_t l = begin; l < end; ++l) {
+      const double f = base[self[l]];
+      double back = f;
+      if (interpolate) {
+        // In float, rounded as the fluid receives it.
+        back = static_cast<T>(f + kappa[l] * (double(base[first[l]]) - double(base[second[l]])));
+      }
+      if (update) {
+        base[self[l]] = static_cast<T>(back);
+        defect += back - f;
+        if (l + 1 == end || node[l + 1] != node[l]) {
+          base[node[l]] = static_cast<T>(base[node[l]] - correction);
+        }
+      }
+      if (force != nullptr) {
+        // f = g + w: the rest part 2 w_i c_i sums to zero over a closed body but is kept so that
+        // the force is the momentum exchange of the true populations.
+        const int q = L.direction[l];
+        const double sum = f + back + 2.0 * d3q19::weight(q);
+        const auto& c = kC[q];
+        double* fb = force + 3 * static_cast<std::size_t>(L.body[l]);
+        fb[0] += sum * c[0];
+        fb[1] += sum * c[1];
+        fb[2] += sum * c[2];
+      }
+    }
+    partial_defect_[static_cast<std::size_t>(t)] += defect;
+  }
+
+  const SparseLattice& lattice_;
+  const LinkTable& links_;
+  SolverSettings settings_;
+  int threads_;
+  Populations<T> populations_;
+  KernelParams<T> params_;
+  std::vector<double> even_force_;
+  std::vector<std::vector<double>> partial_force_;  ///< Per work range.
+  std::vector<double> partial_defect_;              ///< Per work range.
+  double pending_defect_ = 0.0;  ///< Net mass added by the last interpolation pass.
+  std::int64_t boundary_nodes_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<SolverBase> make_solver(Precision precision, const SparseLattice& lattice,
+                                        const LinkTable& links, const SolverSettings& settings,
+                                        int threads) {
+  if (precision == Precision::kFloat) {
+    return std::make_unique<Solver<float>>(lattice, links, settings, threads);
+  }
+  return std::make_unique<Solver<double>>(lattice, links, settings, threads);
+}
+
+}  // namespace lbm
+}  // namespace draglab
