@@ -313,6 +313,8 @@ class Solver final : public SolverBase {
     }
   }
 
+  double force_magnitude() const override { return force_magnitude_; }
+
   MomentSummary moments() const override {
     const int ranges = lattice_.num_ranges();
     std::vector<MomentSummary> partial(static_cast<std::size_t>(ranges));
@@ -472,7 +474,7 @@ class Solver final : public SolverBase {
     const bool links = update || body_force != nullptr;
     const std::size_t bodies = links_.num_bodies();
     if (body_force != nullptr) {
-      for (auto& partial : partial_force_) partial.assign(3 * bodies, 0.0);
+      for (auto& partial : partial_force_) partial.assign(3 * bodies + 1, 0.0);
     }
     for (auto& d : partial_defect_) d = 0.0;
     // Net mass the interpolation added in the previous step, returned evenly through the rest
@@ -515,9 +517,12 @@ class Solver final : public SolverBase {
     if (body_force != nullptr) {
       // Fixed summation order: the same result whatever the thread timing.
       body_force->assign(3 * bodies, 0.0);
+      double magnitude = 0.0;
       for (const auto& partial : partial_force_) {
-        for (std::size_t k = 0; k < partial.size(); ++k) (*body_force)[k] += partial[k];
+        for (std::size_t k = 0; k < 3 * bodies; ++k) (*body_force)[k] += partial[k];
+        magnitude += partial[3 * bodies];
       }
+      force_magnitude_ = parity == 1 ? 0.5 * (force_magnitude_ + magnitude) : magnitude;
     }
   }
 
@@ -561,6 +566,7 @@ class Solver final : public SolverBase {
         const double sum = f + back + 2.0 * d3q19::weight(q);
         const auto& c = kC[q];
         double* fb = force + 3 * static_cast<std::size_t>(L.body[l]);
+        force[3 * links_.num_bodies()] += std::abs(sum * c[0]);
         fb[0] += sum * c[0];
         fb[1] += sum * c[1];
         fb[2] += sum * c[2];
@@ -578,7 +584,8 @@ class Solver final : public SolverBase {
   std::vector<double> even_force_;
   std::vector<std::vector<double>> partial_force_;  ///< Per work range.
   std::vector<double> partial_defect_;              ///< Per work range.
-  double pending_defect_ = 0.0;  ///< Net mass added by the last interpolation pass.
+  double pending_defect_ = 0.0;   ///< Net mass added by the last interpolation pass.
+  double force_magnitude_ = 0.0;  ///< See force_magnitude().
   std::int64_t boundary_nodes_ = 0;
 };
 

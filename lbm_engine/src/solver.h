@@ -59,6 +59,9 @@ class SolverBase {
   /// Two time steps (even then odd, with their link passes). If body_force is non-null it gets
   /// 3 components per body: the momentum exchange of the second step.
   virtual void advance_pair(std::vector<double>* body_force) = 0;
+  /// Sum over links of |momentum exchange along x| of the last force evaluation: the scale of the
+  /// round-off in the body-force sum (about 1e-16 of it).
+  virtual double force_magnitude() const = 0;
   /// Valid after advance_pair (streamed layout).
   virtual MomentSummary moments() const = 0;
   /// Multiplies every population deviation g_i = f_i - w_i by `factor` (rescales a Stokes

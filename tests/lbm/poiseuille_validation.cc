@@ -20,10 +20,11 @@
 // Tolerances:
 //  - 1e-10 relative on the superficial velocity (a double sum over the fluid nodes): round-off of
 //    O(1e-16) per node times at most a few thousand nodes, plus the remaining transient, which a
-//    convergence tolerance of 1e-12 bounds (the slowest channel mode decays by e^-pi^2 per
-//    characteristic time H^2/nu, so the change per characteristic time is the remaining error);
-//    1e-10 leaves a wide margin and is still six orders below the smallest BGK deviation tested
-//    (5e-5).
+//    convergence tolerance of 1e-11 bounds (the slowest channel mode decays by e^-pi^2 per
+//    characteristic time H^2/nu, so the change per characteristic time is the remaining error;
+//    the engine also requires the momentum balance below the tolerance, and its round-off floor
+//    reaches ~1e-12 in the wider channels, so 1e-12 could never be met); 1e-10 is still seven
+//    orders below the smallest slip deviation the tests must see (1.9e-3).
 //  - 2e-6 relative on the node-by-node profile: the fields are single precision (relative spacing
 //    6e-8 of a float, doubled for the subtraction, with a margin for the sum of the mean).
 //  - 1e-10 on the momentum balance, as required of a converged run.
@@ -40,7 +41,7 @@ namespace lbm {
 namespace validation {
 namespace {
 
-constexpr double kConvergedTolerance = 1e-12;  // the smallest the engine accepts
+constexpr double kConvergedTolerance = 1e-11;
 constexpr double kMeanTolerance = 1e-10;
 constexpr double kProfileTolerance = 2e-6;
 constexpr double kBalanceTolerance = 1e-10;
@@ -54,17 +55,8 @@ RunOptions plates_options(Collision collision, double tau, double magic, double 
   options.re = re;
   options.tolerance = kConvergedTolerance;
   options.max_steps = 2000000;
+  options.throw_on_failure = false;
   return options;
-}
-
-std::string describe(const PlatesOutcome& o) {
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "lambda=%.4g U-error vs parabola=%.3e, vs lattice solution=%.3e; profile vs "
-                "parabola=%.3e, vs lattice=%.3e; cross=%.1e | ",
-                o.lambda, o.mean_error_vs_parabola, o.mean_error_vs_lattice_solution,
-                o.profile_error_vs_parabola, o.profile_error_vs_lattice_solution, o.cross_flow);
-  return line + format_run(o.result);
 }
 
 void expect_converged_and_balanced(const PlatesOutcome& o) {

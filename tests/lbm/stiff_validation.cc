@@ -11,11 +11,11 @@
 //     the momentum balance holds, and F is near the van der Hoef 2005 fit (37.85 at phi = 0.6):
 //     within 20 % for one packing at d = 16 (mean gaps of 0.1-0.2 d are only 2-3 nodes wide, so
 //     the near-contact regions are under-resolved; realization scatter at N = 27 is several %).
-//  b. Re = 1000 at phi = 0.3 (random packing, 27 spheres, d = 16, engine defaults). The Mach
-//     budget (max |u| ~ 0.1) gives nu = U d/Re and tau = 1/2 + 1.3e-3, boundary layers of
-//     d/sqrt(Re) = 0.5 node: hopelessly under-resolved. The flow at this Re is also unsteady
-//     in random arrays. Expected: no drag value; the run stops (within a bounded number of
-//     steps) with a diagnosis naming the limit it hit.
+//  b. Re = 1000 at phi = 0.3 (random packing, 27 spheres, d = 16, engine defaults, with TRT and
+//     with the regularized collision). The Mach budget (max |u| ~ 0.1) gives nu = U d/Re and
+//     tau = 1/2 + 1.3e-3, boundary layers of d/sqrt(Re) = 0.5 node: hopelessly under-resolved.
+//     Expected: no drag value; the run stops before the step limit at a stability limit
+//     (divergence or the Mach limit), with the node and a remedy named.
 //  c. tau = 0.5001: refused up front for TRT and BGK (tau - 1/2 < 1e-3) with a diagnosis that
 //     names tau and the remedy, after zero steps. The regularized collision accepts it; in Stokes
 //     flow it is stable, but the viscosity 3.3e-5 makes the steady state d^2/nu ~ 4e6 steps
@@ -76,18 +76,27 @@ TEST(StiffValidation, DenseRandomPackingPhi06) {
 
 TEST(StiffValidation, Re1000AtPhi03StopsWithADiagnosis) {
   const arrays::Packing packing = make_random_packing(0.3, 27, 1);
-  RunOptions options;  // engine defaults: TRT, interpolated bounce-back, tau from the Mach budget
-  options.re = 1000.0;
-  options.min_gap_nodes = 0.0;
-  options.max_steps = 40000;
-  options.throw_on_failure = false;
-  const RunResult r = lbm::run(packing, 16.0, options);
-  report("stiff Re=1000 phi=0.3 d=16", format_run(r) + " | " + r.diagnosis);
-  expect_no_drag(r);
-  EXPECT_LE(r.steps, options.max_steps);
-  // The throwing variant reports the same failure as an exception.
-  options.throw_on_failure = true;
-  EXPECT_THROW(lbm::run(packing, 16.0, options), Error);
+  for (Collision collision : {Collision::kTrt, Collision::kRegularized}) {
+    RunOptions options;  // engine defaults: interpolated bounce-back, tau from the Mach budget
+    options.collision = collision;
+    options.re = 1000.0;
+    options.min_gap_nodes = 0.0;
+    options.max_steps = 40000;
+    options.throw_on_failure = false;
+    const RunResult r = lbm::run(packing, 16.0, options);
+    report(std::string("stiff Re=1000 phi=0.3 d=16 ") + to_string(collision),
+           format_run(r) + " | " + r.diagnosis);
+    expect_no_drag(r);
+    // A stability limit (divergence: non-finite values or density <= 0; or the Mach limit),
+    // hit before the step limit, with the place and a remedy named.
+    EXPECT_TRUE(contains(r.diagnosis, "diverged") || contains(r.diagnosis, "Mach")) << r.diagnosis;
+    EXPECT_TRUE(contains(r.diagnosis, "node")) << r.diagnosis;
+    EXPECT_TRUE(contains(r.diagnosis, "remedy")) << r.diagnosis;
+    EXPECT_LT(r.steps, options.max_steps);
+    // The throwing variant reports the same failure as an exception.
+    options.throw_on_failure = true;
+    EXPECT_THROW(lbm::run(packing, 16.0, options), Error);
+  }
 }
 
 TEST(StiffValidation, TauNearOneHalf) {

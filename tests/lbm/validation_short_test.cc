@@ -8,7 +8,7 @@
 //     parameter, (tau - 1/2)^2 for BGK, (tau - 1/2)/2 for the regularized collision
 //     (validation_support.h, run_plates). TRT with Lambda = 3/16 is exact; BGK's error depends on
 //     tau exactly as predicted. Tolerance 1e-10 on the superficial velocity: round-off plus a
-//     transient bounded by the convergence tolerance 1e-12.
+//     transient bounded by the convergence tolerance 1e-11.
 //  2. Stokes drag on a simple-cubic array, phi = 0.125, d = 12, against the Sangani & Acrivos
 //     1982 series, in the drag-only convention F = (1 - phi) K. Tolerances per scheme:
 //       TRT + interpolated bounce-back (IBB): 2 %. Second order with an erratic, placement-
@@ -76,8 +76,9 @@ RunOptions plates_options(Collision collision, double tau, double re) {
   options.boundary = Boundary::kHalfwayBounceBack;
   options.tau = tau;
   options.re = re;
-  options.tolerance = 1e-12;
+  options.tolerance = 1e-11;
   options.max_steps = 1000000;
+  options.throw_on_failure = false;
   return options;
 }
 
@@ -85,8 +86,7 @@ TEST(LbmValidationShort, PoiseuilleTrtExactBgkDependsOnTau) {
   const int H = 16;
   for (double tau : {0.6, 1.5}) {
     const PlatesOutcome o = run_plates(H, plates_options(Collision::kTrt, tau, 0.0));
-    report("short poiseuille trt tau=" + std::to_string(tau),
-           std::to_string(o.mean_error_vs_parabola) + " | " + format_run(o.result));
+    report("short poiseuille trt tau=" + std::to_string(tau), describe(o));
     ASSERT_TRUE(o.result.converged) << o.result.diagnosis;
     EXPECT_LT(std::fabs(o.mean_error_vs_parabola), 1e-10);
     EXPECT_LT(o.profile_error_vs_parabola, 2e-6);  // single-precision fields
@@ -103,8 +103,7 @@ TEST(LbmValidationShort, PoiseuilleTrtExactBgkDependsOnTau) {
   std::vector<double> bgk_errors;
   for (double tau : {0.6, 1.0, 1.5}) {
     const PlatesOutcome o = run_plates(H, plates_options(Collision::kBgk, tau, 0.0));
-    report("short poiseuille bgk tau=" + std::to_string(tau),
-           std::to_string(o.mean_error_vs_parabola) + " | " + format_run(o.result));
+    report("short poiseuille bgk tau=" + std::to_string(tau), describe(o));
     ASSERT_TRUE(o.result.converged) << o.result.diagnosis;
     const double lambda = (tau - 0.5) * (tau - 0.5);
     EXPECT_NEAR(o.mean_error_vs_parabola, (16.0 * lambda - 3.0) / (2.0 * H * H + 1.0), 1e-10);
@@ -142,7 +141,7 @@ TEST_P(ShortSimpleCubic, StokesDragAgainstSanganiAcrivos) {
   const RunResult r = lbm::run(sc.grid, sc.packing.phi(), options);
   const double error = r.F / sangani_acrivos_F(phi) - 1.0;
   report(std::string("short sc ") + c.name,
-         "rel.error " + std::to_string(error) + " | " + format_run(r));
+         "rel.error " + scientific(error) + " | " + format_run(r));
   ASSERT_TRUE(r.converged) << r.diagnosis;
   EXPECT_LT(std::fabs(error), c.tolerance);
   EXPECT_LT(r.momentum_balance_rel, c.precision == Precision::kFloat ? 1e-4 : 1e-5);
@@ -212,7 +211,7 @@ TEST(LbmValidationShort, RandomArraysNearVanDerHoef2005) {
     options.min_gap_nodes = 0.0;  // hard-sphere packings have near contacts at any resolution
     const RunResult r = lbm::run(packing, 12.0, options);
     report("short random phi=0.3 seed=" + std::to_string(seed),
-           "F/F_vdH - 1 = " + std::to_string(r.F / reference - 1.0) + " | " + format_run(r));
+           "F/F_vdH - 1 = " + scientific(r.F / reference - 1.0) + " | " + format_run(r));
     ASSERT_TRUE(r.converged) << r.diagnosis;
     ASSERT_EQ(r.body_F.size(), 27u);
     EXPECT_NEAR(mean_of(r.body_F), r.F, 1e-9 * r.F);

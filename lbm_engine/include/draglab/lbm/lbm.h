@@ -140,7 +140,9 @@ struct RunResult {
   double F_standard_error = 0.0;  ///< Over the bodies (spread of per-sphere drag / sqrt(N)).
   std::vector<double> body_F;     ///< Per-body drag-only F along the flow (x) direction.
   // State.
-  double re = 0.0;   ///< Achieved Re.
+  /// Achieved Re = U d / nu; 0 for a Stokes-mode run with target 0 (the linear scheme solves
+  /// the Re -> 0 limit; the lattice U d / nu is then only a scale, kept in the history).
+  double re = 0.0;
   double phi = 0.0;  ///< Exact solids fraction of the packing (or lattice, without one).
   double phi_lattice = 0.0;
   double d = 0.0;  ///< Diameter used in the normalisation (lattice units).
@@ -178,16 +180,17 @@ RunResult run(const arrays::Packing& packing, double resolution, const RunOption
 /// Velocity, density and solid mask of the last run's final state, for HDF5/XDMF output.
 struct Fields {
   std::array<std::int64_t, 3> dims{0, 0, 0};
-  std::vector<float> velocity;  ///< 3 components per node (zero in solids), z-y-x node order.
-  std::vector<float> density;
-  std::vector<std::uint8_t> solid;
+  std::vector<float> velocity;      ///< 3 components per node (zero in solids), z-y-x node order.
+  std::vector<float> density;       ///< rho (0 in solids).
+  std::vector<std::uint8_t> solid;  ///< 1 = solid.
 };
 /// Same as run() but also returns the final fields.
 RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
                           const RunOptions& options, Fields* fields,
                           const ProgressCallback& progress = nullptr);
 
-/// Performance measurement (`draglab lbm bench`).
+/// Performance measurement (`draglab lbm bench`): medians of `repeat` interleaved runs (see
+/// src/bench.cc); about 10 s per repeat on a 2-core machine. threads = 0: all.
 struct BenchResult {
   double mflups = 0.0;                   ///< 100^3 all-fluid periodic box, double, TRT.
   double mflups_fluid_packing = 0.0;     ///< Fluid-node updates/s on a phi = 0.4 random packing
