@@ -1,5 +1,5 @@
-// lattice.cc: fluid list in blocks, run-length coded AA neighbour table, work ranges, links and
-// the first-touch population buffer.
+// lattice.cc: stored-node list (fluid + ghost layer) by x-rows, run-length coded AA neighbour
+// table, work ranges, links and the first-touch population buffer.
 #include "lattice.h"
 
 #include <algorithm>

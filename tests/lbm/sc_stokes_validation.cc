@@ -90,8 +90,7 @@ void expect_sound(const ScRun& run) {
   EXPECT_NEAR(run.result.phi, run.phi, 1e-12);  // the exact solids fraction is reported
 }
 
-// ---- 2a: within 1 % at d <= 24
-// -------------------------------------------------------------------
+// ---- 2a: within 1 % at d <= 24 ------------------------------------------------------------------
 
 class ScAccuracy : public ::testing::TestWithParam<double> {};
 
@@ -107,8 +106,7 @@ TEST_P(ScAccuracy, TrtInterpolatedWithinOnePercentAtDiameter24) {
 INSTANTIATE_TEST_SUITE_P(ScStokesValidation, ScAccuracy,
                          ::testing::Values(0.027, 0.064, 0.125, 0.216));
 
-// ---- 2b: convergence orders
-// ----------------------------------------------------------------------
+// ---- 2b: convergence orders ---------------------------------------------------------------------
 
 struct OrderCase {
   double phi;
@@ -184,6 +182,44 @@ INSTANTIATE_TEST_SUITE_P(
                       OrderCase{0.125, Boundary::kHalfwayBounceBack, kSweep, 6, 0.4, 1.5},
                       OrderCase{0.216, Boundary::kInterpolated, kSweep, 6, 1.4, 3.0},
                       OrderCase{0.216, Boundary::kHalfwayBounceBack, kSweep, 6, 0.4, 1.5}));
+
+// ---- 3: tau independence at fixed Lambda --------------------------------------------------------
+
+TEST(ScStokesValidation, TrtDragIsIndependentOfTauAtFixedLambdaBgkIsNot) {
+  const double phi = 0.125;
+  const double d = 16.0;
+  const std::vector<double> taus = {0.6, 1.0, 1.5, 3.0};
+  for (Collision collision : {Collision::kTrt, Collision::kBgk}) {
+    for (Boundary boundary : {Boundary::kHalfwayBounceBack, Boundary::kInterpolated}) {
+      if (collision == Collision::kBgk && boundary == Boundary::kInterpolated) continue;
+      std::vector<double> F;
+      for (double tau : taus) {
+        RunOptions options = stokes_options(collision, boundary, tau);
+        options.tolerance = 1e-10;
+        options.max_steps = 2000000;
+        const ScRun run = run_sc(phi, d, options);
+        expect_sound(run);
+        F.push_back(run.result.F);
+      }
+      const double spread =
+          (*std::max_element(F.begin(), F.end()) - *std::min_element(F.begin(), F.end())) /
+          mean_of(F);
+      char text[160];
+      std::snprintf(text, sizeof(text),
+                    "F(tau=0.6, 1.0, 1.5, 3.0) = %.8g %.8g %.8g %.8g, spread %.3e", F[0], F[1],
+                    F[2], F[3], spread);
+      report(std::string("sc stokes tau dependence ") + to_string(collision) + "-" +
+                 to_string(boundary),
+             text);
+      if (collision == Collision::kTrt) {
+        EXPECT_LT(spread, 1e-6);
+      } else {
+        EXPECT_GT(spread, 0.01);
+        for (std::size_t i = 1; i < F.size(); ++i) EXPECT_GT(F[i - 1], F[i]);
+      }
+    }
+  }
+}
 
 }  // namespace
 }  // namespace validation

@@ -46,7 +46,7 @@ namespace lbm {
 namespace validation {
 namespace {
 
-// ---- reference data ---------------------------------------------------------------------------
+// ---- reference data -----------------------------------------------------------------------------
 
 TEST(LbmValidationShort, SanganiAcrivosSeriesMatchesZickHomsy) {
   const auto rows = read_data_csv("zick_homsy_sc_dilute.csv");
@@ -68,7 +68,7 @@ TEST(LbmValidationShort, VanDerHoefFormulaMatchesTabulatedValues) {
   }
 }
 
-// ---- 1. Poiseuille ----------------------------------------------------------------------------
+// ---- 1. Poiseuille ------------------------------------------------------------------------------
 
 RunOptions plates_options(Collision collision, double tau, double re) {
   RunOptions options;
@@ -164,7 +164,7 @@ INSTANTIATE_TEST_SUITE_P(
                       SchemeCase{"trt-ibb-float", Collision::kTrt, Boundary::kInterpolated,
                                  kFastStokesTau, Precision::kFloat, 0.02}));
 
-// ---- 3. tau independence ----------------------------------------------------------------------
+// ---- 3. tau independence ------------------------------------------------------------------------
 
 TEST(LbmValidationShort, TrtDragIndependentOfTauBgkNot) {
   const ScArray sc = make_sc_array(0.125, 12.0);
