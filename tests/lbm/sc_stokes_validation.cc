@@ -35,11 +35,11 @@
 //      (runs at tolerance 1e-10; accepted spread 1e-6). This holds for BB and for the engine's
 //      interpolation, Ginzburg's central linear interpolation (CLI), whose closure combines
 //      post-collision values along one link line with tau-free weights (1 - 2q)/(1 + 2q), i.e.
-//      is parametrized by Lambda alone (Ginzburg, Verhaeghe & d'Humieres 2008); a Bouzidi-type
-//      scheme would not pass (its error depends on tau at fixed Lambda). BGK
+//      is parametrized by Lambda alone (Ginzburg, Verhaeghe & d'Humieres 2008); a closure that
+//      mixed tau into its weights would not pass. BGK
 //      (Lambda = (tau - 1/2)^2) moves the bounce-back wall with tau: the Poiseuille analogue
 //      (poiseuille_validation.cc) gives a relative flow-rate change of (16 Delta Lambda)/(2 H^2)
-//      between tau = 0.6 and 1.5, i.e. 3 % for a 16-node channel (13 % up to tau = 3); the pores
+//      between tau = 0.6 and 1.5, i.e. 3 % for a 16-node channel (19 % up to tau = 3); the pores
 //      of this array (phi = 0.125, d = 16: gaps of 10 nodes) are narrower, so BGK must show a
 //      spread > 1 %, with F falling as tau grows (the wall slips more as Lambda rises from 0.01
 //      to 6.25).
