@@ -55,6 +55,15 @@ void add_db_commands(CLI::App& app, CliContext& ctx);
 /// Registers `draglab lbm ...` (lbm_commands.cc).
 void add_lbm_commands(CLI::App& app, CliContext& ctx);
 
+/// Registers `draglab campaign ...` and `draglab dataset ...` (campaign_commands.cc).
+void add_campaign_commands(CLI::App& app, CliContext& ctx);
+/// Registers `draglab fit` and `draglab law publish` (fit_commands.cc).
+void add_fit_commands(CLI::App& app, CliContext& ctx);
+/// Registers `draglab report` (report_commands.cc).
+void add_report_commands(CLI::App& app, CliContext& ctx);
+/// Registers `draglab pipeline` (pipeline_commands.cc).
+void add_pipeline_commands(CLI::App& app, CliContext& ctx);
+
 /// Parses "a,b,c" into doubles; throws UsageError naming `field`.
 std::vector<double> parse_double_list(const std::string& text, const std::string& field);
 /// Formats a double with `digits` significant digits.

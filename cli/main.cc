@@ -104,6 +104,10 @@ int main(int argc, char** argv) {
   draglab::cli::add_pack_commands(app, ctx);
   draglab::cli::add_db_commands(app, ctx);
   draglab::cli::add_lbm_commands(app, ctx);
+  draglab::cli::add_campaign_commands(app, ctx);
+  draglab::cli::add_fit_commands(app, ctx);
+  draglab::cli::add_report_commands(app, ctx);
+  draglab::cli::add_pipeline_commands(app, ctx);
 
   try {
     app.parse(argc, argv);

@@ -17,6 +17,9 @@ packages=(
   libssl-dev                        # SHA-256 content hashes (OpenSSL libcrypto)
   nlohmann-json3-dev                # JSON output and records
   libceres-dev libeigen3-dev        # automatic derivatives (Jet), fitting
+  libnlopt-dev                      # global and minimax fits (fitter/)
+  libtomlplusplus-dev               # campaign specs (TOML)
+  python3-matplotlib                # draglab report: PNG figures (Debian's /usr/bin/python3)
   libcli11-dev libfmt-dev           # command line
   libhdf5-dev hdf5-tools            # packing and field files (h5dump: format tests)
   libgtest-dev                      # test suite

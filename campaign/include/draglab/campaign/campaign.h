@@ -1,0 +1,121 @@
+// draglab/campaign/campaign.h: drag data campaigns with the LBM engine.
+//
+// A campaign is a grid of units, one per (phi, Re, realization, resolution): generate the
+// realization's random packing (deterministic seed from the spec's seed, phi index and
+// realization), run the LBM engine at the resolution and target Re, and commit the measurement
+// (F, beta, achieved Re, error estimate, steps, wall time, convergence status and diagnosis,
+// packing hash, code version) in its own transaction. The spec is TOML (docs/campaigns.md,
+// examples in data/campaigns/). State lives in the drag-law database (schema version 4 tables
+// campaigns and campaign_units), so a campaign killed at any moment (SIGKILL included) resumes
+// with --resume: finished units are kept, units that were in flight are re-run, none is
+// duplicated (a unit row is claimed and completed by single UPDATE transactions). A unit that
+// diverges or does not converge is recorded as failed with the engine's diagnosis and does not
+// stop the others. Units run in parallel across the cores (`jobs` workers, each with its own
+// database connection; the LBM runs of a worker use threads = max(1, cores / jobs)).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "draglab/drag_db/dataset.h"
+
+namespace draglab {
+class Database;
+
+namespace campaign {
+
+/// A campaign spec (TOML). Every field is validated by IsValid and by parse_campaign_spec, which
+/// names the field and the allowed range in its Error(kInvalidArgument).
+struct CampaignSpec {
+  std::string name;                 ///< [campaign] name, non-empty.
+  std::string description;          ///< [campaign] description (optional).
+  std::vector<double> phi;          ///< [grid] phi: solids fractions, each in [0.05, 0.6].
+  std::vector<double> re;           ///< [grid] re: target Re (superficial), each in [0, 1000].
+  int realizations = 1;             ///< [grid] realizations per (phi, Re), [1, 100].
+  std::uint64_t seed = 1;           ///< [grid] seed: base seed of the packings.
+  int spheres = 16;                 ///< [packing] spheres per box, [1, 100000] (or box_size).
+  double box_size = 0.0;            ///< [packing] box edge in diameters (> 0 overrides spheres).
+  std::string distribution = "mono";  ///< [packing] mono, bi or lognormal.
+  double size_ratio = 2.0;          ///< [packing] bidisperse d_large/d_small.
+  double large_fraction = 0.5;      ///< [packing] bidisperse volume share of the large spheres.
+  double sigma = 0.2;               ///< [packing] lognormal sigma of ln d.
+  double min_gap = 0.0;             ///< [packing] min surface gap in d; 0 = 1.5/min(resolutions).
+  std::vector<double> resolutions;  ///< [lbm] resolutions d (lattice units per diameter), >= 4.
+  std::string collision = "trt";    ///< [lbm] trt, bgk or rr.
+  std::string boundary = "ibb";     ///< [lbm] ibb or bb.
+  double tolerance = 1e-5;          ///< [lbm] convergence tolerance (relative change per T).
+  std::int64_t max_steps = 200000;  ///< [lbm] step limit of one unit.
+  std::string extrapolation = "richardson";  ///< [dataset] richardson, inverse_d or finest.
+  bool IsValid(std::string* error) const;
+  /// Canonical JSON text (stored with the campaign; its hash identifies the spec).
+  std::string to_json() const;
+};
+
+/// Parses and validates a TOML spec file: unknown keys, missing or empty grids, values out of
+/// range and contradictions (e.g. spheres and box_size both set) are Error(kInvalidArgument).
+CampaignSpec parse_campaign_spec(const std::string& path);
+CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::string& origin);
+
+/// One unit's stored state.
+struct UnitRecord {
+  std::int64_t id = 0;
+  std::int64_t campaign_id = 0;
+  double phi = 0.0;
+  double re_target = 0.0;
+  int realization = 0;
+  double resolution = 0.0;
+  std::string status;  ///< "pending", "running", "done" or "failed".
+  // Measurement (status "done"):
+  double F = 0.0, beta_d2_over_mu = 0.0, re = 0.0, error_estimate = 0.0;
+  std::int64_t steps = 0;
+  double wall_s = 0.0;
+  double mflups = 0.0;
+  std::string diagnosis;  ///< Why a failed unit failed (the engine's diagnosis).
+  std::string packing_hash;
+  std::string code_version;
+  std::string finished_at;
+};
+
+struct CampaignStatus {
+  std::int64_t id = 0;
+  std::string name;
+  std::string spec_hash;
+  std::string created_at;
+  std::int64_t units_total = 0, units_done = 0, units_failed = 0, units_pending = 0,
+               units_running = 0;
+  double wall_s = 0.0;  ///< Sum of the finished units' run times.
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+struct RunCampaignOptions {
+  int jobs = 0;         ///< Parallel units; 0 = number of cores.
+  bool resume = false;  ///< Continue the campaign of the same name (same spec hash required).
+  /// Progress: units finished (done + failed), total, and a status line (ETA included).
+  std::function<void(std::int64_t finished, std::int64_t total, const std::string& line)>
+      progress;
+};
+
+/// Creates the campaign (or, with resume, finds it) and runs its pending units. Returns the
+/// final status. Errors: Error(kInvalidArgument) for a spec that fails IsValid, a new campaign
+/// whose name exists (use resume) or a resume whose spec differs from the stored one.
+CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
+                            const RunCampaignOptions& options);
+
+/// Status by id (decimal) or name; throws Error(kNotFound).
+CampaignStatus campaign_status(const Database& db, const std::string& id_or_name);
+std::vector<CampaignStatus> list_campaigns(const Database& db);
+std::vector<UnitRecord> list_units(const Database& db, std::int64_t campaign_id);
+CampaignSpec stored_spec(const Database& db, std::int64_t campaign_id);
+
+/// Builds the dataset of a campaign from its finished units (per (phi, Re): realization mean and
+/// standard error at each resolution, then the spec's resolution extrapolation), stores it
+/// (store_dataset) and returns it. Points whose units all failed are left out and listed in
+/// *skipped (if given). Throws Error(kInvalidArgument) if no point has a finished unit.
+Dataset build_dataset(Database& db, std::int64_t campaign_id,
+                      std::vector<std::string>* skipped = nullptr);
+
+}  // namespace campaign
+}  // namespace draglab

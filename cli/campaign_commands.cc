@@ -1,0 +1,10 @@
+// Placeholder: `draglab campaign` is being written (replaced by the real commands).
+#include "cli/cli_context.h"
+
+namespace draglab {
+namespace cli {
+
+void add_campaign_commands(CLI::App& /*app*/, CliContext& /*ctx*/) {}
+
+}  // namespace cli
+}  // namespace draglab

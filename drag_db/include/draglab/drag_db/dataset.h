@@ -1,0 +1,70 @@
+// draglab/drag_db/dataset.h: drag datasets, the input of the fitter.
+//
+// A dataset is one table of drag measurements on a (phi, Re) grid: per point the mean canonical
+// drag-only F over packing realizations with its standard error, extrapolated in resolution
+// (Richardson with the measured order, or the seed's 1/d extrapolation) with a discretisation-error
+// estimate, and the total 1-sigma uncertainty. Conventions (drag_db/conventions.h): F = F_d/(3 pi
+// mu d eps u) drag only, Re = rho eps d u / mu with the superficial velocity eps u.
+//
+// Datasets are immutable once stored: the content hash (SHA-256 over the canonical JSON of the
+// points) is their identity, the id is its first 12 hex digits, and SQL triggers refuse UPDATE and
+// DELETE (schema version 4, docs/database.md). Storing the same points twice returns the
+// existing dataset. They come from a campaign (campaign::build_dataset) or from a CSV file
+// (users' own LBM or DNS data: read_dataset_csv). Storage: drag_db/src/db/dataset_store.cc.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace draglab {
+class Database;
+
+/// One (phi, Re) point. Absolute uncertainties (same units as F), 1 sigma.
+struct DatasetPoint {
+  double phi = 0.0;        ///< Solids fraction (exact, of the packings).
+  double re_target = 0.0;  ///< Requested Re (0 = Stokes flow).
+  double re = 0.0;         ///< Mean achieved Re = U d / nu (superficial), 0 for Stokes runs.
+  double F = 0.0;          ///< Canonical drag-only F, resolution-extrapolated mean.
+  double F_standard_error = 0.0;        ///< Over realizations (0 if only one).
+  double F_discretisation_error = 0.0;  ///< Resolution-extrapolation (or engine) estimate.
+  double F_uncertainty = 0.0;           ///< sqrt(standard_error^2 + discretisation_error^2).
+  int realizations = 0;                 ///< Converged realizations that entered the mean.
+  std::vector<double> resolutions;      ///< Resolutions d (lattice units per diameter) used.
+  std::vector<double> F_at_resolution;  ///< Mean F at each resolution (same order).
+  double order = 0.0;                   ///< Convergence order used (0: none / not measured).
+  std::string extrapolation;            ///< "richardson", "inverse_d" or "finest".
+  double wall_s = 0.0;                  ///< Total LBM run time of the point's units.
+};
+
+struct Dataset {
+  std::string id;    ///< First 12 hex digits of `hash`.
+  std::string hash;  ///< SHA-256 over the canonical JSON of the points (dataset_hash).
+  std::int64_t campaign_id = 0;  ///< 0 for imported data.
+  std::string name;              ///< Campaign name or the imported file's stem.
+  std::string method;            ///< How it was built: JSON text (extrapolation, options).
+  std::string created_at;        ///< ISO 8601 UTC.
+  std::string code_version;      ///< draglab version that built it.
+  std::vector<DatasetPoint> points;
+};
+
+/// SHA-256 (hex) of the canonical JSON of the points (values as %.17g); stable across runs.
+std::string dataset_hash(const std::vector<DatasetPoint>& points);
+
+/// Stores `dataset` (computing hash and id; created_at and code_version if empty) in one
+/// transaction; if a dataset with the same hash exists, returns that one unchanged.
+Dataset store_dataset(Database& db, Dataset dataset);
+/// Loads by id or unique hash prefix (at least 4 hex digits); throws Error(kNotFound).
+Dataset load_dataset(const Database& db, const std::string& id_or_prefix);
+/// All datasets, newest first, without their points.
+std::vector<Dataset> list_datasets(const Database& db);
+
+/// CSV with a header line; columns phi,re,F,F_uncertainty are required (re_target defaults to
+/// re, the other fields to 0/empty), '#' lines are comments. Throws Error(kInvalidArgument)
+/// naming the line and column for malformed input (non-numeric, phi outside (0, 0.74], Re < 0,
+/// F <= 0, uncertainty <= 0).
+Dataset read_dataset_csv(const std::string& path);
+/// Writes every field of the points (resolutions joined with ';').
+void write_dataset_csv(const Dataset& dataset, const std::string& path);
+
+}  // namespace draglab

@@ -1,0 +1,109 @@
+// draglab/fitter/fit.h: fitting drag-law forms to drag data (Ceres, confirmed by NLopt).
+//
+// A form from the law library (drag_db/law_form.h) is fitted with the same templated formula the
+// library evaluates, so Ceres gets automatic derivatives (ceres::Jet through
+// LawForm::F_autodiff). Default form: the seed's Eq. 6 (vdh2004), freeing the C0 and C1
+// coefficients k0, k1, c10, c11, c12 (the seed's a, b, c0, c1, c2; these aliases are accepted,
+// as is n for n0). Objective, with F_i +- sigma_i the data and F(x) the model, both canonical
+// drag-only F:
+//   least squares: sum_i rho(((F(phi_i, Re_i; x) - F_i) / sigma_i)^2)  (sigma absolute; for data
+//     spanning orders of magnitude this is the relative residual over the relative uncertainty),
+//     rho = identity or a robust loss (Huber, Cauchy) with scale `loss_scale` sigmas;
+//   minimax: max_i |F(x)/F_i - 1| (NLopt, epigraph form).
+// Uncertainty: Ceres covariance of the free parameters (scaled by chi2/dof when chi2/dof > 1),
+// 95 % intervals from the Student t quantile with dof = points - free; optional bootstrap over the
+// points; k-fold cross-validation RMS relative error. NLopt: a global search (multi-start around
+// the optimum) confirms that Ceres found the global optimum, and the physical constraints (F > 0,
+// dF/dRe >= 0 on a grid over the validity box) are checked for the least-squares optimum and
+// imposed in the minimax fit.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "draglab/drag_db/law.h"
+
+namespace draglab {
+namespace fitter {
+
+/// One data point: canonical F at (phi, Re superficial) with its absolute 1-sigma uncertainty.
+struct FitPoint {
+  double phi = 0.0;
+  double re = 0.0;
+  double F = 0.0;
+  double sigma = 0.0;
+};
+
+enum class Objective { kLeastSquares, kMinimax };
+const char* to_string(Objective o);
+Objective objective_from_string(const std::string& s);  ///< "lsq", "minimax"
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+const char* to_string(RobustLoss l);
+RobustLoss robust_loss_from_string(const std::string& s);  ///< "none", "huber", "cauchy"
+
+struct FitOptions {
+  std::string form = "vdh2004";  ///< Law-form key.
+  /// Parameters to fit (names or aliases); empty = the form's default set (vdh2004: k0, k1, c10,
+  /// c11, c12; other forms: all parameters).
+  std::vector<std::string> free;
+  /// Starting / fixed values by name (others: the form's published defaults).
+  std::vector<std::pair<std::string, double>> initial;
+  Objective objective = Objective::kLeastSquares;
+  RobustLoss loss = RobustLoss::kNone;
+  double loss_scale = 2.0;        ///< Robust loss scale in units of sigma, > 0.
+  bool global_check = true;       ///< NLopt multi-start global search around the optimum.
+  bool check_constraints = true;  ///< F > 0 and dF/dRe >= 0 over the validity grid.
+  int cv_folds = 5;               ///< k-fold cross-validation (0 = off; needs points >= 2 folds).
+  int bootstrap = 0;              ///< Bootstrap resamples for a covariance check (0 = off).
+  unsigned seed = 1;              ///< Seeds the folds, the bootstrap and the global search.
+  bool IsValid(std::string* error) const;
+  std::string to_json() const;  ///< Canonical JSON text (stored as the law's fitter settings).
+};
+
+struct FitResult {
+  std::string form;
+  std::vector<std::string> names;  ///< All parameters of the form, in the form's order.
+  std::vector<double> values;
+  std::vector<bool> is_free;
+  std::vector<double> covariance;           ///< Full n x n row-major, zeros for fixed ones.
+  std::vector<double> ci95_low, ci95_high;  ///< 95 % intervals (= value for fixed ones).
+  int num_points = 0, num_free = 0, dof = 0;
+  double chi2 = 0.0, chi2_per_dof = 0.0;
+  double rms_rel_err = 0.0, max_rel_err = 0.0;  ///< Of the fit against the data.
+  double cv_rms_rel_err = -1.0;                 ///< -1 if not computed.
+  std::vector<double> bootstrap_stddev;         ///< Per parameter, empty if not computed.
+  // NLopt confirmation.
+  bool global_checked = false;
+  double global_best_cost = 0.0;  ///< Best least-squares cost the global search found.
+  bool global_agrees = true;      ///< Ceres' cost within 1e-6 relative of the global best.
+  bool constraints_checked = false;
+  bool constraints_satisfied = true;
+  std::string constraint_report;  ///< Where a constraint is violated, if anywhere.
+  std::string ceres_report;       ///< ceres::Solver::Summary::BriefReport().
+  bool converged = false;
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+/// Fits `points` as the options say. Throws Error(kInvalidArgument) for invalid options, an
+/// unknown form or parameter (listing the valid names), non-positive F or sigma, or fewer points
+/// than free parameters + 1; Error(kOutOfValidity) if the optimizer does not converge.
+FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options);
+
+/// Index of parameter `name_or_alias` of `form`; throws Error(kInvalidArgument) listing names.
+int parameter_index(const LawForm& form, const std::string& name_or_alias);
+
+/// Relative errors F(phi_i, Re_i)/F_i - 1 of a law against the points (for comparisons).
+std::vector<double> relative_errors(const Law& law, const std::vector<FitPoint>& points);
+
+/// A draft record of the fitted law: form, fitted values, covariance, the form's convention and
+/// validity box narrowed to the data's (phi, Re) range, provenance kind "fitted" with the given
+/// dataset id/hash, fitter settings JSON (options + residual statistics) and code version.
+LawRecord fitted_record(const FitResult& result, const FitOptions& options,
+                        const std::string& name, const std::string& dataset_id,
+                        const std::string& dataset_hash, const std::vector<FitPoint>& points);
+
+}  // namespace fitter
+}  // namespace draglab
