@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/drag_db/error.h"
+#include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/law.h"
 #include "drag_db_version.h"
 
@@ -53,6 +54,9 @@ std::string exact(double x) {
   return buf;
 }
 
+
+}  // namespace
+
 std::string sha256_hex(const std::string& data) {
   unsigned char digest[EVP_MAX_MD_SIZE];
   unsigned int length = 0;
@@ -67,8 +71,6 @@ std::string sha256_hex(const std::string& data) {
   }
   return out;
 }
-
-}  // namespace
 
 const char* to_string(ForceKind v) { return enum_name(v, kForceKinds); }
 const char* to_string(Normalisation v) { return enum_name(v, kNormalisations); }

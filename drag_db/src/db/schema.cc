@@ -297,6 +297,113 @@ END;
   return sql;
 }
 
+// Version 4: drag campaigns, their units (one LBM measurement each) and datasets.
+//   campaigns: one row per campaign, the spec as canonical JSON and its hash; rows are never
+//     changed or deleted (a campaign with another spec is another campaign).
+//   campaign_units: one row per (phi, Re, realization, resolution) of a campaign; a unit moves
+//     pending -> running -> done | failed through single-statement UPDATEs (a worker claims the
+//     next pending unit with UPDATE ... RETURNING, so no unit runs twice); a finished unit (done
+//     or failed) is immutable, and units are never deleted. A process killed mid-run leaves its
+//     claimed units 'running'; `campaign run --resume` returns them to 'pending'.
+//   datasets: immutable tables of (phi, Re) points identified by the SHA-256 of their canonical
+//     JSON (dataset.h); no UPDATE, DELETE or REPLACE.
+std::string migration_4() {
+  return R"sql(
+CREATE TABLE campaigns (
+  id INTEGER PRIMARY KEY,
+  name TEXT NOT NULL UNIQUE,
+  spec_json TEXT NOT NULL,
+  spec_hash TEXT NOT NULL,
+  created_at TEXT NOT NULL,
+  code_version TEXT NOT NULL
+);
+CREATE TABLE campaign_units (
+  id INTEGER PRIMARY KEY,
+  campaign_id INTEGER NOT NULL REFERENCES campaigns(id),
+  phi_index INTEGER NOT NULL,
+  re_index INTEGER NOT NULL,
+  realization INTEGER NOT NULL,
+  resolution_index INTEGER NOT NULL,
+  phi REAL NOT NULL,
+  re_target REAL NOT NULL,
+  resolution REAL NOT NULL,
+  seed INTEGER NOT NULL,
+  status TEXT NOT NULL DEFAULT 'pending'
+    CHECK (status IN ('pending', 'running', 'done', 'failed')),
+  attempts INTEGER NOT NULL DEFAULT 0,
+  claimed_by TEXT,
+  started_at TEXT,
+  finished_at TEXT,
+  F REAL,
+  beta_d2_over_mu REAL,
+  re REAL,
+  error_estimate REAL,
+  steps INTEGER,
+  wall_s REAL,
+  mflups REAL,
+  converged INTEGER,
+  diagnosis TEXT,
+  packing_hash TEXT,
+  code_version TEXT,
+  result_json TEXT,
+  UNIQUE (campaign_id, phi_index, re_index, realization, resolution_index)
+);
+CREATE INDEX campaign_units_by_status ON campaign_units (campaign_id, status);
+CREATE TABLE datasets (
+  id TEXT PRIMARY KEY,
+  hash TEXT NOT NULL UNIQUE,
+  campaign_id INTEGER,
+  name TEXT NOT NULL,
+  method TEXT NOT NULL,
+  created_at TEXT NOT NULL,
+  code_version TEXT NOT NULL,
+  points_json TEXT NOT NULL
+);
+CREATE TRIGGER campaigns_immutable_update BEFORE UPDATE ON campaigns
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: campaigns are immutable (a campaign with another spec is a new campaign); create a new version instead');
+END;
+CREATE TRIGGER campaigns_immutable_delete BEFORE DELETE ON campaigns
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: campaigns are immutable and cannot be deleted; create a new version instead');
+END;
+CREATE TRIGGER campaigns_no_replace_insert BEFORE INSERT ON campaigns
+WHEN EXISTS (SELECT 1 FROM campaigns WHERE id = NEW.id OR name = NEW.name)
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: a campaign with this id or name exists (resume it, or choose another name); create a new version instead');
+END;
+CREATE TRIGGER campaign_units_finished_immutable BEFORE UPDATE ON campaign_units
+WHEN OLD.status IN ('done', 'failed')
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: a finished campaign unit is immutable; create a new version instead');
+END;
+CREATE TRIGGER campaign_units_no_delete BEFORE DELETE ON campaign_units
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: campaign units are never deleted; create a new version instead');
+END;
+CREATE TRIGGER campaign_units_no_replace_insert BEFORE INSERT ON campaign_units
+WHEN EXISTS (SELECT 1 FROM campaign_units WHERE id = NEW.id OR (campaign_id = NEW.campaign_id
+  AND phi_index = NEW.phi_index AND re_index = NEW.re_index AND realization = NEW.realization
+  AND resolution_index = NEW.resolution_index))
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: this campaign unit exists already; create a new version instead');
+END;
+CREATE TRIGGER datasets_immutable_update BEFORE UPDATE ON datasets
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: datasets are immutable; create a new version instead');
+END;
+CREATE TRIGGER datasets_immutable_delete BEFORE DELETE ON datasets
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: datasets are immutable and cannot be deleted; create a new version instead');
+END;
+CREATE TRIGGER datasets_no_replace_insert BEFORE INSERT ON datasets
+WHEN EXISTS (SELECT 1 FROM datasets WHERE id = NEW.id OR hash = NEW.hash)
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: datasets are immutable (a dataset with this id or hash exists); create a new version instead');
+END;
+)sql";
+}
+
 }  // namespace
 
 const std::vector<Migration>& migrations() {
@@ -306,6 +413,8 @@ const std::vector<Migration>& migrations() {
       {2, "law_events: append-only history of every law version", migration_2()},
       {3, "no REPLACE conflict resolution against published, retracted or history rows",
        migration_3()},
+      {4, "drag campaigns, campaign units (measurements) and immutable datasets",
+       migration_4()},
   };
   return all;
 }
@@ -365,6 +474,16 @@ std::vector<std::string> expected_triggers(int schema_version) {
   if (schema_version >= 3) {
     for (const char* name :
          {"laws_no_replace_insert", "laws_no_replace_update", "law_events_no_replace_insert"}) {
+      names.push_back(name);
+    }
+  }
+  if (schema_version >= 4) {
+    for (const char* name :
+         {"campaigns_immutable_update", "campaigns_immutable_delete",
+          "campaigns_no_replace_insert", "campaign_units_finished_immutable",
+          "campaign_units_no_delete", "campaign_units_no_replace_insert",
+          "datasets_immutable_update", "datasets_immutable_delete",
+          "datasets_no_replace_insert"}) {
       names.push_back(name);
     }
   }

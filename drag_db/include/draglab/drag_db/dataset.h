@@ -48,6 +48,10 @@ struct Dataset {
   std::vector<DatasetPoint> points;
 };
 
+/// SHA-256 of `data` as 64 lower-case hex digits: the hash of law contents, datasets and
+/// packings.
+std::string sha256_hex(const std::string& data);
+
 /// SHA-256 (hex) of the canonical JSON of the points (values as %.17g); stable across runs.
 std::string dataset_hash(const std::vector<DatasetPoint>& points);
 

@@ -1,0 +1,62 @@
+// Private helpers of the campaign module, exposed to its tests: resolution extrapolation,
+// deterministic seeds, content hashes and the unit cost model.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "draglab/arrays/packing.h"
+#include "draglab/campaign/campaign.h"
+
+namespace draglab {
+namespace campaign {
+namespace internal {
+
+/// Result of a resolution extrapolation F(d) -> F(d = infinity).
+struct Extrapolation {
+  double F_inf = 0.0;
+  double order = 0.0;               ///< Convergence order p used (0: none).
+  double discretisation_error = 0.0;  ///< |F_inf - F(finest)|, absolute.
+  std::string method;               ///< "richardson", "inverse_d" or "finest" (what was done).
+  std::string note;                 ///< Why a fallback was taken ("" if none).
+};
+
+/// Richardson extrapolation from the three finest resolutions with the measured order: solves
+/// (F1 - F2)/(F2 - F3) = (d1^-p - d2^-p)/(d2^-p - d3^-p) for p (bisection, p in [0.25, 6];
+/// d1 < d2 < d3 need not be in constant ratio), then F_inf = F3 - (F2 - F3) d3^-p /
+/// (d2^-p - d3^-p). Falls back to inverse_d (with a note) for fewer than 3 resolutions, for
+/// non-monotone data, or for an order outside [0.5, 4] (noise, not asymptotic convergence).
+/// `d` and `F` are in the same order; d need not be sorted.
+Extrapolation extrapolate_richardson(const std::vector<double>& d, const std::vector<double>& F);
+
+/// The seed's extrapolation: least-squares fit of F(d) = F_inf + a/d over all resolutions (>= 2;
+/// with 1 it returns "finest" with zero discretisation error and a note).
+Extrapolation extrapolate_inverse_d(const std::vector<double>& d, const std::vector<double>& F);
+
+/// Deterministic packing seed of (spec seed, phi index, realization): splitmix64 mixing, masked to
+/// 63 bits so that it fits SQLite's signed INTEGER. Independent of Re and resolution, so every
+/// Re and resolution of a realization sees the same geometry.
+std::uint64_t packing_seed(std::uint64_t spec_seed, int phi_index, int realization);
+
+/// SHA-256 (hex) of `text` (OpenSSL).
+std::string sha256_hex(const std::string& text);
+
+/// SHA-256 of the packing's box, centres and diameters written as %.17g.
+std::string packing_hash(const arrays::Packing& packing);
+
+/// Random-packing options of a unit (phi, spheres from spheres or box_size, distribution, gap).
+arrays::RandomPackingOptions packing_options(const CampaignSpec& spec, double phi,
+                                             std::uint64_t seed);
+
+/// The minimum surface gap (in d) the packings of `spec` use: spec.min_gap, or 1.5 lattice units at
+/// the coarsest resolution when it is 0 (the engine needs >= 1 node across every gap).
+double effective_min_gap(const CampaignSpec& spec);
+
+/// Relative cost estimate of a unit (fluid nodes x steps, with an empirical factor for the
+/// non-linear scheme at Re > 0): used only for the order of work and the ETA.
+double unit_cost_estimate(const CampaignSpec& spec, double phi, double re, double resolution);
+
+}  // namespace internal
+}  // namespace campaign
+}  // namespace draglab

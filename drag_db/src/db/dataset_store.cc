@@ -1,0 +1,363 @@
+// Storage of drag datasets (dataset.h) in the datasets table of schema version 4, and their CSV
+// form. A dataset's identity is the SHA-256 of the canonical JSON of its points; the row holds
+// the same JSON, so what is loaded is byte for byte what was hashed.
+#include <sqlite3.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "db/schema.h"
+#include "db/sqlite_util.h"
+#include "drag_db_version.h"
+#include "draglab/drag_db/database.h"
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace {
+
+using db::Statement;
+using db::Transaction;
+
+constexpr int kDatasetSchema = 4;
+
+std::string exact(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+// Canonical JSON: fixed key order (nlohmann::json sorts object keys), doubles as %.17g strings so
+// that the text, and the hash, do not depend on the JSON library's number formatting.
+nlohmann::json canonical_points(const std::vector<DatasetPoint>& points) {
+  nlohmann::json array = nlohmann::json::array();
+  for (const DatasetPoint& p : points) {
+    nlohmann::json resolutions = nlohmann::json::array(), at = nlohmann::json::array();
+    for (double d : p.resolutions) resolutions.push_back(exact(d));
+    for (double f : p.F_at_resolution) at.push_back(exact(f));
+    array.push_back({{"phi", exact(p.phi)},
+                     {"re_target", exact(p.re_target)},
+                     {"re", exact(p.re)},
+                     {"F", exact(p.F)},
+                     {"F_standard_error", exact(p.F_standard_error)},
+                     {"F_discretisation_error", exact(p.F_discretisation_error)},
+                     {"F_uncertainty", exact(p.F_uncertainty)},
+                     {"realizations", p.realizations},
+                     {"resolutions", resolutions},
+                     {"F_at_resolution", at},
+                     {"order", exact(p.order)},
+                     {"extrapolation", p.extrapolation},
+                     {"wall_s", exact(p.wall_s)}});
+  }
+  return array;
+}
+
+double number_of(const nlohmann::json& j) { return std::stod(j.get<std::string>()); }
+
+std::vector<DatasetPoint> points_from_json(const std::string& text) {
+  const nlohmann::json array = nlohmann::json::parse(text);
+  std::vector<DatasetPoint> points;
+  for (const nlohmann::json& j : array) {
+    DatasetPoint p;
+    p.phi = number_of(j.at("phi"));
+    p.re_target = number_of(j.at("re_target"));
+    p.re = number_of(j.at("re"));
+    p.F = number_of(j.at("F"));
+    p.F_standard_error = number_of(j.at("F_standard_error"));
+    p.F_discretisation_error = number_of(j.at("F_discretisation_error"));
+    p.F_uncertainty = number_of(j.at("F_uncertainty"));
+    p.realizations = j.at("realizations").get<int>();
+    for (const auto& d : j.at("resolutions")) p.resolutions.push_back(number_of(d));
+    for (const auto& f : j.at("F_at_resolution")) p.F_at_resolution.push_back(number_of(f));
+    p.order = number_of(j.at("order"));
+    p.extrapolation = j.at("extrapolation").get<std::string>();
+    p.wall_s = number_of(j.at("wall_s"));
+    points.push_back(p);
+  }
+  return points;
+}
+
+void require_dataset_schema(sqlite3* handle, const std::string& what) {
+  const int version = db::read_schema_version(handle);
+  if (version < kDatasetSchema) {
+    throw Error(ErrorCode::kDatabase,
+                "database '" + db::database_path(handle) + "' has schema version " +
+                    std::to_string(version) + ", " + what + " needs version " +
+                    std::to_string(kDatasetSchema) + ": run `draglab db migrate` on it");
+  }
+}
+
+Dataset dataset_from_row(const Statement& row, bool with_points) {
+  Dataset d;
+  d.id = row.text(0);
+  d.hash = row.text(1);
+  d.campaign_id = row.is_null(2) ? 0 : row.integer(2);
+  d.name = row.text(3);
+  d.method = row.text(4);
+  d.created_at = row.text(5);
+  d.code_version = row.text(6);
+  if (with_points) d.points = points_from_json(row.text(7));
+  return d;
+}
+
+constexpr const char* kSelect =
+    "SELECT id, hash, campaign_id, name, method, created_at, code_version, points_json "
+    "FROM datasets ";
+
+// Validation shared by storing and CSV import: every number a fit will divide by or take the
+// log of must be finite and in range.
+void validate_point(const DatasetPoint& p, const std::string& where) {
+  auto fail = [&](const std::string& field, double value, const std::string& range) {
+    throw Error(ErrorCode::kInvalidArgument, where + ": " + field + " = " + exact(value) +
+                                                 " is out of range (allowed: " + range + ")");
+  };
+  if (!(p.phi > 0.0 && p.phi <= 0.74)) fail("phi", p.phi, "(0, 0.74]");
+  if (!(p.re >= 0.0 && std::isfinite(p.re))) fail("re", p.re, "finite, >= 0");
+  if (!(p.re_target >= 0.0 && std::isfinite(p.re_target))) {
+    fail("re_target", p.re_target, "finite, >= 0");
+  }
+  if (!(p.F > 0.0 && std::isfinite(p.F))) fail("F", p.F, "finite, > 0");
+  if (!(p.F_uncertainty > 0.0 && std::isfinite(p.F_uncertainty))) {
+    fail("F_uncertainty", p.F_uncertainty, "finite, > 0");
+  }
+}
+
+}  // namespace
+
+std::string dataset_hash(const std::vector<DatasetPoint>& points) {
+  return sha256_hex(canonical_points(points).dump());
+}
+
+Dataset store_dataset(Database& database, Dataset dataset) {
+  sqlite3* handle = database.handle();
+  if (dataset.points.empty()) {
+    throw Error(ErrorCode::kInvalidArgument, "dataset '" + dataset.name + "' has no points");
+  }
+  for (std::size_t i = 0; i < dataset.points.size(); ++i) {
+    validate_point(dataset.points[i], "dataset '" + dataset.name + "', point " + std::to_string(i));
+  }
+  const std::string points_json = canonical_points(dataset.points).dump();
+  dataset.hash = sha256_hex(points_json);
+  dataset.id = dataset.hash.substr(0, 12);
+  if (dataset.created_at.empty()) dataset.created_at = db::utc_now_iso8601();
+  if (dataset.code_version.empty()) dataset.code_version = kDragDbVersion;
+  if (dataset.method.empty()) dataset.method = "{}";
+  Transaction t(handle, Transaction::Kind::kWrite);
+  require_dataset_schema(handle, "storing a dataset");
+  {
+    Statement existing(handle, std::string(kSelect) + "WHERE hash = ?1");
+    existing.bind(1, dataset.hash);
+    if (existing.step()) return dataset_from_row(existing, true);  // same points: same dataset
+  }
+  Statement insert(handle,
+                   "INSERT INTO datasets (id, hash, campaign_id, name, method, created_at, "
+                   "code_version, points_json) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+  insert.bind(1, dataset.id).bind(2, dataset.hash);
+  if (dataset.campaign_id > 0) {
+    insert.bind(3, dataset.campaign_id);
+  } else {
+    insert.bind_null(3);
+  }
+  insert.bind(4, dataset.name).bind(5, dataset.method).bind(6, dataset.created_at);
+  insert.bind(7, dataset.code_version).bind(8, points_json);
+  insert.run();
+  t.commit();
+  dataset.points = points_from_json(points_json);  // exactly what is stored
+  return dataset;
+}
+
+Dataset load_dataset(const Database& database, const std::string& id_or_prefix) {
+  sqlite3* handle = database.handle();
+  const bool hex = !id_or_prefix.empty() &&
+                   id_or_prefix.find_first_not_of("0123456789abcdef") == std::string::npos;
+  if (!hex || id_or_prefix.size() < 4) {
+    throw Error(ErrorCode::kNotFound,
+                "dataset '" + id_or_prefix +
+                    "': a dataset id is at least 4 lower-case hex digits of its hash (see "
+                    "`draglab dataset list`)");
+  }
+  Transaction t(handle, Transaction::Kind::kRead);
+  require_dataset_schema(handle, "loading a dataset");
+  Statement q(handle, std::string(kSelect) + "WHERE hash >= ?1 AND hash < ?2 ORDER BY hash");
+  q.bind(1, id_or_prefix).bind(2, id_or_prefix + "g");  // 'g' sorts after every hex digit
+  std::vector<Dataset> found;
+  while (q.step()) found.push_back(dataset_from_row(q, true));
+  if (found.empty()) {
+    throw Error(ErrorCode::kNotFound, "no dataset '" + id_or_prefix + "' in '" + database.path() +
+                                          "' (see `draglab dataset list`)");
+  }
+  if (found.size() > 1) {
+    throw Error(ErrorCode::kNotFound, "dataset prefix '" + id_or_prefix + "' is ambiguous (" +
+                                          std::to_string(found.size()) +
+                                          " datasets): give more digits");
+  }
+  return found.front();
+}
+
+std::vector<Dataset> list_datasets(const Database& database) {
+  sqlite3* handle = database.handle();
+  Transaction t(handle, Transaction::Kind::kRead);
+  if (db::read_schema_version(handle) < kDatasetSchema) return {};
+  Statement q(handle, std::string(kSelect) + "ORDER BY created_at DESC, id");
+  std::vector<Dataset> all;
+  while (q.step()) all.push_back(dataset_from_row(q, false));
+  return all;
+}
+
+namespace {
+
+std::vector<std::string> split(const std::string& line, char separator) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(line);
+  while (std::getline(in, item, separator)) {
+    const auto b = item.find_first_not_of(" \t\r");
+    const auto e = item.find_last_not_of(" \t\r");
+    out.push_back(b == std::string::npos ? "" : item.substr(b, e - b + 1));
+  }
+  if (!line.empty() && line.back() == separator) out.push_back("");
+  return out;
+}
+
+}  // namespace
+
+Dataset read_dataset_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "dataset file '" + path + "' cannot be read: " + std::strerror(errno));
+  }
+  std::string line;
+  int line_number = 0;
+  std::vector<std::string> header;
+  std::map<std::string, std::size_t> column;
+  Dataset dataset;
+  const std::size_t slash = path.find_last_of('/');
+  dataset.name = path.substr(slash == std::string::npos ? 0 : slash + 1);
+  if (dataset.name.size() > 4 && dataset.name.substr(dataset.name.size() - 4) == ".csv") {
+    dataset.name.resize(dataset.name.size() - 4);
+  }
+  while (std::getline(in, line)) {
+    ++line_number;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::string where = "'" + path + "' line " + std::to_string(line_number);
+    if (header.empty()) {
+      header = split(line, ',');
+      for (std::size_t c = 0; c < header.size(); ++c) column[header[c]] = c;
+      for (const char* required : {"phi", "re", "F", "F_uncertainty"}) {
+        if (!column.count(required)) {
+          throw Error(ErrorCode::kInvalidArgument,
+                      where + ": the header has no column '" + required +
+                          "' (required: phi,re,F,F_uncertainty; optional: re_target, "
+                          "F_standard_error, F_discretisation_error, realizations, resolutions, "
+                          "F_at_resolution, order, extrapolation, wall_s)");
+        }
+      }
+      continue;
+    }
+    const std::vector<std::string> cells = split(line, ',');
+    if (cells.size() != header.size()) {
+      throw Error(ErrorCode::kInvalidArgument, where + ": " + std::to_string(cells.size()) +
+                                                   " columns, the header has " +
+                                                   std::to_string(header.size()));
+    }
+    auto number = [&](const std::string& name, double fallback) {
+      const auto it = column.find(name);
+      if (it == column.end() || cells[it->second].empty()) return fallback;
+      const std::string& text = cells[it->second];
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) {
+        throw Error(ErrorCode::kInvalidArgument,
+                    where + ", column '" + name + "': '" + text + "' is not a finite number");
+      }
+      return v;
+    };
+    auto list = [&](const std::string& name) {
+      std::vector<double> values;
+      const auto it = column.find(name);
+      if (it == column.end() || cells[it->second].empty()) return values;
+      for (const std::string& item : split(cells[it->second], ';')) {
+        char* end = nullptr;
+        const double v = std::strtod(item.c_str(), &end);
+        if (end == item.c_str() || *end != '\0' || !std::isfinite(v)) {
+          throw Error(ErrorCode::kInvalidArgument,
+                      where + ", column '" + name + "': '" + item + "' is not a finite number");
+        }
+        values.push_back(v);
+      }
+      return values;
+    };
+    DatasetPoint p;
+    p.phi = number("phi", NAN);
+    p.re = number("re", NAN);
+    p.re_target = number("re_target", p.re);
+    p.F = number("F", NAN);
+    p.F_uncertainty = number("F_uncertainty", NAN);
+    p.F_standard_error = number("F_standard_error", 0.0);
+    p.F_discretisation_error = number("F_discretisation_error", 0.0);
+    p.realizations = static_cast<int>(number("realizations", 0.0));
+    p.resolutions = list("resolutions");
+    p.F_at_resolution = list("F_at_resolution");
+    p.order = number("order", 0.0);
+    if (column.count("extrapolation")) p.extrapolation = cells[column["extrapolation"]];
+    p.wall_s = number("wall_s", 0.0);
+    validate_point(p, where);
+    dataset.points.push_back(p);
+  }
+  if (dataset.points.empty()) {
+    throw Error(ErrorCode::kInvalidArgument, "dataset file '" + path + "' has no data rows");
+  }
+  dataset.method = nlohmann::json{{"source", "csv"}, {"file", dataset.name}}.dump();
+  dataset.hash = dataset_hash(dataset.points);
+  dataset.id = dataset.hash.substr(0, 12);
+  return dataset;
+}
+
+void write_dataset_csv(const Dataset& dataset, const std::string& path) {
+  std::ostringstream out;
+  out << "# draglab dataset " << dataset.id << " (" << dataset.name << "), hash " << dataset.hash
+      << "\n# canonical drag-only F = F_d/(3 pi mu d eps u); Re = rho eps d u/mu (superficial); "
+         "uncertainties absolute, 1 sigma\n";
+  out << "phi,re_target,re,F,F_standard_error,F_discretisation_error,F_uncertainty,realizations,"
+         "resolutions,F_at_resolution,order,extrapolation,wall_s\n";
+  auto joined = [](const std::vector<double>& v) {
+    std::string s;
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ";" : "") + exact(v[i]);
+    return s;
+  };
+  for (const DatasetPoint& p : dataset.points) {
+    out << exact(p.phi) << ',' << exact(p.re_target) << ',' << exact(p.re) << ',' << exact(p.F)
+        << ',' << exact(p.F_standard_error) << ',' << exact(p.F_discretisation_error) << ','
+        << exact(p.F_uncertainty) << ',' << p.realizations << ',' << joined(p.resolutions) << ','
+        << joined(p.F_at_resolution) << ',' << exact(p.order) << ',' << p.extrapolation << ','
+        << exact(p.wall_s) << '\n';
+  }
+  // Write to a temporary name and rename, so a reader never sees half a file.
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream file(temporary, std::ios::trunc);
+    if (!file) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  "cannot write '" + path + "': " + std::strerror(errno));
+    }
+    file << out.str();
+    if (!file.flush()) {
+      throw Error(ErrorCode::kDatabase, "writing '" + path + "' failed: " + std::strerror(errno));
+    }
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    throw Error(ErrorCode::kDatabase,
+                "renaming '" + temporary + "' to '" + path + "' failed: " + std::strerror(errno));
+  }
+}
+
+}  // namespace draglab

@@ -1,0 +1,198 @@
+// Datasets in the drag-law database (dataset.h, schema version 4).
+//
+// Set-up: a fresh database file per test; datasets made of a few hand-written points.
+// What is checked: the content hash is a function of the points only (stable, order-sensitive,
+// changed by any value), a store/load round trip is bit-exact, storing the same points twice
+// returns the existing dataset, prefixes resolve (and ambiguous or unknown ones are refused),
+// the rows are immutable from the sqlite3 C API too (UPDATE, DELETE, INSERT OR REPLACE), and the
+// CSV form round-trips and refuses malformed files naming line and column.
+#include "draglab/drag_db/dataset.h"
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <stdlib.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "draglab/drag_db/database.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "draglab_dataset_test_XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (fs::path(path_) / name).string(); }
+
+ private:
+  std::string path_;
+};
+
+Dataset sample(double scale = 1.0) {
+  Dataset d;
+  d.name = "sample";
+  for (double phi : {0.2, 0.3, 0.4}) {
+    for (double re : {0.0, 10.0}) {
+      DatasetPoint p;
+      p.phi = phi;
+      p.re_target = re;
+      p.re = re * 1.001;
+      p.F = scale * (1.0 + 10.0 * phi + 0.1 * re) + 1e-13;  // not a short decimal
+      p.F_standard_error = 0.01 * p.F;
+      p.F_discretisation_error = 0.02 * p.F;
+      p.F_uncertainty = 0.0223606797749979 * p.F;
+      p.realizations = 3;
+      p.resolutions = {8.0, 12.0};
+      p.F_at_resolution = {p.F * 0.97, p.F * 0.99};
+      p.order = 1.0;
+      p.extrapolation = "inverse_d";
+      p.wall_s = 1.5;
+      d.points.push_back(p);
+    }
+  }
+  return d;
+}
+
+TEST(DatasetStore, HashDependsOnPointsOnly) {
+  const Dataset a = sample(), b = sample();
+  EXPECT_EQ(dataset_hash(a.points), dataset_hash(b.points));
+  EXPECT_EQ(dataset_hash(a.points).size(), 64u);
+  Dataset c = sample();
+  c.points[3].F = std::nextafter(c.points[3].F, 1e9);  // one ulp
+  EXPECT_NE(dataset_hash(a.points), dataset_hash(c.points));
+  Dataset swapped = sample();
+  std::swap(swapped.points[0], swapped.points[1]);
+  EXPECT_NE(dataset_hash(a.points), dataset_hash(swapped.points));
+}
+
+TEST(DatasetStore, RoundTripIsExactAndStoringTwiceReturnsTheSameDataset) {
+  TempDir dir;
+  Database db(dir.file("d.db"));
+  EXPECT_GE(db.schema_version(), 4);
+  const Dataset stored = store_dataset(db, sample());
+  EXPECT_EQ(stored.id, stored.hash.substr(0, 12));
+  EXPECT_EQ(stored.hash, dataset_hash(sample().points));
+  const Dataset loaded = load_dataset(db, stored.id);
+  ASSERT_EQ(loaded.points.size(), 6u);
+  const Dataset original = sample();
+  for (std::size_t i = 0; i < 6; ++i) {
+    const DatasetPoint& p = loaded.points[i];
+    const DatasetPoint& q = original.points[i];
+    EXPECT_EQ(p.F, q.F);  // bit-exact
+    EXPECT_EQ(p.F_uncertainty, q.F_uncertainty);
+    EXPECT_EQ(p.re, q.re);
+    EXPECT_EQ(p.F_at_resolution, q.F_at_resolution);
+    EXPECT_EQ(p.extrapolation, q.extrapolation);
+  }
+  const Dataset again = store_dataset(db, sample());
+  EXPECT_EQ(again.id, stored.id);
+  EXPECT_EQ(again.created_at, stored.created_at);
+  EXPECT_EQ(list_datasets(db).size(), 1u);
+  EXPECT_EQ(load_dataset(db, stored.hash.substr(0, 4)).id, stored.id);
+  store_dataset(db, sample(2.0));
+  EXPECT_EQ(list_datasets(db).size(), 2u);
+  try {
+    load_dataset(db, "zz");
+    FAIL() << "bad id accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kNotFound);
+  }
+  EXPECT_THROW(load_dataset(db, "0000000"), Error);
+}
+
+TEST(DatasetStore, RowsAreImmutableForEveryClient) {
+  TempDir dir;
+  const std::string path = dir.file("d.db");
+  std::string id;
+  {
+    Database db(path);
+    id = store_dataset(db, sample()).id;
+  }
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &raw), SQLITE_OK);
+  for (const std::string sql :
+       {"UPDATE datasets SET name = 'x'", "DELETE FROM datasets",
+        "INSERT OR REPLACE INTO datasets SELECT id, hash, campaign_id, 'x', method, created_at, "
+        "code_version, points_json FROM datasets"}) {
+    char* message = nullptr;
+    EXPECT_NE(sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, &message), SQLITE_OK) << sql;
+    ASSERT_NE(message, nullptr);
+    EXPECT_NE(std::string(message).find("immutable"), std::string::npos) << message;
+    sqlite3_free(message);
+  }
+  sqlite3_close(raw);
+  Database db(path);
+  EXPECT_EQ(load_dataset(db, id).name, "sample");
+}
+
+TEST(DatasetStore, RefusesInvalidPointsAndWritesNothing) {
+  TempDir dir;
+  Database db(dir.file("d.db"));
+  Dataset bad = sample();
+  bad.points[2].F_uncertainty = 0.0;
+  try {
+    store_dataset(db, bad);
+    FAIL() << "zero uncertainty accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("F_uncertainty"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(list_datasets(db).empty());
+}
+
+TEST(DatasetStore, CsvRoundTripAndMalformedFiles) {
+  TempDir dir;
+  Dataset d = sample();
+  d.hash = dataset_hash(d.points);
+  d.id = d.hash.substr(0, 12);
+  write_dataset_csv(d, dir.file("out.csv"));
+  const Dataset back = read_dataset_csv(dir.file("out.csv"));
+  EXPECT_EQ(back.hash, d.hash);  // %.17g text round-trips every double
+  EXPECT_EQ(back.name, "out");
+
+  auto write = [&](const std::string& text) {
+    std::ofstream(dir.file("x.csv")) << text;
+    return dir.file("x.csv");
+  };
+  // Minimal columns.
+  const Dataset minimal =
+      read_dataset_csv(write("# comment\nphi,re,F,F_uncertainty\n0.3,0,5.1,0.1\n"));
+  ASSERT_EQ(minimal.points.size(), 1u);
+  EXPECT_EQ(minimal.points[0].re_target, 0.0);
+  struct Case {
+    const char* text;
+    const char* expect;
+  };
+  for (const Case& c : {Case{"phi,re,F\n0.3,0,5\n", "F_uncertainty"},
+                        Case{"phi,re,F,F_uncertainty\n0.3,0,abc,0.1\n", "column 'F'"},
+                        Case{"phi,re,F,F_uncertainty\n0.9,0,5,0.1\n", "phi"},
+                        Case{"phi,re,F,F_uncertainty\n0.3,-1,5,0.1\n", "re"},
+                        Case{"phi,re,F,F_uncertainty\n0.3,0,5\n", "columns"},
+                        Case{"phi,re,F,F_uncertainty\n", "no data rows"}}) {
+    try {
+      read_dataset_csv(write(c.text));
+      FAIL() << "accepted: " << c.text;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(read_dataset_csv(dir.file("missing.csv")), Error);
+}
+
+}  // namespace
+}  // namespace draglab
