@@ -167,6 +167,10 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     result.F = result.K = result.beta_d2_over_mu = result.F_standard_error = nan;
     result.error_estimate = nan;
     result.body_F.clear();
+    // The last Re the run reached (not a measurement: it says how far the run got).
+    if (!result.history.empty() && !(stokes && target_re == 0.0)) {
+      result.re = result.history.back().re;
+    }
     result.wall_s = seconds_since(start);
     if (options.throw_on_failure) throw Error(ErrorCode::kOutOfValidity, "lbm run: " + diagnosis);
     return result;
@@ -495,13 +499,21 @@ RunResult run(const arrays::Packing& packing, double resolution, const RunOption
   const double gap = arrays::min_gap_lattice_units(packing, resolution);
   if (gap < options.min_gap_nodes) {
     const double needed = gap > 0.0 ? resolution * options.min_gap_nodes / gap : 0.0;
-    throw Error(ErrorCode::kInvalidArgument,
-                "lbm run: resolution " + fmt("%g", resolution) +
-                    " too low for the gaps: the smallest gap between spheres spans " +
-                    fmt("%.3g", gap) +
-                    " lattice units, below min_gap_nodes = " + fmt("%g", options.min_gap_nodes) +
-                    (gap > 0.0 ? "; raise the resolution to at least " + fmt("%.4g", needed)
-                               : std::string("; the spheres touch or overlap")));
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        "lbm run: resolution " + fmt("%g", resolution) +
+            " too low for the gaps: the smallest gap between spheres spans " + fmt("%.3g", gap) +
+            " lattice units, below min_gap_nodes = " + fmt("%g", options.min_gap_nodes) +
+            (gap > 0.0 && needed <= 512.0
+                 ? "; raise the resolution to at least " + fmt("%.4g", needed) + ", or"
+                 : std::string(gap > 0.0 ? " (the resolution it would need, " +
+                                               fmt("%.4g", needed) + ", is beyond the limit 512);"
+                                         : "; the spheres touch or overlap;")) +
+            " generate the packing with a minimum surface gap of at least " +
+            fmt("%.3g", options.min_gap_nodes / resolution) +
+            " diameters (draglab pack --min-gap " +
+            fmt("%.3g", 1.5 * options.min_gap_nodes / resolution) +
+            "), or lower min_gap_nodes if under-resolved gaps are acceptable");
   }
   arrays::VoxelizationOptions vox;
   vox.resolution = resolution;

@@ -291,8 +291,8 @@ TEST(LbmEngineSmoke, FieldsAndProgressAreConsistent) {
   options.re = 1.0;
   Fields fields;
   std::vector<double> fractions;
-  const RunResult r = run_with_fields(grid, 0.125, options, &fields,
-                                      [&](double f, const std::string&) { fractions.push_back(f); });
+  const RunResult r = run_with_fields(
+      grid, 0.125, options, &fields, [&](double f, const std::string&) { fractions.push_back(f); });
   ASSERT_TRUE(r.converged) << r.diagnosis;
   ASSERT_EQ(fields.dims, grid.dims);
   ASSERT_EQ(fields.velocity.size(), 3 * static_cast<std::size_t>(grid.num_nodes()));
@@ -356,6 +356,21 @@ TEST(LbmEngineSmoke, MachLimitStopsTheRun) {
   EXPECT_LT(r.steps, options.max_steps);
 }
 
+// A failed finite-Re run still says how far it got: the last Re of its history (not a
+// measurement; F stays NaN).
+TEST(LbmEngineSmoke, FailedRunReportsTheReItReached) {
+  const arrays::VoxelGrid grid = simple_cubic_grid(0.125, 12);
+  RunOptions options = quick_options();
+  options.re = 10.0;
+  options.max_steps = 600;
+  const RunResult r = run(grid, 0.125, options);
+  EXPECT_FALSE(r.converged);
+  EXPECT_TRUE(std::isnan(r.F));
+  ASSERT_FALSE(r.history.empty());
+  EXPECT_EQ(r.re, r.history.back().re);
+  EXPECT_GT(r.re, 0.0);
+}
+
 // Hitting max_steps is "not converged", never a drag value.
 TEST(LbmEngineSmoke, StepLimitMeansNotConverged) {
   const arrays::VoxelGrid grid = simple_cubic_grid(0.125, 12);
@@ -384,6 +399,9 @@ TEST(LbmEngineSmoke, GapTooSmallForResolutionIsBadInput) {
     const std::string message = e.what();
     EXPECT_NE(message.find("gap"), std::string::npos) << message;
     EXPECT_NE(message.find("0.2"), std::string::npos) << message;
+    // Remedies: the resolution that would resolve the gap, or a packing with a minimum gap.
+    EXPECT_NE(message.find("raise the resolution to at least"), std::string::npos) << message;
+    EXPECT_NE(message.find("--min-gap"), std::string::npos) << message;
   }
 }
 
