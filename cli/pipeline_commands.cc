@@ -1,10 +1,362 @@
-// Placeholder: `draglab pipeline` is being written (replaced by the real commands).
+// `draglab pipeline`: the product's main job end to end, from nothing to a published law.
+//
+//   campaign spec -> LBM units (campaign/) -> dataset (drag_db/) -> Ceres fit of Eq. 6 with the
+//   NLopt check (fitter/) -> new law version, published -> report (figures + summary).
+//
+// Sample runs:
+//   draglab pipeline --preset quick                 # what ./run.sh runs (minutes on 2 cores)
+//   draglab pipeline --preset standard --jobs 2     # about an hour, Richardson in d
+//   draglab pipeline --spec my_campaign.toml --law-name eq6_mine --out out/mine
+//
+// Re-running is cheap and safe: the campaign resumes (finished units are kept), the dataset is
+// identified by its content hash, and a fit that gives a law identical to the latest published
+// version of the name (same content hash, same dataset) reuses it instead of adding a version.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <fmt/core.h>
+
 #include "cli/cli_context.h"
+#include "cli/progress.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/fitter/fit.h"
 
 namespace draglab {
 namespace cli {
+namespace {
 
-void add_pipeline_commands(CLI::App& /*app*/, CliContext& /*ctx*/) {}
+namespace fs = std::filesystem;
+
+std::string executable_path() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("draglab") : self.string();
+}
+
+// The preset's spec file: next to the sources in a build tree, under share/draglab when
+// installed (relative to the executable, so installs are relocatable).
+std::string preset_path(const std::string& preset) {
+  const std::string file = "campaigns/" + preset + ".toml";
+  const fs::path source = fs::path(DRAGLAB_SOURCE_DATA_DIR) / file;
+  if (fs::exists(source)) return source.string();
+  const fs::path installed =
+      fs::path(executable_path()).parent_path() / ".." / DRAGLAB_INSTALL_SHARE_DIR / file;
+  if (fs::exists(installed)) return installed.lexically_normal().string();
+  throw UsageError("preset '" + preset + "': no spec file " + source.string() + " or " +
+                   installed.lexically_normal().string());
+}
+
+std::vector<fitter::FitPoint> fit_points(const Dataset& dataset) {
+  std::vector<fitter::FitPoint> points;
+  for (const DatasetPoint& p : dataset.points) {
+    points.push_back({p.phi, p.re, p.F, p.F_uncertainty});
+  }
+  return points;
+}
+
+struct Deviation {
+  double rms = 0.0, max = 0.0;
+};
+Deviation deviation_of(const std::vector<double>& relative) {
+  Deviation d;
+  for (double r : relative) {
+    d.rms += r * r;
+    d.max = std::max(d.max, std::abs(r));
+  }
+  d.rms = relative.empty() ? 0.0 : std::sqrt(d.rms / static_cast<double>(relative.size()));
+  return d;
+}
+
+// Relative difference of `law` from `reference` at the dataset's (phi, Re) points.
+Deviation law_difference(const Law& law, const Law& reference, const Dataset& dataset) {
+  std::vector<double> relative;
+  for (const DatasetPoint& p : dataset.points) {
+    relative.push_back(law.F(p.phi, p.re) / reference.F(p.phi, p.re) - 1.0);
+  }
+  return deviation_of(relative);
+}
+
+// Stores the fit as a new published version of `name`, unless the latest published version
+// already has the same content and dataset (re-running the pipeline on the same data).
+LawRecord publish_fit(Database& db, const LawRecord& draft_record) {
+  LawRecord probe = draft_record;
+  probe.content_hash = content_hash_of(probe);
+  for (const LawRecord& existing : db.list(draft_record.name, false)) {
+    if (existing.status == LawStatus::kPublished && existing.content_hash == probe.content_hash &&
+        existing.provenance.data_hash == draft_record.provenance.data_hash) {
+      return existing;
+    }
+  }
+  return db.add_published(draft_record);
+}
+
+int run_report(const CliContext& ctx, const std::string& dataset_id, const std::string& law,
+               std::int64_t campaign_id, const std::string& out_dir) {
+  std::vector<std::string> args = {executable_path(), "report",   "--db",  ctx.resolved_db_path(),
+                                   "--dataset",       dataset_id, "--law", law,
+                                   "--out",           out_dir};
+  if (campaign_id > 0) {
+    args.push_back("--campaign");
+    args.push_back(std::to_string(campaign_id));
+  }
+  if (ctx.quiet) args.push_back("-q");
+  std::cout.flush();
+  const pid_t child = fork();
+  if (child < 0) return -1;
+  if (child == 0) {
+    // The report's own stdout (its file list) goes to stderr: stdout carries our summary/JSON.
+    dup2(STDERR_FILENO, STDOUT_FILENO);
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(argv[0], argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+struct PipelineArgs {
+  std::string preset = "quick";
+  std::string spec;
+  std::string law_name;
+  std::string out_dir;
+  int jobs = 0;
+  bool no_report = false;
+};
+
+void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const std::string spec_path = args.spec.empty() ? preset_path(args.preset) : args.spec;
+  const campaign::CampaignSpec spec = campaign::parse_campaign_spec(spec_path);
+  const std::string law_name = args.law_name.empty() ? "eq6_" + spec.name : args.law_name;
+  const std::string out_dir = args.out_dir.empty() ? "out/" + spec.name : args.out_dir;
+  {
+    // Validate the law name before hours of LBM (the database would refuse it only at the end).
+    const bool ok = !law_name.empty() && law_name.find_first_not_of(
+                                             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                             "0123456789_-.") == std::string::npos;
+    if (!ok) {
+      throw UsageError("--law-name '" + law_name + "': use letters, digits, '_', '-' and '.' only");
+    }
+  }
+  const std::string db_path = ctx.resolved_db_path();
+  ctx.open_database(false);  // create, migrate and seed the database before the workers open it
+
+  // 1. Campaign (resumed if it exists with the same spec).
+  ctx.info("pipeline: campaign '" + spec.name + "' from " + spec_path + " -> " + db_path);
+  campaign::RunCampaignOptions run_options;
+  run_options.jobs = args.jobs;
+  run_options.resume = false;
+  {
+    auto db = ctx.open_database(true);
+    for (const campaign::CampaignStatus& c : campaign::list_campaigns(*db)) {
+      if (c.name == spec.name) run_options.resume = true;  // same name: continue it
+    }
+  }
+  ProgressLine progress(!ctx.quiet);
+  run_options.progress = [&progress](std::int64_t finished, std::int64_t total,
+                                     const std::string& line) {
+    progress.update(total > 0 ? static_cast<double>(finished) / static_cast<double>(total) : 1.0,
+                    "campaign " + line);
+  };
+  const auto campaign_start = Clock::now();
+  const campaign::CampaignStatus status = campaign::run_campaign(db_path, spec, run_options);
+  progress.finish();
+  const double campaign_s = std::chrono::duration<double>(Clock::now() - campaign_start).count();
+  ctx.info(status.BriefReport());
+
+  // 2. Dataset.
+  auto db = ctx.open_database(false);
+  std::vector<std::string> skipped;
+  const Dataset dataset = campaign::build_dataset(*db, status.id, &skipped);
+  for (const std::string& s : skipped) ctx.warn("dataset: left out " + s);
+
+  // 3. Fit of Eq. 6 (the C0 and C1 coefficients), confirmed by NLopt, then published.
+  fitter::FitOptions fit_options;  // vdh2004, free k0, k1, c10, c11, c12
+  fit_options.cv_folds = dataset.points.size() >= 10 ? 5 : 0;
+  const std::vector<fitter::FitPoint> points = fit_points(dataset);
+  const fitter::FitResult fit = fitter::fit_law(points, fit_options);
+  const LawRecord record = publish_fit(
+      *db, fitter::fitted_record(fit, fit_options, law_name, dataset.id, dataset.hash, points));
+  const auto fitted = db->load(record.reference(), RangePolicy::kExtrapolate);
+
+  // 4. Comparison over the campaign grid.
+  struct Row {
+    std::string law;
+    Deviation from_data;
+    Deviation from_bvk;
+  };
+  std::vector<Row> rows;
+  std::shared_ptr<Law> bvk;
+  try {
+    bvk = db->load("bvk2007@1", RangePolicy::kExtrapolate);
+  } catch (const Error&) {
+    ctx.warn("bvk2007@1 is not in the database: no comparison with it");
+  }
+  auto add_row = [&](const std::string& label, const Law& law) {
+    Row row;
+    row.law = label;
+    row.from_data = deviation_of(fitter::relative_errors(law, points));
+    if (bvk) row.from_bvk = law_difference(law, *bvk, dataset);
+    rows.push_back(row);
+  };
+  add_row(record.reference() + " (fit)", *fitted);
+  for (const char* ref : {"vdh2004@1", "bvk2007@1", "ergun@1"}) {
+    try {
+      const auto law = db->load(ref, RangePolicy::kExtrapolate);
+      add_row(std::string(ref) + (std::string(ref) == "vdh2004@1" ? " (Eq. 6 as printed)" : ""),
+              *law);
+    } catch (const Error& e) {
+      ctx.warn(std::string(ref) + ": " + e.what());
+    }
+  }
+
+  // 5. Report.
+  std::string report_file;
+  if (!args.no_report) {
+    const int rc = run_report(ctx, dataset.id, record.reference(), status.id, out_dir);
+    if (rc == 0) {
+      report_file = (fs::path(out_dir) / "report.md").string();
+    } else {
+      ctx.warn(
+          "draglab report exited with " + std::to_string(rc) +
+          ": no figures (the dataset and the law are stored; rerun `draglab report --dataset " +
+          dataset.id + " --law " + record.reference() + " --out " + out_dir + "`)");
+    }
+  }
+  const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+
+  if (ctx.json) {
+    nlohmann::json params = nlohmann::json::object(), ci95 = nlohmann::json::object();
+    for (std::size_t i = 0; i < fit.names.size(); ++i) {
+      params[fit.names[i]] = fit.values[i];
+      if (fit.is_free[i]) ci95[fit.names[i]] = {fit.ci95_low[i], fit.ci95_high[i]};
+    }
+    nlohmann::json comparison = nlohmann::json::array();
+    for (const Row& r : rows) {
+      comparison.push_back({{"law", r.law},
+                            {"rms_rel_err", r.from_data.rms},
+                            {"max_rel_err", r.from_data.max},
+                            {"rms_rel_diff_bvk2007", r.from_bvk.rms},
+                            {"max_rel_diff_bvk2007", r.from_bvk.max}});
+    }
+    ctx.print_json({{"campaign", status.name},
+                    {"campaign_id", status.id},
+                    {"units_total", status.units_total},
+                    {"units_done", status.units_done},
+                    {"units_failed", status.units_failed},
+                    {"dataset", dataset.id},
+                    {"points", dataset.points.size()},
+                    {"law", record.name},
+                    {"version", record.version},
+                    {"params", params},
+                    {"ci95", ci95},
+                    {"rms_rel_err", fit.rms_rel_err},
+                    {"max_rel_err", fit.max_rel_err},
+                    {"cv_rms_rel_err", fit.cv_rms_rel_err},
+                    {"chi2_per_dof", fit.chi2_per_dof},
+                    {"global_agrees", fit.global_agrees},
+                    {"constraints_satisfied", fit.constraints_satisfied},
+                    {"comparison", comparison},
+                    {"report", report_file},
+                    {"campaign_s", campaign_s},
+                    {"wall_s", wall_s}});
+    return;
+  }
+
+  std::ostringstream out;
+  out << fmt::format("draglab pipeline '{}': {} of {} LBM units done, {} failed ({:.0f} s)\n",
+                     spec.name, status.units_done, status.units_total, status.units_failed,
+                     campaign_s);
+  out << fmt::format(
+      "dataset {}: {} (phi, Re) points, F with realization and resolution "
+      "uncertainty\n\n",
+      dataset.id, dataset.points.size());
+  out << "Eq. 6 refitted (Ceres, weighted least squares on F; 95 % intervals):\n"
+      << "  beta d^2/mu = [A + C0] phi^2/eps + [B + C1] (phi/eps) Re,\n"
+      << "  C0 = a eps^n (1 + b sqrt(phi))/phi,  C1 = c0 + c1 phi + c2 phi^2\n";
+  const LawForm& form = find_law_form(fit.form);
+  const char* seed_names[] = {"A", "B", "a", "n", "b", "c0", "c1", "c2"};
+  out << fmt::format("  {:<10}{:>10}{:>12}   {}\n", "parameter", "printed", "fitted",
+                     "95 % interval");
+  for (std::size_t i = 0; i < fit.names.size(); ++i) {
+    const std::string label = fit.form == "vdh2004" && i < 8
+                                  ? fmt::format("{} ({})", seed_names[i], fit.names[i])
+                                  : fit.names[i];
+    out << fmt::format("  {:<10}{:>10.4g}{:>12.5g}   {}\n", label,
+                       form.description.parameters[i].value, fit.values[i],
+                       fit.is_free[i]
+                           ? fmt::format("[{:.5g}, {:.5g}]", fit.ci95_low[i], fit.ci95_high[i])
+                           : std::string("fixed"));
+  }
+  out << fmt::format("  chi2/dof {:.3g} (dof {}), RMS rel. error {:.2f} %, max {:.2f} %",
+                     fit.chi2_per_dof, fit.dof, 100 * fit.rms_rel_err, 100 * fit.max_rel_err);
+  if (fit.cv_rms_rel_err >= 0) {
+    out << fmt::format(", {}-fold CV {:.2f} %", fit_options.cv_folds, 100 * fit.cv_rms_rel_err);
+  }
+  out << "\n  NLopt global search: "
+      << (fit.global_checked ? (fit.global_agrees ? "agrees" : "found a different optimum")
+                             : "not run")
+      << "; constraints F > 0, dF/dRe >= 0: "
+      << (fit.constraints_checked
+              ? (fit.constraints_satisfied ? "satisfied" : "VIOLATED: " + fit.constraint_report)
+              : "not checked")
+      << "\n\n";
+  out << "Over the campaign grid (relative differences):\n";
+  out << fmt::format("  {:<34}{:>12}{:>12}{:>16}{:>16}\n", "law", "RMS vs data", "max vs data",
+                     "RMS vs bvk2007", "max vs bvk2007");
+  for (const Row& r : rows) {
+    out << fmt::format("  {:<34}{:>11.2f}%{:>11.2f}%{:>15.2f}%{:>15.2f}%\n", r.law,
+                       100 * r.from_data.rms, 100 * r.from_data.max, 100 * r.from_bvk.rms,
+                       100 * r.from_bvk.max);
+  }
+  out << "\nStored: law " << record.reference() << " (published, immutable) in " << db_path
+      << "; dataset " << dataset.id << "\n";
+  if (!report_file.empty()) out << "Report: " << report_file << " (figures in " << out_dir << ")\n";
+  out << fmt::format("Pipeline wall time {:.0f} s.\n", wall_s);
+  out << "Next: draglab law show " << record.reference() << " | draglab law eval "
+      << record.reference() << " --phi 0.3 --re 20 | draglab fit --dataset " << dataset.id
+      << " --free a,n,b,c0,c1,c2\n";
+  std::cout << out.str();
+}
+
+}  // namespace
+
+void add_pipeline_commands(CLI::App& app, CliContext& ctx) {
+  auto args = std::make_shared<PipelineArgs>();
+  auto* cmd = app.add_subcommand(
+      "pipeline", "Campaign -> dataset -> fit of Eq. 6 -> published law -> report, in one command");
+  cmd->add_option("--preset", args->preset, "Campaign preset: quick, standard or paper")
+      ->check(CLI::IsMember({"quick", "standard", "paper"}))
+      ->capture_default_str();
+  cmd->add_option("--spec", args->spec, "Campaign spec file (TOML) instead of a preset")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--law-name", args->law_name,
+                  "Name of the fitted law (default eq6_<campaign name>)");
+  cmd->add_option("--out", args->out_dir, "Report directory (default out/<campaign name>)");
+  cmd->add_option("--jobs", args->jobs, "Parallel LBM units (0 = number of cores)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_flag("--no-report", args->no_report, "Skip the figures");
+  cmd->footer(
+      "Examples:\n"
+      "  draglab pipeline --preset quick\n"
+      "  draglab pipeline --preset standard --jobs 2 --out out/standard\n"
+      "  draglab pipeline --spec my.toml --law-name eq6_mine --json\n"
+      "Re-running resumes the campaign and reuses an identical fitted version.");
+  cmd->callback([&ctx, args] { ctx.action = [&ctx, args] { run_pipeline(ctx, *args); }; });
+}
 
 }  // namespace cli
 }  // namespace draglab
