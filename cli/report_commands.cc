@@ -1,10 +1,616 @@
-// Placeholder: `draglab report` is being written (replaced by the real commands).
+// `draglab report`: figures and a Markdown summary of a drag dataset against fitted and
+// literature laws.
+//
+// The C++ side does every evaluation (the same Law objects solvers use, range policy
+// `extrapolate` with the points outside each law's validity box flagged) and writes
+// OUT/report_bundle.json; scripts/draglab_report.py (Debian's /usr/bin/python3 + matplotlib) only
+// draws from it, so a figure can be re-rendered or restyled without a database. docs/report.md
+// describes the figures and the bundle.
+#include <limits.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+
 #include "cli/cli_context.h"
+#include "drag_db_version.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace cli {
 
-void add_report_commands(CLI::App& /*app*/, CliContext& /*ctx*/) {}
+namespace {
+
+/// Eq. 6 as printed, the classic packed-bed law, the LBM law the seed compares with and the
+/// published final form of the seed group's law.
+const char* const kDefaultComparisons = "vdh2004@1,ergun@1,hill_koch_ladd@1,bvk2007@1";
+/// Two-sided 95 % quantile of the standard normal distribution (Abramowitz & Stegun 26.2).
+constexpr double kNormalQuantile975 = 1.959963984540054;
+constexpr int kReCurvePoints = 60;      // per phi; smooth on a log axis spanning ~3 decades
+constexpr int kStokesCurvePoints = 81;  // F(phi, 0) over the data's phi range
+const char* const kFigures[] = {"fig3_seed.png", "parity.png", "residuals.png",
+                                "work_precision.png"};
+
+struct ReportCommand {
+  std::string dataset_id;
+  std::string data_csv;
+  std::vector<std::string> laws;
+  std::string compare;
+  bool compare_given = false;
+  std::string campaign;
+  std::string out_dir;
+};
+
+/// A law of the report: fitted (--law) or a comparison (--compare / the default list).
+struct ReportLaw {
+  std::shared_ptr<Law> law;
+  std::string role;  ///< "fit" or "reference"
+  std::string label;
+};
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (!item.empty()) items.push_back(item);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return items;
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return out + "'";
+}
+
+bool file_exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool directory_exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+/// mkdir -p; throws UsageError naming --out if a component cannot be created.
+void make_directories(const std::string& path) {
+  std::string partial;
+  std::size_t pos = 0;
+  while (pos != std::string::npos) {
+    pos = path.find('/', pos + 1);
+    partial = path.substr(0, pos);
+    if (partial.empty() || directory_exists(partial)) continue;
+    if (::mkdir(partial.c_str(), 0777) != 0 && !directory_exists(partial)) {
+      throw UsageError(fmt::format("--out: cannot create directory '{}'", partial));
+    }
+  }
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::string executable_dir() {
+  char buf[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return "";
+  std::string path(buf, static_cast<std::size_t>(n));
+  return path.substr(0, path.rfind('/'));
+}
+
+/// The renderer: installed next to the executable (bin/../share/draglab), else the source tree's.
+std::string find_report_script() {
+  const std::string installed =
+      executable_dir() + "/../" + DRAGLAB_INSTALL_SHARE_DIR + "/draglab_report.py";
+  if (file_exists(installed)) return installed;
+  const std::string source = std::string(DRAGLAB_SOURCE_SCRIPTS_DIR) + "/draglab_report.py";
+  if (file_exists(source)) return source;
+  throw std::runtime_error(
+      fmt::format("the report renderer draglab_report.py was found neither at {} nor at {}",
+                  installed, source));
+}
+
+/// $DRAGLAB_PYTHON (for tests and unusual installs), else Debian's interpreter, which is the
+/// one that sees the python3-matplotlib package.
+std::string python_interpreter() {
+  const char* p = std::getenv("DRAGLAB_PYTHON");
+  return p && *p ? p : "/usr/bin/python3";
+}
+
+std::string law_label(const LawRecord& r, const std::string& role) {
+  if (role == "fit") return r.reference() + " (fit)";
+  if (r.name == "vdh2004") return r.reference() + " (Eq. 6 as printed)";
+  if (r.name == "ergun") return r.reference() + " (Ergun)";
+  if (r.name == "hill_koch_ladd") return r.reference() + " (Hill-Koch-Ladd)";
+  if (r.name == "bvk2007") return r.reference() + " (Beetstra et al. 2007)";
+  return r.reference();
+}
+
+/// F at (phi, re) with the extrapolate policy; NaN when the formula gives no finite value there.
+double evaluate_or_nan(const Law& law, double phi, double re, bool* outside) {
+  try {
+    const LawEvaluation e = law.evaluate(phi, re);
+    *outside = e.out_of_validity;
+    return std::isfinite(e.F) ? e.F : std::numeric_limits<double>::quiet_NaN();
+  } catch (const Error&) {
+    *outside = true;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+nlohmann::json number_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
+std::vector<double> log_grid(double lo, double hi, int n) {
+  std::vector<double> g(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    g[static_cast<std::size_t>(i)] =
+        lo * std::pow(hi / lo, static_cast<double>(i) / static_cast<double>(n - 1));
+  }
+  return g;
+}
+
+struct LawStats {
+  double max_rel = 0.0, rms_rel = 0.0;
+  int evaluated = 0, outside = 0;
+};
+
+/// Everything the figures need for one law: smooth curves, the Stokes curve, values at the data
+/// points and the relative differences from the data.
+nlohmann::json law_json(const ReportLaw& rl, const Dataset& ds, LawStats* stats_out) {
+  const Law& law = *rl.law;
+  const LawRecord& r = law.record();
+  nlohmann::json j = {{"reference", r.reference()},
+                      {"name", r.name},
+                      {"version", r.version},
+                      {"label", rl.label},
+                      {"role", rl.role},
+                      {"form", r.form},
+                      {"status", to_string(r.status)},
+                      {"hash", r.content_hash},
+                      {"provenance", r.provenance.kind},
+                      {"validity",
+                       {{"phi", {r.validity.phi.min, r.validity.phi.max}},
+                        {"re", {r.validity.re.min, r.validity.re.max}}}}};
+  if (!r.provenance.dataset_id.empty()) j["dataset_id"] = r.provenance.dataset_id;
+  nlohmann::json params = nlohmann::json::array();
+  for (const LawParameter& p : r.parameters) {
+    params.push_back({{"name", p.name}, {"value", p.value}, {"unit", p.unit}});
+  }
+  j["parameters"] = params;
+  if (!r.provenance.fitter_settings.empty()) {
+    // The fitter's record of which parameters were free and its statistics (fitter/record.cc);
+    // shown in report.md when present, ignored if it is not the JSON the fitter writes.
+    const nlohmann::json settings =
+        nlohmann::json::parse(r.provenance.fitter_settings, nullptr, /*allow_exceptions=*/false);
+    if (settings.is_object()) {
+      nlohmann::json fitter = nlohmann::json::object();
+      for (const char* key : {"free_parameters", "statistics"}) {
+        if (settings.contains(key)) fitter[key] = settings[key];
+      }
+      if (!fitter.empty()) j["fitter"] = fitter;
+    }
+  }
+  const std::size_t n = r.parameters.size();
+  if (r.covariance.size() == n * n && n > 0) {
+    j["covariance"] = r.covariance;
+    nlohmann::json ci = nlohmann::json::array();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double var = r.covariance[i * n + i];
+      const double half = std::sqrt(std::max(var, 0.0)) * kNormalQuantile975;
+      ci.push_back({r.parameters[i].value - half, r.parameters[i].value + half});
+    }
+    j["ci95"] = ci;
+  }
+
+  // Curves for the seed figure: per phi of the data, Re on a log grid over the data's Re > 0.
+  std::set<double> phis;
+  double re_min = std::numeric_limits<double>::infinity(), re_max = 0.0;
+  double phi_min = 1.0, phi_max = 0.0;
+  for (const DatasetPoint& p : ds.points) {
+    phis.insert(p.phi);
+    phi_min = std::min(phi_min, p.phi);
+    phi_max = std::max(phi_max, p.phi);
+    if (p.re > 0.0) {
+      re_min = std::min(re_min, p.re);
+      re_max = std::max(re_max, p.re);
+    }
+  }
+  nlohmann::json curves = nlohmann::json::array();
+  if (re_max > 0.0) {
+    const std::vector<double> res = log_grid(re_min / 1.5, re_max * 1.5, kReCurvePoints);
+    for (double phi : phis) {
+      nlohmann::json F = nlohmann::json::array(), outside = nlohmann::json::array();
+      for (double re : res) {
+        bool out = false;
+        F.push_back(number_or_null(evaluate_or_nan(law, phi, re, &out)));
+        outside.push_back(out);
+      }
+      curves.push_back({{"phi", phi}, {"re", res}, {"F", F}, {"outside_validity", outside}});
+    }
+  }
+  j["curves"] = curves;
+  {
+    // Stokes limit over the data's phi range, widened a little so the data sit inside the line.
+    const double lo = std::max(0.01, phi_min - 0.05), hi = std::min(0.65, phi_max + 0.05);
+    nlohmann::json phi_grid = nlohmann::json::array(), F = nlohmann::json::array(),
+                   outside = nlohmann::json::array();
+    for (int i = 0; i < kStokesCurvePoints; ++i) {
+      const double phi = lo + (hi - lo) * i / (kStokesCurvePoints - 1);
+      bool out = false;
+      phi_grid.push_back(phi);
+      F.push_back(number_or_null(evaluate_or_nan(law, phi, 0.0, &out)));
+      outside.push_back(out);
+    }
+    j["stokes_curve"] = {{"phi", phi_grid}, {"F", F}, {"outside_validity", outside}};
+  }
+
+  LawStats s;
+  double sum_sq = 0.0;
+  nlohmann::json F = nlohmann::json::array(), outside = nlohmann::json::array();
+  for (const DatasetPoint& p : ds.points) {
+    bool out = false;
+    const double f = evaluate_or_nan(law, p.phi, p.re, &out);
+    F.push_back(number_or_null(f));
+    outside.push_back(out);
+    if (out) ++s.outside;
+    if (!std::isfinite(f)) continue;
+    const double rel = std::fabs(f / p.F - 1.0);
+    s.max_rel = std::max(s.max_rel, rel);
+    sum_sq += rel * rel;
+    ++s.evaluated;
+  }
+  s.rms_rel = s.evaluated ? std::sqrt(sum_sq / s.evaluated) : std::nan("");
+  if (!s.evaluated) s.max_rel = std::nan("");
+  j["at_points"] = {{"F", F}, {"outside_validity", outside}};
+  j["stats"] = {{"max_rel_diff", number_or_null(s.max_rel)},
+                {"rms_rel_diff", number_or_null(s.rms_rel)},
+                {"n_evaluated", s.evaluated},
+                {"n_outside_validity", s.outside}};
+  if (stats_out) *stats_out = s;
+  return j;
+}
+
+nlohmann::json dataset_json(const Dataset& ds, const std::string& source) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const DatasetPoint& p : ds.points) {
+    points.push_back({{"phi", p.phi},
+                      {"re", p.re},
+                      {"re_target", p.re_target},
+                      {"F", p.F},
+                      {"F_uncertainty", p.F_uncertainty},
+                      {"F_standard_error", p.F_standard_error},
+                      {"F_discretisation_error", p.F_discretisation_error},
+                      {"realizations", p.realizations},
+                      {"resolutions", p.resolutions},
+                      {"extrapolation", p.extrapolation},
+                      {"wall_s", p.wall_s}});
+  }
+  return {{"id", ds.id},
+          {"hash", ds.hash},
+          {"name", ds.name},
+          {"source", source},
+          {"campaign_id", ds.campaign_id},
+          {"points", points}};
+}
+
+nlohmann::json units_json(const std::vector<campaign::UnitRecord>& units) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const campaign::UnitRecord& u : units) {
+    out.push_back({{"id", u.id},
+                   {"phi", u.phi},
+                   {"re_target", u.re_target},
+                   {"realization", u.realization},
+                   {"resolution", u.resolution},
+                   {"status", u.status},
+                   {"F", u.F},
+                   {"re", u.re},
+                   {"error_estimate", u.error_estimate},
+                   {"wall_s", u.wall_s},
+                   {"steps", u.steps},
+                   {"diagnosis", u.diagnosis}});
+  }
+  return out;
+}
+
+/// The dataset's checks the figures rely on (a stored dataset passed them already; a CSV too, but
+/// an empty one would give empty axes).
+void check_dataset(const Dataset& ds, const std::string& field) {
+  if (ds.points.empty()) throw UsageError(field + ": the dataset has no points");
+  for (const DatasetPoint& p : ds.points) {
+    if (!(p.F > 0.0) || !std::isfinite(p.F) || !(p.phi > 0.0 && p.phi < 1.0) || !(p.re >= 0.0)) {
+      throw UsageError(fmt::format(
+          "{}: point phi = {}, Re = {}, F = {}: every point needs phi in (0, 1), Re >= 0 and a "
+          "finite F > 0",
+          field, p.phi, p.re, p.F));
+    }
+  }
+}
+
+struct ReportInputs {
+  Dataset dataset;
+  std::string source;
+  std::vector<ReportLaw> laws;
+  nlohmann::json missing = nlohmann::json::array();
+  std::int64_t campaign_id = 0;
+  std::vector<campaign::UnitRecord> units;
+};
+
+/// Loads the dataset, the laws and the units; throws (exit 2) on bad input before anything is
+/// written.
+ReportInputs load_inputs(const CliContext& ctx, const Database& db, const ReportCommand& c) {
+  ReportInputs in;
+  if (!c.data_csv.empty()) {
+    if (!file_exists(c.data_csv)) {
+      throw UsageError(fmt::format("--data: no such file '{}'", c.data_csv));
+    }
+    in.dataset = read_dataset_csv(c.data_csv);  // Error(kInvalidArgument) names line and column
+    in.source = "csv:" + c.data_csv;
+    check_dataset(in.dataset, "--data");
+  } else {
+    in.dataset = load_dataset(db, c.dataset_id);  // Error(kNotFound): exit 2
+    in.source = "database";
+    check_dataset(in.dataset, "--dataset");
+  }
+
+  auto add_law = [&](const std::string& ref, const std::string& role, bool required) {
+    std::string warning;
+    std::shared_ptr<Law> law;
+    try {
+      law = db.load(ref, RangePolicy::kExtrapolate, &warning);
+    } catch (const Error& e) {
+      if (required || e.code() != ErrorCode::kNotFound) {
+        throw Error(e.code(),
+                    fmt::format("{} {}: {}", role == "fit" ? "--law" : "--compare", ref, e.what()));
+      }
+      ctx.warn(fmt::format("comparison law {} skipped: {}", ref, e.what()));
+      in.missing.push_back({{"reference", ref}, {"reason", e.what()}});
+      return;
+    }
+    if (law->num_extra_inputs() != 0) {
+      const std::string why = fmt::format(
+          "{} needs {} extra (polydisperse) input(s) per point, which a dataset does not carry",
+          law->reference(), law->num_extra_inputs());
+      if (required) throw UsageError(why);
+      ctx.warn("comparison law skipped: " + why);
+      in.missing.push_back({{"reference", ref}, {"reason", why}});
+      return;
+    }
+    for (const ReportLaw& have : in.laws) {
+      if (have.law->reference() == law->reference()) return;  // listed twice: draw it once
+    }
+    // A fitted draft is the normal case (before `law publish`); a retraction always warns.
+    if (!warning.empty() && (role != "fit" || law->record().status == LawStatus::kRetracted)) {
+      ctx.warn(warning);
+    }
+    in.laws.push_back({law, role, law_label(law->record(), role)});
+  };
+  for (const std::string& ref : c.laws) add_law(ref, "fit", true);
+  const std::vector<std::string> compare =
+      split_list(c.compare_given ? c.compare : kDefaultComparisons);
+  for (const std::string& ref : compare) add_law(ref, "reference", c.compare_given);
+  if (in.laws.empty()) {
+    throw UsageError("no law to compare with: give --law NAME@V or --compare REF,...");
+  }
+
+  if (!c.campaign.empty()) {
+    in.campaign_id = campaign::campaign_status(db, c.campaign).id;  // kNotFound: exit 2
+  } else {
+    in.campaign_id = in.dataset.campaign_id;
+  }
+  if (in.campaign_id != 0) {
+    try {
+      in.units = campaign::list_units(db, in.campaign_id);
+    } catch (const Error& e) {
+      if (!c.campaign.empty()) throw;
+      // The dataset names a campaign this database does not hold (copied dataset): no units.
+      ctx.warn(fmt::format("campaign {} of the dataset: {}; the work-precision figure stays empty",
+                           in.campaign_id, e.what()));
+    }
+  }
+  return in;
+}
+
+nlohmann::json conventions_json() {
+  return {
+      {"F", "canonical drag-only force F = F_d / (3 pi mu d eps u), mean-pressure part excluded"},
+      {"Re", "superficial, diameter based: Re = rho eps d u / mu (u interstitial slip)"},
+      {"beta", "beta d^2/mu = 18 phi eps F; K = F/(1 - phi) is the total force"},
+      {"fig3_axes",
+       "y = (beta d^2/mu) eps/((1 - eps) Re) = 18 eps^2 F / Re, x = Re/(1 - eps) = Re/phi"},
+      {"relative_difference", "|F_law/F_data - 1| at the data points"},
+      {"range_policy",
+       "laws are evaluated with the 'extrapolate' policy; outside_validity marks the points "
+       "outside a law's validity box"},
+      {"uncertainty", "F_uncertainty is 1 sigma (realizations and resolution extrapolation)"},
+      {"ci95", "parameter value +- 1.959964 sqrt(covariance diagonal) (normal quantile)"}};
+}
+
+/// Writes `text` to `path` through a temporary file, so a reader never sees half a bundle.
+void write_file_atomically(const std::string& path, const std::string& text) {
+  const std::string partial = path + ".partial";
+  {
+    std::ofstream out(partial);
+    out << text;
+    if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", partial));
+  }
+  if (std::rename(partial.c_str(), path.c_str()) != 0) {
+    std::remove(partial.c_str());
+    throw std::runtime_error(fmt::format("cannot write '{}'", path));
+  }
+}
+
+struct ReportOutcome {
+  nlohmann::json json;
+  std::vector<std::pair<std::string, LawStats>> stats;
+  bool units = false;
+};
+
+ReportOutcome make_report(const CliContext& ctx, const Database& db, ReportCommand c) {
+  while (c.out_dir.size() > 1 && c.out_dir.back() == '/') c.out_dir.pop_back();
+  if (c.out_dir.empty()) throw UsageError("--out DIR is required");
+  if (file_exists(c.out_dir)) {
+    throw UsageError(fmt::format("--out: '{}' is a file, not a directory", c.out_dir));
+  }
+  ReportInputs in = load_inputs(ctx, db, c);
+
+  ReportOutcome outcome;
+  nlohmann::json laws = nlohmann::json::array();
+  for (const ReportLaw& rl : in.laws) {
+    LawStats s;
+    laws.push_back(law_json(rl, in.dataset, &s));
+    outcome.stats.emplace_back(rl.label, s);
+    if (s.outside > 0) {
+      ctx.info(fmt::format("{}: {} of {} data point(s) outside its validity box (extrapolated)",
+                           rl.law->reference(), s.outside, in.dataset.points.size()));
+    }
+  }
+  nlohmann::json bundle = {{"format", "draglab_report_bundle"},
+                           {"format_version", 1},
+                           {"generated_at", utc_now()},
+                           {"code_version", kDragDbVersion},
+                           {"database", db.path()},
+                           {"conventions", conventions_json()},
+                           {"dataset", dataset_json(in.dataset, in.source)},
+                           {"laws", laws},
+                           {"missing_laws", in.missing},
+                           {"campaign_id", in.campaign_id},
+                           {"units", units_json(in.units)}};
+  outcome.units = !in.units.empty();
+
+  make_directories(c.out_dir);
+  const std::string bundle_path = c.out_dir + "/report_bundle.json";
+  const std::string report_path = c.out_dir + "/report.md";
+  // Outputs of an earlier report in the same directory must not pass for this one's.
+  for (const char* name : kFigures) std::remove((c.out_dir + "/" + name).c_str());
+  std::remove(report_path.c_str());
+  write_file_atomically(bundle_path, bundle.dump(1) + "\n");
+  ctx.info("report: bundle written to " + bundle_path);
+
+  const std::string python = python_interpreter();
+  const std::string probe = shell_quote(python) + " -c 'import matplotlib' >/dev/null 2>&1";
+  if (std::system(probe.c_str()) != 0) {
+    throw std::runtime_error(fmt::format(
+        "{} cannot import matplotlib: install the Debian package python3-matplotlib "
+        "(apt-get install python3-matplotlib) and rerun, or render the figures later with "
+        "'/usr/bin/python3 {} {} {}'. The bundle was written.",
+        python, find_report_script(), bundle_path, c.out_dir));
+  }
+  const std::string script = find_report_script();
+  // The script's messages go to stderr; stdout stays ours (results / JSON).
+  const std::string command = shell_quote(python) + " " + shell_quote(script) + " " +
+                              shell_quote(bundle_path) + " " + shell_quote(c.out_dir) +
+                              (ctx.quiet ? " --quiet" : "") + " 1>&2";
+  const int status = std::system(command.c_str());
+  if (status != 0 || !file_exists(report_path)) {
+    throw std::runtime_error(
+        fmt::format("the report renderer failed (exit status {}): '{}'; the bundle {} was kept",
+                    status, command, bundle_path));
+  }
+  nlohmann::json figures = nlohmann::json::array();
+  for (const char* name : kFigures) {
+    const std::string path = c.out_dir + "/" + name;
+    if (file_exists(path)) figures.push_back(path);
+  }
+  outcome.json = {{"out_dir", c.out_dir},
+                  {"report", report_path},
+                  {"figures", figures},
+                  {"bundle", bundle_path}};
+  return outcome;
+}
+
+void print_outcome(const CliContext& ctx, const ReportOutcome& o) {
+  if (ctx.json) {
+    ctx.print_json(o.json);
+    return;
+  }
+  std::cout << fmt::format("{:<44} {:>14} {:>14} {:>9}\n", "law", "max |rel diff|", "RMS rel diff",
+                           "outside");
+  for (const auto& [label, s] : o.stats) {
+    std::cout << fmt::format(
+        "{:<44} {:>14} {:>14} {:>9}\n", label,
+        std::isfinite(s.max_rel) ? fmt::format("{:.2f} %", 100 * s.max_rel) : std::string("-"),
+        std::isfinite(s.rms_rel) ? fmt::format("{:.2f} %", 100 * s.rms_rel) : std::string("-"),
+        s.outside);
+  }
+  std::cout << "report   " << o.json["report"].get<std::string>() << '\n';
+  for (const auto& f : o.json["figures"]) std::cout << "figure   " << f.get<std::string>() << '\n';
+  if (!o.units) std::cout << "(no campaign units: work_precision.png says so and is empty)\n";
+  std::cout << "bundle   " << o.json["bundle"].get<std::string>() << '\n';
+}
+
+}  // namespace
+
+void add_report_commands(CLI::App& app, CliContext& ctx) {
+  auto c = std::make_shared<ReportCommand>();
+  CLI::App* report = app.add_subcommand(
+      "report",
+      "Figures and a Markdown summary of a dataset against fitted and literature laws: the seed's "
+      "Fig. 3, parity, residuals against phi and Re, and the campaign's work-precision");
+  auto* dataset = report->add_option("--dataset", c->dataset_id,
+                                     "Stored dataset id or hash prefix (draglab campaign ...)");
+  auto* data = report->add_option("--data", c->data_csv,
+                                  "CSV dataset instead (columns phi,re,F,F_uncertainty; "
+                                  "docs/report.md)");
+  dataset->excludes(data);
+  report->add_option("--law", c->laws, "Fitted law version to show, NAME@V (repeatable)");
+  report
+      ->add_option("--compare", c->compare,
+                   std::string("Comparison laws, comma separated (default ") + kDefaultComparisons +
+                       "; a missing default is skipped with a warning)")
+      ->each([c](const std::string&) { c->compare_given = true; });
+  report->add_option("--campaign", c->campaign,
+                     "Campaign (id or name) whose units give the work-precision figure "
+                     "(default: the dataset's campaign)");
+  report->add_option("--out", c->out_dir, "Output directory (created)")->required();
+  report->footer(
+      "Examples:\n"
+      "  draglab report --dataset 3f2a9c1b7d0e --law vdh2004_fit@1 --out report/\n"
+      "  draglab report --data mydata.csv --compare bvk2007,tang2015 --out report/ --json\n"
+      "Writes OUT/report_bundle.json, then /usr/bin/python3 scripts/draglab_report.py (Debian "
+      "package python3-matplotlib) draws fig3_seed.png, parity.png, residuals.png, "
+      "work_precision.png and report.md. F is the canonical drag-only F = F_d/(3 pi mu d eps u), "
+      "Re = rho eps d u/mu.\nExit codes: 0 success, 1 failure, 2 bad input.");
+  report->callback([&ctx, c]() {
+    ctx.action = [&ctx, c]() {
+      if (c->dataset_id.empty() && c->data_csv.empty()) {
+        throw UsageError("one of --dataset ID or --data FILE.csv is required");
+      }
+      // A CSV report needs the database only for the laws; it is read, never written, except
+      // that a missing database is created and seeded with the literature library.
+      const bool exists = file_exists(ctx.resolved_db_path());
+      auto db = ctx.open_database(/*read_only=*/exists);
+      print_outcome(ctx, make_report(ctx, *db, *c));
+    };
+  });
+}
 
 }  // namespace cli
 }  // namespace draglab

@@ -34,7 +34,7 @@ BUNDLE_FORMAT = "draglab_report_bundle"
 FIGURES = ("fig3_seed.png", "parity.png", "residuals.png", "work_precision.png")
 # Line styles by law role/name: the fit is the solid line, the literature laws are told apart by
 # dashes so that colour can stay the phi of the curve (as in the seed's Fig. 3).
-KNOWN_STYLES = {"vdh2004": "--", "ergun": ":", "hill_koch_ladd": "-.", "bvk2007": (0, (5, 1, 1, 1))}
+KNOWN_STYLES = {"vdh2004": "--", "ergun": ":", "hill_koch_ladd": "-.", "bvk2007": (0, (6, 2, 1, 2, 1, 2))}
 EXTRA_STYLES = [(0, (1, 1)), (0, (3, 1, 1, 1, 1, 1)), (0, (8, 2)), (0, (2, 2))]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "<", ">"]
 
@@ -144,10 +144,12 @@ def figure_seed(bundle, out_dir):
         ax.legend(loc="lower right", fontsize=8)
 
     # Right: Stokes limit F(phi, Re = 0), not representable on the left (y ~ 1/Re).
-    for law in laws:
+    law_colours = plt.get_cmap("tab10")
+    for i, law in enumerate(laws):
         sc = law.get("stokes_curve")
         if sc:
-            plot_law_line(ax_stokes, sc["phi"], sc["F"], sc.get("outside_validity"), "black",
+            plot_law_line(ax_stokes, sc["phi"], sc["F"], sc.get("outside_validity"),
+                          "black" if law.get("role") == "fit" else law_colours(i % 10),
                           styles[law["reference"]], law["label"],
                           2.0 if law.get("role") == "fit" else 1.2)
     for phi in phis:
@@ -240,13 +242,22 @@ def figure_residuals(bundle, out_dir):
 
 
 def figure_work_precision(bundle, out_dir):
-    """Returns a note for report.md; draws only if there are finished units."""
+    """Draws error estimate against wall time of the finished units; returns a note for report.md."""
     units = bundle.get("units") or []
     done = [u for u in units if u.get("status") == "done" and finite(u.get("wall_s"))
             and finite(u.get("error_estimate")) and u["wall_s"] > 0 and u["error_estimate"] > 0]
     if not done:
-        return ("no finished campaign units with a positive error estimate and wall time "
-                "(dataset without campaign, or imported): work_precision.png not drawn")
+        # Drawn anyway, saying why it is empty, so that the report's set of figures is fixed.
+        note = ("no finished campaign units with a positive error estimate and wall time "
+                "(imported dataset, or a campaign this database does not hold)")
+        fig, ax = plt.subplots(figsize=(7.5, 6))
+        ax.text(0.5, 0.5, "no campaign units:\n" + note.replace(" (", "\n("), ha="center",
+                va="center", transform=ax.transAxes, wrap=True)
+        ax.set_axis_off()
+        ax.set_title("Work-precision of the campaign's units")
+        fig.savefig(os.path.join(out_dir, "work_precision.png"), dpi=100)
+        plt.close(fig)
+        return note + ": the figure is empty"
     resolutions = sorted({u["resolution"] for u in done})
     cmap = plt.get_cmap("plasma")
     fig, ax = plt.subplots(figsize=(7.5, 6))
@@ -277,9 +288,12 @@ def fmt(x, digits=4):
 def coefficient_table(law):
     lines = ["| parameter | value | 95 % interval | unit |", "|---|---|---|---|"]
     ci = law.get("ci95")
+    free = law.get("fitter", {}).get("free_parameters")
     for i, p in enumerate(law["parameters"]):
         interval = "-"
-        if ci and ci[i] is not None:
+        if free is not None and p["name"] not in free:
+            interval = "fixed"
+        elif ci and ci[i] is not None:
             lo, hi = ci[i]
             interval = "fixed" if lo == hi else "[%s, %s]" % (fmt(lo, 5), fmt(hi, 5))
         lines.append("| %s | %s | %s | %s |" % (p["name"], fmt(p["value"], 6), interval,
@@ -321,6 +335,14 @@ def write_markdown(bundle, out_dir, drawn, work_note):
                                            law.get("status", "?")), ""]
         md += coefficient_table(law)
         md.append("")
+        stats = law.get("fitter", {}).get("statistics")
+        if stats:
+            md.append("Fit statistics (from the fitter's record): %s points, dof %s, "
+                      "chi^2/dof %s, RMS relative error %s, max %s, k-fold CV RMS %s." % (
+                          stats.get("num_points", "-"), stats.get("dof", "-"),
+                          fmt(stats.get("chi2_per_dof")), fmt(stats.get("rms_rel_err")),
+                          fmt(stats.get("max_rel_err")), fmt(stats.get("cv_rms_rel_err"))))
+            md.append("")
         md.append("95 % intervals: value +- 1.96 sqrt(covariance diagonal) (normal quantile); "
                   "'fixed' = not fitted, '-' = no covariance stored." if law.get("ci95") else
                   "No covariance stored with this version: no intervals.")
@@ -366,9 +388,9 @@ def main(argv):
         sys.stderr.write("error: the bundle's dataset has no points\n")
         return 2
     os.makedirs(out_dir, exist_ok=True)
-    stale = os.path.join(out_dir, "work_precision.png")
-    if os.path.exists(stale):
-        os.remove(stale)  # a previous report's figure must not be linked by this one
+    for name in FIGURES + ("report.md",):  # an earlier report's files must not pass for ours
+        if os.path.exists(os.path.join(out_dir, name)):
+            os.remove(os.path.join(out_dir, name))
     figure_seed(bundle, out_dir)
     figure_parity(bundle, out_dir)
     figure_residuals(bundle, out_dir)
