@@ -20,7 +20,7 @@ namespace internal {
 /// A form with every parameter value; the free ones are moved by the optimizers through z.
 struct Model {
   const LawForm* form = nullptr;
-  std::vector<double> params;  ///< All parameters (fixed ones at their fixed values).
+  std::vector<double> params;   ///< All parameters (fixed ones at their fixed values).
   std::vector<int> free_index;  ///< Indices into params of the free parameters.
   std::vector<double> scale;    ///< x = scale * z for each free parameter, > 0.
 
@@ -64,8 +64,7 @@ struct GlobalSearchResult {
 GlobalSearchResult global_search(const Model& m, const std::vector<FitPoint>& points,
                                  RobustLoss loss, double loss_scale,
                                  const std::vector<double>& z_center,
-                                 const std::vector<double>& z_halfwidth, unsigned seed,
-                                 int starts);
+                                 const std::vector<double>& z_halfwidth, unsigned seed, int starts);
 
 /// Minimax fit in epigraph form with NLopt SLSQP: minimise t subject to |F_i(z)/F_i - 1| <= t and,
 /// if `grid` is non-null, F > 0 and dF/dRe >= 0 on it. Starts at z_start; returns false (with

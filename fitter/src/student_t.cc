@@ -53,8 +53,8 @@ double regularized_incomplete_beta(double a, double b, double x) {
   }
   if (x == 0.0 || x == 1.0) return x;
   // Prefactor x^a (1-x)^b / (a B(a, b)), in logarithms to avoid overflow for large a, b.
-  const double log_front = std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
-                           a * std::log(x) + b * std::log1p(-x);
+  const double log_front =
+      std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
   const double front = std::exp(log_front);
   if (x < (a + 1.0) / (a + b + 2.0)) return front * incomplete_beta_continued_fraction(a, b, x) / a;
   return 1.0 - front * incomplete_beta_continued_fraction(b, a, 1.0 - x) / b;
@@ -73,8 +73,8 @@ double student_t_cdf(double t, double dof) {
 double student_t_quantile(double p, double dof) {
   if (!(p > 0.0 && p < 1.0) || !(dof > 0.0) || !std::isfinite(dof)) {
     throw Error(ErrorCode::kInvalidArgument,
-                "student_t_quantile: p = " + std::to_string(p) + " must be in (0, 1) and dof = " +
-                    std::to_string(dof) + " finite and > 0");
+                "student_t_quantile: p = " + std::to_string(p) +
+                    " must be in (0, 1) and dof = " + std::to_string(dof) + " finite and > 0");
   }
   if (p == 0.5) return 0.0;
   if (p < 0.5) return -student_t_quantile(1.0 - p, dof);

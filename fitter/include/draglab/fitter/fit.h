@@ -27,7 +27,8 @@
 namespace draglab {
 namespace fitter {
 
-/// One data point: canonical F at (phi, Re superficial) with its absolute 1-sigma uncertainty.
+/// One data point (input of fit_law): canonical F at (phi, Re superficial) with its absolute
+/// 1-sigma uncertainty.
 struct FitPoint {
   double phi = 0.0;
   double re = 0.0;
@@ -43,12 +44,14 @@ enum class RobustLoss { kNone, kHuber, kCauchy };
 const char* to_string(RobustLoss l);
 RobustLoss robust_loss_from_string(const std::string& s);  ///< "none", "huber", "cauchy"
 
+/// How to fit: form, free/fixed parameters, objective, robust loss, and which checks to run.
 struct FitOptions {
   std::string form = "vdh2004";  ///< Law-form key.
   /// Parameters to fit (names or aliases); empty = the form's default set (vdh2004: k0, k1, c10,
   /// c11, c12; other forms: all parameters).
   std::vector<std::string> free;
-  /// Starting / fixed values by name (others: the form's published defaults).
+  /// Starting values (free parameters) and fixed values (the others) by name or alias; any
+  /// parameter not named starts at / stays fixed at the form's published default.
   std::vector<std::pair<std::string, double>> initial;
   Objective objective = Objective::kLeastSquares;
   RobustLoss loss = RobustLoss::kNone;
@@ -62,6 +65,10 @@ struct FitOptions {
   std::string to_json() const;  ///< Canonical JSON text (stored as the law's fitter settings).
 };
 
+/// Outcome of fit_law. Parameters are dimensionless (as in the form); errors are relative
+/// (0.05 = 5 %); chi2 is in units of the points' sigmas. Covariance and intervals describe the
+/// least-squares optimum (for a minimax fit, the least-squares covariance around the minimax
+/// values).
 struct FitResult {
   std::string form;
   std::vector<std::string> names;  ///< All parameters of the form, in the form's order.
@@ -78,11 +85,17 @@ struct FitResult {
   bool global_checked = false;
   double global_best_cost = 0.0;  ///< Best least-squares cost the global search found.
   bool global_agrees = true;      ///< Ceres' cost within 1e-6 relative of the global best.
+  /// The global search found a clearly better optimum and Ceres was restarted from it (the
+  /// reported fit is the restarted one).
+  bool global_restarted = false;
   bool constraints_checked = false;
   bool constraints_satisfied = true;
   std::string constraint_report;  ///< Where a constraint is violated, if anywhere.
   std::string ceres_report;       ///< ceres::Solver::Summary::BriefReport().
   bool converged = false;
+  /// What the fitter decided along the way (covariance scaled by chi2/dof, Ceres restarted from
+  /// the global optimum, CV skipped, minimax outcome), one sentence each.
+  std::vector<std::string> notes;
   std::string BriefReport() const;
   std::string FullReport() const;
 };
@@ -95,15 +108,16 @@ FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options
 /// Index of parameter `name_or_alias` of `form`; throws Error(kInvalidArgument) listing names.
 int parameter_index(const LawForm& form, const std::string& name_or_alias);
 
-/// Relative errors F(phi_i, Re_i)/F_i - 1 of a law against the points (for comparisons).
+/// Relative errors F(phi_i, Re_i)/F_i - 1 of a law against the points (for comparisons). Uses the
+/// law's range policy: load it with RangePolicy::kExtrapolate to compare outside its box.
 std::vector<double> relative_errors(const Law& law, const std::vector<FitPoint>& points);
 
 /// A draft record of the fitted law: form, fitted values, covariance, the form's convention and
 /// validity box narrowed to the data's (phi, Re) range, provenance kind "fitted" with the given
 /// dataset id/hash, fitter settings JSON (options + residual statistics) and code version.
-LawRecord fitted_record(const FitResult& result, const FitOptions& options,
-                        const std::string& name, const std::string& dataset_id,
-                        const std::string& dataset_hash, const std::vector<FitPoint>& points);
+LawRecord fitted_record(const FitResult& result, const FitOptions& options, const std::string& name,
+                        const std::string& dataset_id, const std::string& dataset_hash,
+                        const std::vector<FitPoint>& points);
 
 }  // namespace fitter
 }  // namespace draglab

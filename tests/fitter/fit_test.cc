@@ -1,0 +1,405 @@
+// Fitter tests on synthetic data made by the forms themselves: recovery of known parameters,
+// interval coverage, Ceres vs NLopt, covariance vs bootstrap, n0 = 3 vs 4, minimax, constraints,
+// bvk2007 / tang2015 refits, records, and bad input.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "draglab/drag_db/error.h"
+#include "draglab/drag_db/law.h"
+#include "draglab/fitter/fit.h"
+#include "fit_internal.h"
+
+namespace draglab {
+namespace fitter {
+namespace {
+
+/// A campaign-like grid: phi 0.1..0.6, Re 0 and 1..1000 log-spaced.
+std::vector<std::pair<double, double>> campaign_grid(int n_phi = 6, int n_re = 7) {
+  std::vector<std::pair<double, double>> grid;
+  for (int i = 0; i < n_phi; ++i) {
+    const double phi = 0.1 + 0.5 * i / (n_phi - 1.0);
+    grid.push_back({phi, 0.0});
+    for (int j = 0; j < n_re - 1; ++j) grid.push_back({phi, std::pow(1000.0, j / (n_re - 2.0))});
+  }
+  return grid;
+}
+
+/// F from `form` at `params` plus Gaussian relative noise of standard deviation `rel_sigma`;
+/// sigma_i = rel_sigma * F_true (the known noise level).
+std::vector<FitPoint> synthetic(
+    const std::string& form_key, const std::vector<double>& params, double rel_sigma, unsigned seed,
+    const std::vector<std::pair<double, double>>& grid = campaign_grid()) {
+  const LawForm& form = find_law_form(form_key);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<FitPoint> points;
+  for (const auto& [phi, re] : grid) {
+    const double F = form.F(phi, re, nullptr, params.data());
+    points.push_back({phi, re, F * (1.0 + rel_sigma * gauss(rng)), rel_sigma * F});
+  }
+  return points;
+}
+
+std::vector<double> with(const std::string& form_key,
+                         std::vector<std::pair<std::string, double>> changes) {
+  const LawForm& form = find_law_form(form_key);
+  std::vector<double> p = form.default_parameters();
+  for (const auto& [name, value] : changes) p[parameter_index(form, name)] = value;
+  return p;
+}
+
+// Truth for vdh2004: every C0/C1 coefficient moved away from the printed value (the start).
+const std::vector<std::pair<std::string, double>> kVdhTruth = {
+    {"k0", 16.5}, {"k1", 1.9}, {"c10", -1.1}, {"c11", 1.4}, {"c12", -1.1}};
+
+double sd(const FitResult& r, int k) { return std::sqrt(r.covariance[k * r.names.size() + k]); }
+
+TEST(Fit, RecoversVdh2004ParametersWithinIntervals) {
+  const std::vector<double> truth = with("vdh2004", kVdhTruth);
+  const auto points = synthetic("vdh2004", truth, 0.02, 11);
+  FitOptions options;
+  options.bootstrap = 0;
+  const FitResult r = fit_law(points, options);
+  ASSERT_TRUE(r.converged);
+  EXPECT_EQ(r.num_free, 5);
+  EXPECT_EQ(r.dof, static_cast<int>(points.size()) - 5);
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    if (!r.is_free[k]) {
+      EXPECT_EQ(r.values[k], truth[k]) << r.names[k];  // fixed at the printed value = truth
+      continue;
+    }
+    // This draw (seed 11) has every estimate inside its 95 % interval; any estimate more than
+    // 4 sd away would mean a wrong fit or a wrong covariance, not bad luck.
+    EXPECT_LE(r.ci95_low[k], truth[k]) << r.names[k];
+    EXPECT_GE(r.ci95_high[k], truth[k]) << r.names[k];
+    EXPECT_LT(std::fabs(r.values[k] - truth[k]), 4.0 * sd(r, k)) << r.names[k];
+  }
+  // 2 % noise: RMS relative error of the fit close to 2 %, chi2/dof close to 1 (dof 37:
+  // sd of chi2/dof = sqrt(2/37) = 0.23, band of 3 sd).
+  EXPECT_NEAR(r.rms_rel_err, 0.02, 0.006);
+  EXPECT_NEAR(r.chi2_per_dof, 1.0, 0.7);
+  EXPECT_GT(r.cv_rms_rel_err, 0.0);
+  EXPECT_TRUE(r.global_checked);
+  EXPECT_TRUE(r.global_agrees);
+  EXPECT_TRUE(r.constraints_checked);
+  EXPECT_TRUE(r.constraints_satisfied) << r.constraint_report;
+  EXPECT_FALSE(r.FullReport().empty());
+}
+
+TEST(Fit, IntervalsCoverTheTruthAtAbout95Percent) {
+  // 200 noise draws; for each parameter the fraction of 95 % intervals containing the truth is a
+  // binomial proportion with sd sqrt(0.95 * 0.05 / 200) = 0.0154: accept 0.95 +- 3 sd
+  // = [0.904, 0.996]. (The chi2/dof > 1 scaling makes intervals slightly conservative, which
+  // stays within this band.)
+  const std::vector<double> truth = with("vdh2004", kVdhTruth);
+  FitOptions options;
+  options.global_check = false;
+  options.check_constraints = false;
+  options.cv_folds = 0;
+  const int draws = 200;
+  std::vector<int> covered(truth.size(), 0);
+  std::vector<int> free_index;
+  for (int d = 0; d < draws; ++d) {
+    const FitResult r = fit_law(synthetic("vdh2004", truth, 0.03, 1000 + d), options);
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      if (r.is_free[k] && r.ci95_low[k] <= truth[k] && truth[k] <= r.ci95_high[k]) ++covered[k];
+    }
+    if (d == 0) {
+      for (std::size_t k = 0; k < truth.size(); ++k) {
+        if (r.is_free[k]) free_index.push_back(static_cast<int>(k));
+      }
+    }
+  }
+  ASSERT_EQ(free_index.size(), 5u);
+  for (int k : free_index) {
+    const double rate = static_cast<double>(covered[k]) / draws;
+    EXPECT_GE(rate, 0.904) << "parameter " << k;
+    EXPECT_LE(rate, 0.996) << "parameter " << k;
+  }
+}
+
+TEST(Fit, CeresAndNloptAgreeOnTheLeastSquaresOptimum) {
+  const std::vector<double> truth = with("vdh2004", kVdhTruth);
+  const auto points = synthetic("vdh2004", truth, 0.03, 5);
+  FitOptions options;
+  const FitResult r = fit_law(points, options);
+  ASSERT_TRUE(r.global_checked);
+  EXPECT_TRUE(r.global_agrees);
+  EXPECT_FALSE(r.global_restarted);
+  // Ceres' cost is chi2/2 without a robust loss.
+  EXPECT_NEAR(r.global_best_cost, 0.5 * r.chi2, 1e-6 * r.chi2);
+
+  // NLopt on its own, from starts far from the optimum (k0 = 30, c10 = +1, ...), finds the
+  // same parameters to well within their uncertainty.
+  internal::Model m;
+  m.form = &find_law_form("vdh2004");
+  m.params = m.form->default_parameters();
+  for (std::size_t k = 0; k < r.names.size(); ++k) {
+    if (r.is_free[k]) {
+      m.free_index.push_back(static_cast<int>(k));
+      m.scale.push_back(1.0);
+    }
+  }
+  const std::vector<double> far = {30.0, 0.0, 1.0, 0.0, 0.0};
+  const auto g = internal::global_search(m, points, RobustLoss::kNone, 1.0, far,
+                                         {20.0, 3.0, 3.0, 3.0, 3.0}, 3, 8);
+  ASSERT_GT(g.successful_starts, 0);
+  EXPECT_NEAR(g.best_cost, 0.5 * r.chi2, 1e-6 * r.chi2);
+  for (int j = 0; j < m.num_free(); ++j) {
+    const int k = m.free_index[j];
+    EXPECT_NEAR(g.best_z[j], r.values[k], 1e-3 * sd(r, k)) << r.names[k];
+  }
+}
+
+TEST(Fit, CovarianceAgreesWithBootstrap) {
+  // 8 x 8 grid, 2 % noise, 400 bootstrap resamples. The bootstrap sd estimates the actual
+  // scatter, i.e. the nominal (sigma-based) sd times sqrt(chi2/dof), while the reported
+  // covariance is scaled by chi2/dof only when it exceeds 1: compare like with like. Tolerance:
+  // the bootstrap sd of 400 resamples has a relative sampling error 1/sqrt(2 * 399) = 3.5 %
+  // (3 sd = 11 %); resampling pairs on a 64-point design adds O(1/sqrt(N)) = 12 % leverage noise:
+  // 25 % in all.
+  const std::vector<double> truth = with("vdh2004", kVdhTruth);
+  const auto points = synthetic("vdh2004", truth, 0.02, 21, campaign_grid(8, 8));
+  FitOptions options;
+  options.bootstrap = 400;
+  options.global_check = false;
+  options.cv_folds = 0;
+  const FitResult r = fit_law(points, options);
+  ASSERT_EQ(r.bootstrap_stddev.size(), r.names.size());
+  const double factor = std::sqrt(r.chi2_per_dof / std::max(1.0, r.chi2_per_dof));
+  for (std::size_t k = 0; k < r.names.size(); ++k) {
+    if (!r.is_free[k]) {
+      EXPECT_EQ(r.bootstrap_stddev[k], 0.0);
+      continue;
+    }
+    const double expected = sd(r, static_cast<int>(k)) * factor;
+    EXPECT_NEAR(r.bootstrap_stddev[k] / expected, 1.0, 0.25) << r.names[k];
+  }
+}
+
+TEST(Fit, FreeExponentPrefersEps4WhenDataHaveIt) {
+  // Data made with n0 = 4 (the published bvk2007 Stokes term) and otherwise Eq. 6 as printed;
+  // fitting n free (the seed's name) settles eps^3 vs eps^4.
+  const std::vector<double> truth = with("vdh2004", {{"n0", 4.0}});
+  const auto points = synthetic("vdh2004", truth, 0.01, 8);
+  FitOptions options;
+  options.free = {"a", "n", "b", "c0", "c1", "c2"};
+  options.cv_folds = 0;
+  const FitResult r = fit_law(points, options);
+  const int n0 = parameter_index(find_law_form("vdh2004"), "n");
+  EXPECT_LT(std::fabs(r.values[n0] - 4.0), 4.0 * sd(r, n0));
+  EXPECT_LE(r.ci95_low[n0], 4.0);
+  EXPECT_GE(r.ci95_high[n0], 4.0);
+  EXPECT_GT(r.ci95_low[n0], 3.0) << "the interval must exclude the printed eps^3";
+}
+
+TEST(Fit, MinimaxReducesTheMaximumError) {
+  const std::vector<double> truth = with("vdh2004", kVdhTruth);
+  const auto points = synthetic("vdh2004", truth, 0.03, 17);
+  FitOptions options;
+  options.cv_folds = 0;
+  options.global_check = false;
+  const FitResult lsq = fit_law(points, options);
+  options.objective = Objective::kMinimax;
+  options.check_constraints = false;
+  const FitResult minimax = fit_law(points, options);
+  EXPECT_LT(minimax.max_rel_err, lsq.max_rel_err);
+  EXPECT_GE(minimax.rms_rel_err, lsq.rms_rel_err * 0.999);  // lsq is the best in the rms sense
+  options.check_constraints = true;  // imposed in the minimax fit: still better than lsq here
+  const FitResult constrained = fit_law(points, options);
+  EXPECT_LT(constrained.max_rel_err, lsq.max_rel_err);
+  EXPECT_TRUE(constrained.constraints_satisfied) << constrained.constraint_report;
+  // Local optimality of the minimax fit (it is a nonsmooth optimum, so check it directly): no
+  // small step of the free parameters, in any of 300 random directions and at two step sizes
+  // (1e-3 and 1e-2 of each parameter's sd), lowers the maximum error. Rounding of the optimum
+  // (SLSQP xtol 1e-9) is far below these steps' first-order effect.
+  const LawForm& form = find_law_form("vdh2004");
+  auto max_error = [&](const std::vector<double>& p) {
+    double worst = 0.0;
+    for (const FitPoint& pt : points) {
+      worst = std::max(worst, std::fabs(form.F(pt.phi, pt.re, nullptr, p.data()) / pt.F - 1.0));
+    }
+    return worst;
+  };
+  EXPECT_NEAR(max_error(minimax.values), minimax.max_rel_err, 1e-14);
+  std::mt19937 rng(99);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  int lower = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    for (double step : {1e-3, 1e-2}) {
+      std::vector<double> p = minimax.values;
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        if (minimax.is_free[k]) p[k] += step * sd(minimax, static_cast<int>(k)) * gauss(rng);
+      }
+      if (max_error(p) < minimax.max_rel_err * (1.0 - 1e-9)) ++lower;
+    }
+  }
+  EXPECT_EQ(lower, 0);
+}
+
+TEST(Fit, ConstraintCheckFlagsDragDecreasingWithRe) {
+  // B + C1 < 0 makes the inertial term of Eq. 6 negative: dF/dRe < 0 everywhere.
+  const LawForm& form = find_law_form("vdh2004");
+  const auto points = synthetic("vdh2004", form.default_parameters(), 0.01, 4);
+  const internal::ConstraintGrid grid = internal::constraint_grid(form, points);
+  EXPECT_EQ(grid.phi.size(), 12u);
+  EXPECT_EQ(grid.re.size(), 12u);
+  EXPECT_EQ(internal::check_constraints(form, form.default_parameters().data(), grid), "");
+  const std::vector<double> bad = with("vdh2004", {{"c10", -3.0}, {"c11", 0.0}, {"c12", 0.0}});
+  EXPECT_NE(internal::check_constraints(form, bad.data(), grid).find("dF/dRe < 0"),
+            std::string::npos);
+
+  // Data that have the defect: made with B + C1 < 0 at Re <= 10 (F still > 0 there); fitting the
+  // Stokes coefficients with the inertial ones fixed keeps it, and the check reports it.
+  std::vector<std::pair<double, double>> low_re;
+  for (double phi : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6}) {
+    for (double re : {0.0, 1.0, 3.0, 10.0}) low_re.push_back({phi, re});
+  }
+  FitOptions options;
+  options.free = {"a", "b"};
+  options.initial = {{"c0", -3.0}, {"c1", 0.0}, {"c2", 0.0}};
+  options.cv_folds = 0;
+  options.global_check = false;
+  const FitResult r = fit_law(synthetic("vdh2004", bad, 0.01, 4, low_re), options);
+  EXPECT_TRUE(r.constraints_checked);
+  EXPECT_FALSE(r.constraints_satisfied);
+  EXPECT_NE(r.constraint_report.find("dF/dRe < 0"), std::string::npos) << r.constraint_report;
+}
+
+void expect_recovers_all(const std::string& key, double perturbation, unsigned seed) {
+  const LawForm& form = find_law_form(key);
+  std::vector<double> truth = form.default_parameters();
+  for (std::size_t k = 0; k < truth.size(); ++k)
+    truth[k] *= 1.0 + perturbation * ((k % 2) ? 1 : -1);
+  const auto points = synthetic(key, truth, 0.01, seed, campaign_grid(8, 8));
+  FitOptions options;
+  options.form = key;
+  options.cv_folds = 0;
+  const FitResult r = fit_law(points, options);
+  EXPECT_EQ(r.num_free, form.num_parameters);  // other forms: all parameters free by default
+  EXPECT_TRUE(r.global_agrees);
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    EXPECT_LT(std::fabs(r.values[k] - truth[k]), 4.0 * sd(r, static_cast<int>(k)))
+        << key << " " << r.names[k] << " = " << r.values[k] << " vs " << truth[k];
+  }
+  EXPECT_NEAR(r.rms_rel_err, 0.01, 0.004);
+}
+
+TEST(Fit, RefitsBvk2007OnItsOwnData) { expect_recovers_all("bvk2007", 0.1, 31); }
+TEST(Fit, RefitsTang2015OnItsOwnData) { expect_recovers_all("tang2015", 0.1, 32); }
+
+TEST(Fit, StokesOnlyDataCannotDetermineInertialParameters) {
+  std::vector<std::pair<double, double>> grid;
+  for (double phi : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6}) grid.push_back({phi, 0.0});
+  const auto points =
+      synthetic("vdh2004", find_law_form("vdh2004").default_parameters(), 0.01, 2, grid);
+  try {
+    fit_law(points, FitOptions());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    const std::string what = e.what();
+    for (const char* name : {"c10", "c11", "c12", "Re > 0"}) {
+      EXPECT_NE(what.find(name), std::string::npos) << what;
+    }
+    EXPECT_EQ(what.find("k0"), std::string::npos) << what;
+  }
+  // The Stokes coefficients alone are fine on the same data.
+  FitOptions options;
+  options.free = {"a", "b"};
+  EXPECT_NO_THROW(fit_law(points, options));
+}
+
+TEST(Fit, RecordCarriesProvenanceAndEvaluatesTheFit) {
+  const auto points = synthetic("vdh2004", with("vdh2004", kVdhTruth), 0.02, 9);
+  FitOptions options;
+  const FitResult r = fit_law(points, options);
+  const LawRecord rec = fitted_record(r, options, "vdh2004_refit", "abc123", "deadbeef", points);
+  EXPECT_EQ(rec.form, "vdh2004");
+  EXPECT_EQ(rec.provenance.kind, "fitted");
+  EXPECT_EQ(rec.provenance.dataset_id, "abc123");
+  EXPECT_EQ(rec.provenance.data_hash, "deadbeef");
+  EXPECT_FALSE(rec.provenance.code_version.empty());
+  EXPECT_EQ(rec.covariance.size(), 64u);
+  EXPECT_DOUBLE_EQ(rec.validity.phi.min, 0.1);
+  EXPECT_DOUBLE_EQ(rec.validity.phi.max, 0.6);
+  EXPECT_DOUBLE_EQ(rec.validity.re.max, 1000.0);
+  const auto settings = nlohmann::json::parse(rec.provenance.fitter_settings);
+  EXPECT_EQ(settings["options"]["form"], "vdh2004");
+  EXPECT_DOUBLE_EQ(settings["statistics"]["rms_rel_err"].get<double>(), r.rms_rel_err);
+  const Law law(rec, RangePolicy::kExtrapolate);
+  const auto errors = relative_errors(law, points);
+  double max_err = 0.0;
+  for (double e : errors) max_err = std::max(max_err, std::fabs(e));
+  EXPECT_NEAR(max_err, r.max_rel_err, 1e-12);
+  // A literature law evaluated on its own noise-free data has zero relative error.
+  const Law printed(literature_record(find_law_form("vdh2004")));
+  const auto exact = synthetic("vdh2004", find_law_form("vdh2004").default_parameters(), 0.0, 1);
+  for (double e : relative_errors(printed, exact)) EXPECT_NEAR(e, 0.0, 1e-14);
+}
+
+TEST(Fit, RejectsBadInputWithClearMessages) {
+  const auto points = synthetic("vdh2004", find_law_form("vdh2004").default_parameters(), 0.01, 3);
+  auto expect_invalid = [](const std::vector<FitPoint>& pts, const FitOptions& o,
+                           const std::string& fragment) {
+    try {
+      fit_law(pts, o);
+      ADD_FAILURE() << "expected an error mentioning '" << fragment << "'";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument) << e.what();
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  FitOptions o;
+  o.form = "nope";
+  expect_invalid(points, o, "known forms");
+  o = FitOptions();
+  o.free = {"a", "zz"};
+  expect_invalid(points, o, "zz");
+  o.free = {"a", "k0"};  // alias and name of one parameter
+  expect_invalid(points, o, "twice");
+  o = FitOptions();
+  expect_invalid(std::vector<FitPoint>(points.begin(), points.begin() + 5), o, "too few");
+  for (auto [field, value] : std::vector<std::pair<std::string, double>>{
+           {"F", 0.0}, {"F", -1.0}, {"sigma", 0.0}, {"phi", std::nan("")}, {"Re", -1.0}}) {
+    auto bad = points;
+    if (field == "F") bad[3].F = value;
+    if (field == "sigma") bad[3].sigma = value;
+    if (field == "phi") bad[3].phi = value;
+    if (field == "Re") bad[3].re = value;
+    expect_invalid(bad, FitOptions(), field + " = ");
+  }
+  o = FitOptions();
+  o.loss_scale = 0.0;
+  expect_invalid(points, o, "loss_scale");
+  o = FitOptions();
+  o.cv_folds = 1;
+  expect_invalid(points, o, "cv_folds");
+  EXPECT_THROW(objective_from_string("l1"), Error);
+  EXPECT_THROW(robust_loss_from_string("tukey"), Error);
+  EXPECT_EQ(robust_loss_from_string("huber"), RobustLoss::kHuber);
+}
+
+TEST(Fit, RobustLossDownweightsAnOutlier) {
+  const std::vector<double> truth = with("vdh2004", kVdhTruth);
+  auto points = synthetic("vdh2004", truth, 0.01, 12);
+  points[10].F *= 1.5;  // a 50 sigma outlier
+  FitOptions options;
+  options.cv_folds = 0;
+  const FitResult plain = fit_law(points, options);
+  options.loss = RobustLoss::kCauchy;
+  const FitResult robust = fit_law(points, options);
+  const int k0 = parameter_index(find_law_form("vdh2004"), "a");
+  EXPECT_LT(std::fabs(robust.values[k0] - truth[k0]), std::fabs(plain.values[k0] - truth[k0]));
+  EXPECT_TRUE(robust.global_agrees);
+}
+
+}  // namespace
+}  // namespace fitter
+}  // namespace draglab
