@@ -1,10 +1,482 @@
-// Placeholder: `draglab campaign` is being written (replaced by the real commands).
+// `draglab campaign run|status|export` and `draglab dataset build|list|show|export|import`:
+// LBM drag campaigns (docs/campaigns.md) and the datasets built from them.
+#include <sqlite3.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <fmt/core.h>
+
 #include "cli/cli_context.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace cli {
+namespace {
 
-void add_campaign_commands(CLI::App& /*app*/, CliContext& /*ctx*/) {}
+struct RunCommand {
+  std::string spec;
+  bool resume = false;
+  int jobs = 0;
+};
+
+struct ExportCommand {
+  std::string id;
+  bool csv = false;
+  std::string out;
+};
+
+bool file_exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/// A spec path, or a preset name ("quick", "standard", "paper") from data/campaigns.
+std::string resolve_spec_path(const std::string& spec) {
+  if (file_exists(spec) || spec.find('/') != std::string::npos ||
+      spec.find(".toml") != std::string::npos) {
+    return spec;
+  }
+  for (const std::string& dir :
+       {std::string(DRAGLAB_SOURCE_DATA_DIR) + "/campaigns",
+        std::string("/usr/local/") + DRAGLAB_INSTALL_SHARE_DIR + "/campaigns",
+        std::string("/usr/") + DRAGLAB_INSTALL_SHARE_DIR + "/campaigns"}) {
+    if (file_exists(dir + "/" + spec + ".toml")) return dir + "/" + spec + ".toml";
+  }
+  return spec;
+}
+
+nlohmann::json status_json(const campaign::CampaignStatus& s) {
+  return {{"id", s.id},
+          {"name", s.name},
+          {"spec_hash", s.spec_hash},
+          {"created_at", s.created_at},
+          {"units_total", s.units_total},
+          {"units_done", s.units_done},
+          {"units_failed", s.units_failed},
+          {"units_pending", s.units_pending},
+          {"units_running", s.units_running},
+          {"wall_s", s.wall_s}};
+}
+
+nlohmann::json point_json(const DatasetPoint& p) {
+  return {{"phi", p.phi},
+          {"re_target", p.re_target},
+          {"re", p.re},
+          {"F", p.F},
+          {"F_standard_error", p.F_standard_error},
+          {"F_discretisation_error", p.F_discretisation_error},
+          {"F_uncertainty", p.F_uncertainty},
+          {"realizations", p.realizations},
+          {"resolutions", p.resolutions},
+          {"F_at_resolution", p.F_at_resolution},
+          {"order", p.order},
+          {"extrapolation", p.extrapolation},
+          {"wall_s", p.wall_s}};
+}
+
+nlohmann::json dataset_json(const Dataset& d, bool with_points) {
+  nlohmann::json j = {{"id", d.id},
+                      {"hash", d.hash},
+                      {"campaign_id", d.campaign_id},
+                      {"name", d.name},
+                      {"created_at", d.created_at},
+                      {"code_version", d.code_version},
+                      {"points", d.points.size()}};
+  const auto method = nlohmann::json::parse(d.method, nullptr, false);
+  j["method"] = method.is_discarded() ? nlohmann::json(d.method) : method;
+  if (with_points) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const auto& p : d.points) points.push_back(point_json(p));
+    j["points"] = points;
+  }
+  return j;
+}
+
+void print_dataset_table(const Dataset& d) {
+  std::cout << fmt::format("dataset {} ({} points) from {}, built {}\n", d.id, d.points.size(),
+                           d.name, d.created_at);
+  std::cout << fmt::format("{:>7} {:>8} {:>9} {:>11} {:>9} {:>9} {:>9} {:>5} {:>11}\n", "phi",
+                           "Re_tgt", "Re", "F", "se", "disc", "total", "real", "extrap");
+  for (const auto& p : d.points) {
+    std::cout << fmt::format(
+        "{:>7.4g} {:>8.4g} {:>9.4g} {:>11.6g} {:>9.2e} {:>9.2e} {:>9.2e} {:>5} {:>11}\n", p.phi,
+        p.re_target, p.re, p.F, p.F_standard_error, p.F_discretisation_error, p.F_uncertainty,
+        p.realizations, p.extrapolation + (p.order > 0 ? fmt::format("({:.2g})", p.order) : ""));
+  }
+}
+
+/// Builds the dataset of a campaign, printing what was left out; returns it.
+Dataset build_and_report(const CliContext& ctx, Database& db, std::int64_t campaign_id) {
+  std::vector<std::string> skipped;
+  const Dataset d = campaign::build_dataset(db, campaign_id, &skipped);
+  for (const auto& s : skipped) ctx.warn("dataset: left out " + s);
+  const auto method = nlohmann::json::parse(d.method, nullptr, false);
+  if (method.is_object() && method.contains("notes")) {
+    for (const auto& n : method["notes"]) ctx.info("dataset: " + n.get<std::string>());
+  }
+  return d;
+}
+
+void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
+  // The whole spec is checked before the database is opened: bad input writes nothing.
+  const campaign::CampaignSpec spec = campaign::parse_campaign_spec(resolve_spec_path(c.spec));
+  if (c.jobs < 0) throw UsageError("--jobs must be >= 0 (0 = all cores)");
+  campaign::RunCampaignOptions options;
+  options.jobs = c.jobs;
+  options.resume = c.resume;
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  auto last = std::chrono::steady_clock::now() - std::chrono::hours(1);
+  bool printed = false;
+  if (!ctx.quiet) {
+    options.progress = [&](std::int64_t finished, std::int64_t total, const std::string& line) {
+      const auto now = std::chrono::steady_clock::now();
+      const bool failure = line.find("FAILED") != std::string::npos;
+      const double since = std::chrono::duration<double>(now - last).count();
+      if (!failure && finished < total && since < (tty ? 0.2 : 10.0)) return;
+      last = now;
+      if (tty) {
+        std::fprintf(stderr, "\r\033[K%s", line.c_str());
+        if (failure) std::fputc('\n', stderr);
+      } else {
+        std::fprintf(stderr, "%s\n", line.c_str());
+      }
+      printed = true;
+    };
+  }
+  const std::string db_path = ctx.resolved_db_path();
+  ctx.info(fmt::format(
+      "campaign {}: {} phi x {} Re x {} realizations x {} resolutions = {} units "
+      "(database {})",
+      spec.name, spec.phi.size(), spec.re.size(), spec.realizations, spec.resolutions.size(),
+      spec.phi.size() * spec.re.size() * spec.realizations * spec.resolutions.size(), db_path));
+  const auto start = std::chrono::steady_clock::now();
+  const campaign::CampaignStatus st = campaign::run_campaign(db_path, spec, options);
+  if (printed && tty) std::fputc('\n', stderr);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  nlohmann::json j = status_json(st);
+  j["run_wall_s"] = wall;
+  std::unique_ptr<Database> db = ctx.open_database();
+  if (st.units_pending + st.units_running == 0 && st.units_done > 0) {
+    const Dataset d = build_and_report(ctx, *db, st.id);
+    j["dataset_id"] = d.id;
+    j["dataset_hash"] = d.hash;
+    j["dataset_points"] = d.points.size();
+  }
+  if (st.units_failed > 0) {
+    // Failed units are results too (recorded with their diagnosis): list them, exit 0.
+    for (const auto& u : campaign::list_units(*db, st.id)) {
+      if (u.status == "failed") {
+        ctx.warn(fmt::format("unit phi = {}, Re = {}, d = {}, realization {} failed: {}", u.phi,
+                             u.re_target, u.resolution, u.realization, u.diagnosis));
+      }
+    }
+  }
+  const bool nothing_converged = st.units_done == 0 && st.units_pending + st.units_running == 0;
+  if (ctx.json) {
+    ctx.print_json(j);
+    if (nothing_converged) {
+      throw std::runtime_error("no unit of campaign '" + st.name + "' converged: no dataset");
+    }
+    return;
+  }
+  std::cout << st.BriefReport() << "\n";
+  std::cout << fmt::format("wall time        {:.1f} s this run, {:.1f} s of LBM units in all\n",
+                           wall, st.wall_s);
+  if (j.contains("dataset_id")) {
+    std::cout << fmt::format("dataset          {} ({} points): draglab dataset show {}\n",
+                             j["dataset_id"].get<std::string>(),
+                             j["dataset_points"].get<std::size_t>(),
+                             j["dataset_id"].get<std::string>());
+  } else if (nothing_converged) {
+    throw std::runtime_error("no unit of campaign '" + st.name + "' converged: no dataset");
+  }
+}
+
+void run_status(const CliContext& ctx, const std::string& id) {
+  std::unique_ptr<Database> db = ctx.open_database(true);
+  if (!id.empty()) {
+    const campaign::CampaignStatus st = campaign::campaign_status(*db, id);
+    if (ctx.json) {
+      ctx.print_json(status_json(st));
+    } else {
+      std::cout << st.FullReport();
+    }
+    return;
+  }
+  const auto all = campaign::list_campaigns(*db);
+  if (ctx.json) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& s : all) j.push_back(status_json(s));
+    ctx.print_json(j);
+    return;
+  }
+  if (all.empty()) {
+    std::cout << "no campaigns (start one with: draglab campaign run data/campaigns/quick.toml)\n";
+    return;
+  }
+  std::cout << fmt::format("{:>4}  {:<20} {:>6} {:>6} {:>6} {:>6}  {:<20}\n", "id", "name", "total",
+                           "done", "failed", "to run", "created");
+  for (const auto& s : all) {
+    std::cout << fmt::format("{:>4}  {:<20} {:>6} {:>6} {:>6} {:>6}  {:<20}\n", s.id, s.name,
+                             s.units_total, s.units_done, s.units_failed,
+                             s.units_pending + s.units_running, s.created_at);
+  }
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char ch : s) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+
+/// Every column of every unit, straight from the table.
+void run_export(const CliContext& ctx, const ExportCommand& c) {
+  std::unique_ptr<Database> db = ctx.open_database(true);
+  const campaign::CampaignStatus st = campaign::campaign_status(*db, c.id);
+  sqlite3_stmt* stmt = nullptr;
+  if (sqlite3_prepare_v2(db->handle(),
+                         "SELECT * FROM campaign_units WHERE campaign_id = ? ORDER BY phi_index, "
+                         "re_index, realization, resolution_index",
+                         -1, &stmt, nullptr) != SQLITE_OK) {
+    throw Error(ErrorCode::kDatabase,
+                std::string("campaign export: ") + sqlite3_errmsg(db->handle()));
+  }
+  std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> guard(stmt, sqlite3_finalize);
+  sqlite3_bind_int64(stmt, 1, st.id);
+  const int columns = sqlite3_column_count(stmt);
+  std::ostringstream out;
+  nlohmann::json units = nlohmann::json::array();
+  if (c.csv) {
+    for (int i = 0; i < columns; ++i) out << (i ? "," : "") << sqlite3_column_name(stmt, i);
+    out << "\n";
+  }
+  int rc;
+  while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
+    nlohmann::json u = nlohmann::json::object();
+    for (int i = 0; i < columns; ++i) {
+      const std::string name = sqlite3_column_name(stmt, i);
+      const int type = sqlite3_column_type(stmt, i);
+      std::string text;
+      if (type == SQLITE_INTEGER) {
+        u[name] = sqlite3_column_int64(stmt, i);
+        text = std::to_string(sqlite3_column_int64(stmt, i));
+      } else if (type == SQLITE_FLOAT) {
+        u[name] = sqlite3_column_double(stmt, i);
+        text = fmt::format("{:.17g}", sqlite3_column_double(stmt, i));
+      } else if (type == SQLITE_TEXT) {
+        text = reinterpret_cast<const char*>(sqlite3_column_text(stmt, i));
+        if (name == "result_json") {
+          const auto parsed = nlohmann::json::parse(text, nullptr, false);
+          u[name] = parsed.is_discarded() ? nlohmann::json(text) : parsed;
+        } else {
+          u[name] = text;
+        }
+      } else {
+        u[name] = nullptr;
+      }
+      if (c.csv) out << (i ? "," : "") << csv_field(text);
+    }
+    if (c.csv) out << "\n";
+    units.push_back(u);
+  }
+  if (rc != SQLITE_DONE) {
+    throw Error(ErrorCode::kDatabase,
+                std::string("campaign export: ") + sqlite3_errmsg(db->handle()));
+  }
+  std::string text =
+      c.csv ? out.str()
+            : nlohmann::json({{"campaign", status_json(st)}, {"units", units}}).dump(2) + "\n";
+  if (c.out.empty()) {
+    std::cout << text;
+    return;
+  }
+  const std::string partial = c.out + ".partial";
+  {
+    std::ofstream f(partial);
+    if (!f) throw UsageError("--out '" + c.out + "' cannot be written");
+    f << text;
+    if (!f.flush()) throw std::runtime_error("writing '" + c.out + "' failed");
+  }
+  if (std::rename(partial.c_str(), c.out.c_str()) != 0) {
+    std::remove(partial.c_str());
+    throw std::runtime_error("writing '" + c.out + "' failed");
+  }
+  ctx.info(fmt::format("wrote {} units of campaign {} to {}", units.size(), st.name, c.out));
+}
+
+void run_dataset_build(const CliContext& ctx, const std::string& id) {
+  std::unique_ptr<Database> db = ctx.open_database();
+  const campaign::CampaignStatus st = campaign::campaign_status(*db, id);
+  if (st.units_pending + st.units_running > 0) {
+    ctx.warn(fmt::format("campaign {} has {} units not run yet: the dataset uses the {} finished",
+                         st.name, st.units_pending + st.units_running,
+                         st.units_done + st.units_failed));
+  }
+  const Dataset d = build_and_report(ctx, *db, st.id);
+  if (ctx.json) {
+    ctx.print_json(dataset_json(d, true));
+  } else {
+    print_dataset_table(d);
+  }
+}
+
+void run_dataset_list(const CliContext& ctx) {
+  std::unique_ptr<Database> db = ctx.open_database(true);
+  const auto all = list_datasets(*db);
+  if (ctx.json) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& d : all) j.push_back(dataset_json(d, false));
+    ctx.print_json(j);
+    return;
+  }
+  if (all.empty()) {
+    std::cout << "no datasets (build one: draglab dataset build CAMPAIGN, or draglab dataset "
+                 "import FILE.csv)\n";
+    return;
+  }
+  std::cout << fmt::format("{:<12}  {:<20} {:>8}  {:<20}\n", "id", "name", "campaign", "created");
+  for (const auto& d : all) {
+    std::cout << fmt::format("{:<12}  {:<20} {:>8}  {:<20}\n", d.id, d.name,
+                             d.campaign_id ? std::to_string(d.campaign_id) : "-", d.created_at);
+  }
+}
+
+void run_dataset_show(const CliContext& ctx, const std::string& id) {
+  std::unique_ptr<Database> db = ctx.open_database(true);
+  const Dataset d = load_dataset(*db, id);
+  if (ctx.json) {
+    ctx.print_json(dataset_json(d, true));
+  } else {
+    print_dataset_table(d);
+  }
+}
+
+void run_dataset_export(const CliContext& ctx, const std::string& id, const std::string& out) {
+  std::unique_ptr<Database> db = ctx.open_database(true);
+  const Dataset d = load_dataset(*db, id);
+  write_dataset_csv(d, out.empty() ? "/dev/stdout" : out);
+  if (!out.empty())
+    ctx.info(fmt::format("wrote dataset {} ({} points) to {}", d.id, d.points.size(), out));
+}
+
+void run_dataset_import(const CliContext& ctx, const std::string& file) {
+  const Dataset parsed = read_dataset_csv(file);  // checked before the database is touched
+  std::unique_ptr<Database> db = ctx.open_database();
+  const Dataset d = store_dataset(*db, parsed);
+  if (ctx.json) {
+    ctx.print_json(dataset_json(d, false));
+  } else {
+    std::cout << fmt::format("dataset {} ({} points) imported from {}\n", d.id, d.points.size(),
+                             file);
+  }
+}
+
+}  // namespace
+
+void add_campaign_commands(CLI::App& app, CliContext& ctx) {
+  CLI::App* campaign = app.add_subcommand(
+      "campaign", "LBM drag campaigns: a TOML spec -> units (phi, Re, realization, resolution)");
+  campaign->require_subcommand(1);
+  campaign->footer(
+      "Examples:\n  draglab campaign run data/campaigns/quick.toml --jobs 2\n"
+      "  draglab campaign run quick --resume\n  draglab campaign status\n"
+      "  draglab campaign status quick --json\n  draglab campaign export 1 --csv --out units.csv\n"
+      "Spec format: docs/campaigns.md.");
+  {
+    auto* cmd = campaign->add_subcommand(
+        "run",
+        "Run a campaign (each finished unit is committed at once; --resume continues a "
+        "killed or extended one)");
+    auto o = std::make_shared<RunCommand>();
+    cmd->add_option("spec", o->spec, "Spec file (TOML) or preset name: quick, standard, paper")
+        ->required();
+    cmd->add_flag("--resume", o->resume,
+                  "Continue the campaign of the same name (finished units are kept; units in "
+                  "flight when it stopped run again)");
+    cmd->add_option("--jobs", o->jobs, "Units run in parallel (0 = all cores)")
+        ->capture_default_str();
+    cmd->footer(
+        "Examples:\n  draglab campaign run data/campaigns/quick.toml --db q.db --jobs 2\n"
+        "  draglab campaign run data/campaigns/quick.toml --db q.db --resume\n"
+        "One process at a time runs a campaign (a lock file next to the database guards it).\n"
+        "When every unit has finished, the dataset is built and its id printed.");
+    cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_campaign_command(ctx, *o); }; });
+  }
+  {
+    auto* cmd = campaign->add_subcommand("status",
+                                         "Units total/done/failed of one campaign, or "
+                                         "the list of campaigns");
+    auto id = std::make_shared<std::string>();
+    cmd->add_option("campaign", *id, "Campaign id or name (default: list all)");
+    cmd->footer("Examples:\n  draglab campaign status\n  draglab campaign status quick --json");
+    cmd->callback([&ctx, id] { ctx.action = [&ctx, id] { run_status(ctx, *id); }; });
+  }
+  {
+    auto* cmd = campaign->add_subcommand("export", "Every field of every unit (JSON, or CSV)");
+    auto o = std::make_shared<ExportCommand>();
+    cmd->add_option("campaign", o->id, "Campaign id or name")->required();
+    cmd->add_flag("--csv", o->csv, "CSV instead of JSON");
+    cmd->add_option("--out", o->out, "Output file (default: stdout)");
+    cmd->footer(
+        "Examples:\n  draglab campaign export 1 > units.json\n"
+        "  draglab campaign export quick --csv --out units.csv");
+    cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_export(ctx, *o); }; });
+  }
+
+  CLI::App* dataset = app.add_subcommand(
+      "dataset", "Drag datasets (per (phi, Re): mean F, resolution-extrapolated, uncertainty)");
+  dataset->require_subcommand(1);
+  dataset->footer(
+      "Examples:\n  draglab dataset build quick\n  draglab dataset list\n"
+      "  draglab dataset show 3f2a9c --json\n  draglab dataset export 3f2a9c --out quick.csv\n"
+      "  draglab dataset import my_dns.csv");
+  {
+    auto* cmd = dataset->add_subcommand("build",
+                                        "Build (and store) a campaign's dataset from its "
+                                        "finished units");
+    auto id = std::make_shared<std::string>();
+    cmd->add_option("campaign", *id, "Campaign id or name")->required();
+    cmd->callback([&ctx, id] { ctx.action = [&ctx, id] { run_dataset_build(ctx, *id); }; });
+  }
+  {
+    auto* cmd = dataset->add_subcommand("list", "List datasets, newest first");
+    cmd->callback([&ctx] { ctx.action = [&ctx] { run_dataset_list(ctx); }; });
+  }
+  {
+    auto* cmd = dataset->add_subcommand("show", "Show a dataset's points");
+    auto id = std::make_shared<std::string>();
+    cmd->add_option("dataset", *id, "Dataset id or hash prefix (>= 4 hex digits)")->required();
+    cmd->callback([&ctx, id] { ctx.action = [&ctx, id] { run_dataset_show(ctx, *id); }; });
+  }
+  {
+    auto* cmd = dataset->add_subcommand("export", "Write a dataset as CSV");
+    auto id = std::make_shared<std::string>();
+    auto out = std::make_shared<std::string>();
+    cmd->add_option("dataset", *id, "Dataset id or hash prefix")->required();
+    cmd->add_option("--out", *out, "Output file (default: stdout)");
+    cmd->callback(
+        [&ctx, id, out] { ctx.action = [&ctx, id, out] { run_dataset_export(ctx, *id, *out); }; });
+  }
+  {
+    auto* cmd = dataset->add_subcommand(
+        "import", "Import a CSV dataset (columns phi,re,F,F_uncertainty required)");
+    auto file = std::make_shared<std::string>();
+    cmd->add_option("file", *file, "CSV file")->required();
+    cmd->callback([&ctx, file] { ctx.action = [&ctx, file] { run_dataset_import(ctx, *file); }; });
+  }
+}
 
 }  // namespace cli
 }  // namespace draglab

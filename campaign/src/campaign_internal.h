@@ -16,10 +16,10 @@ namespace internal {
 /// Result of a resolution extrapolation F(d) -> F(d = infinity).
 struct Extrapolation {
   double F_inf = 0.0;
-  double order = 0.0;               ///< Convergence order p used (0: none).
+  double order = 0.0;                 ///< Convergence order p used (0: none).
   double discretisation_error = 0.0;  ///< |F_inf - F(finest)|, absolute.
-  std::string method;               ///< "richardson", "inverse_d" or "finest" (what was done).
-  std::string note;                 ///< Why a fallback was taken ("" if none).
+  std::string method;                 ///< "richardson", "inverse_d" or "finest" (what was done).
+  std::string note;                   ///< Why a fallback was taken ("" if none).
 };
 
 /// Richardson extrapolation from the three finest resolutions with the measured order: solves
@@ -49,9 +49,24 @@ std::string packing_hash(const arrays::Packing& packing);
 arrays::RandomPackingOptions packing_options(const CampaignSpec& spec, double phi,
                                              std::uint64_t seed);
 
-/// The minimum surface gap (in d) the packings of `spec` use: spec.min_gap, or 1.5 lattice units at
-/// the coarsest resolution when it is 0 (the engine needs >= 1 node across every gap).
+/// Default minimum gap in lattice units at the coarsest resolution: the engine needs >= 1 node
+/// across every gap; 20 % margin covers the voxelizer's rounding of the box to whole nodes (the
+/// realised d differs from the requested one by <= 0.5 / nodes per edge, ~2 % for 16 spheres at
+/// d = 10). A larger gap would push the padded solids fraction of dense packings towards jamming.
+constexpr double kDefaultGapNodes = 1.2;
+
+/// Largest solids fraction of the spheres padded by min_gap/2 accepted in a spec: the packing
+/// generator's "safe" limit for monodisperse spheres (arrays: they jam near 0.64). Close to it
+/// a small box can still jam (measured: phi = 0.4 with gap 0.15, padded 0.608, 16 spheres jammed
+/// in both attempts); such units fail with the generator's diagnosis. Keep padded <= ~0.58.
+constexpr double kMaxPaddedPhi = 0.62;
+
+/// The minimum surface gap (in d) the packings of `spec` use: spec.min_gap, or kDefaultGapNodes
+/// lattice units at the coarsest resolution when it is 0.
 double effective_min_gap(const CampaignSpec& spec);
+
+/// The spec stored as CampaignSpec::to_json() text.
+CampaignSpec spec_from_json(const std::string& text);
 
 /// Relative cost estimate of a unit (fluid nodes x steps, with an empirical factor for the
 /// non-linear scheme at Re > 0): used only for the order of work and the ETA.

@@ -41,7 +41,7 @@ struct CampaignSpec {
   double size_ratio = 2.0;          ///< [packing] bidisperse d_large/d_small.
   double large_fraction = 0.5;      ///< [packing] bidisperse volume share of the large spheres.
   double sigma = 0.2;               ///< [packing] lognormal sigma of ln d.
-  double min_gap = 0.0;             ///< [packing] min surface gap in d; 0 = 1.5/min(resolutions).
+  double min_gap = 0.0;             ///< [packing] min surface gap in d; 0 = 1.2/min(resolutions).
   std::vector<double> resolutions;  ///< [lbm] resolutions d (lattice units per diameter), >= 4.
   std::string collision = "trt";    ///< [lbm] trt, bgk or rr.
   std::string boundary = "ibb";     ///< [lbm] ibb or bb.
@@ -98,9 +98,13 @@ struct RunCampaignOptions {
       progress;
 };
 
-/// Creates the campaign (or, with resume, finds it) and runs its pending units. Returns the
-/// final status. Errors: Error(kInvalidArgument) for a spec that fails IsValid, a new campaign
-/// whose name exists (use resume) or a resume whose spec differs from the stored one.
+/// Creates the campaign (or, with resume, finds it; resume also creates a missing one) and runs
+/// its pending units; units left 'running' by a dead process run again. One process at a time
+/// runs a campaign: it holds an exclusive flock on "<db_path>.campaign-<id>.lock" (released by
+/// the kernel when the process dies). Returns the final status. Errors: Error(kInvalidArgument)
+/// for a spec that fails IsValid, jobs outside [0, 1024], units too large for the memory, a new
+/// campaign whose name exists (use resume) or a resume whose spec differs from the stored one;
+/// Error(kDatabase) if another live process holds the campaign's lock or the schema is < 4.
 CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
                             const RunCampaignOptions& options);
 

@@ -1,0 +1,624 @@
+// The campaign runner: creates the campaign and its unit rows, claims units one at a time with a
+// single UPDATE ... RETURNING (so no unit runs twice), runs them on `jobs` worker threads with
+// one database connection each, and commits every finished unit in its own transaction.
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "campaign_internal.h"
+#include "db/sqlite_util.h"
+#include "drag_db_version.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/database.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/lbm/lbm.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+using db::Statement;
+using db::Transaction;
+using Clock = std::chrono::steady_clock;
+
+/// ISO 8601 UTC with milliseconds: finished units are ordered and compared by it.
+std::string now_iso8601_ms() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  const long ms = static_cast<long>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000);
+  std::tm utc{};
+  gmtime_r(&t, &utc);
+  char buf[40];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &utc);
+  char out[48];
+  std::snprintf(out, sizeof out, "%s.%03ldZ", buf, ms);
+  return out;
+}
+
+std::string format_duration(double s) {
+  char buf[32];
+  if (!std::isfinite(s) || s < 0) return "?";
+  if (s < 60) {
+    std::snprintf(buf, sizeof buf, "%.0fs", s);
+  } else if (s < 3600) {
+    std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  } else {
+    std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s) / 3600,
+                  (static_cast<int>(s) % 3600) / 60);
+  }
+  return buf;
+}
+
+DatabaseOptions worker_db_options() {
+  DatabaseOptions o;
+  o.create_if_missing = false;
+  o.seed_literature = false;
+  o.busy_timeout_ms = 120000;  // units commit rarely; waiting is always better than failing
+  return o;
+}
+
+void require_campaign_tables(const Database& db) {
+  if (db.schema_version() < 4) {
+    throw Error(ErrorCode::kDatabase, "database '" + db.path() + "' has schema version " +
+                                          std::to_string(db.schema_version()) +
+                                          "; campaigns need version 4: run `draglab db migrate`");
+  }
+}
+
+/// An exclusive flock on "<db>.campaign-<id>.lock", held while a process runs the campaign. The
+/// kernel releases it when the process dies (SIGKILL included), so a stale lock never blocks a
+/// resume; the file itself stays (removing it would race with a process about to lock it).
+class CampaignLock {
+ public:
+  CampaignLock(const std::string& db_path, std::int64_t campaign_id, const std::string& name) {
+    path_ = db_path + ".campaign-" + std::to_string(campaign_id) + ".lock";
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) {
+      throw Error(ErrorCode::kDatabase, "cannot create the campaign lock file '" + path_ + "'");
+    }
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      char holder[128] = {0};
+      const ssize_t got = ::pread(fd_, holder, sizeof holder - 1, 0);
+      if (got > 0) holder[got] = 0;
+      std::string who(holder);
+      while (!who.empty() && (who.back() == '\n' || who.back() == ' ')) who.pop_back();
+      ::close(fd_);
+      throw Error(ErrorCode::kDatabase,
+                  "campaign '" + name + "' is being run by another process (" +
+                      (who.empty() ? std::string("lock file ") + path_ : who) +
+                      "); one process at a time runs a campaign: wait for it, or stop it and use "
+                      "--resume");
+    }
+    char host[256] = {0};
+    ::gethostname(host, sizeof host - 1);
+    const std::string me = "pid " + std::to_string(::getpid()) + " on " + host + "\n";
+    if (::ftruncate(fd_, 0) == 0) {
+      [[maybe_unused]] const ssize_t w = ::pwrite(fd_, me.data(), me.size(), 0);
+    }
+  }
+  ~CampaignLock() {
+    if (fd_ >= 0) ::close(fd_);  // releases the flock
+  }
+  CampaignLock(const CampaignLock&) = delete;
+  CampaignLock& operator=(const CampaignLock&) = delete;
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
+/// A unit claimed by a worker.
+struct ClaimedUnit {
+  std::int64_t id = 0;
+  double phi = 0, re_target = 0, resolution = 0;
+  std::int64_t seed = 0;
+  int realization = 0;
+};
+
+bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token,
+                ClaimedUnit* unit) {
+  Transaction tx(db.handle(), Transaction::Kind::kWrite);
+  // Units are created in order of decreasing estimated cost (longest first balances the workers).
+  Statement s(db.handle(),
+              "UPDATE campaign_units SET status = 'running', attempts = attempts + 1, "
+              "claimed_by = ?, started_at = ? WHERE id = (SELECT id FROM campaign_units WHERE "
+              "campaign_id = ? AND status = 'pending' ORDER BY id LIMIT 1) "
+              "RETURNING id, phi, re_target, resolution, seed, realization");
+  s.bind(1, token).bind(2, now_iso8601_ms()).bind(3, campaign_id);
+  bool got = false;
+  if (s.step()) {
+    unit->id = s.integer(0);
+    unit->phi = s.real(1);
+    unit->re_target = s.real(2);
+    unit->resolution = s.real(3);
+    unit->seed = s.integer(4);
+    unit->realization = static_cast<int>(s.integer(5));
+    got = true;
+    s.run();
+  }
+  tx.commit();
+  return got;
+}
+
+/// What one unit produced.
+struct UnitOutcome {
+  bool done = false;
+  lbm::RunResult run;
+  std::string diagnosis;
+  std::string packing_hash;
+  double wall_s = 0.0;
+  nlohmann::json result;
+};
+
+UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int threads,
+                         std::atomic<double>* fraction) {
+  UnitOutcome out;
+  const auto start = Clock::now();
+  try {
+    const arrays::RandomPackingOptions po =
+        internal::packing_options(spec, unit.phi, static_cast<std::uint64_t>(unit.seed));
+    arrays::GenerationSummary summary;
+    const arrays::Packing packing = arrays::generate_random_packing(po, &summary);
+    out.packing_hash = internal::packing_hash(packing);
+    lbm::RunOptions ro;
+    ro.collision = lbm::collision_from_string(spec.collision);
+    ro.boundary = lbm::boundary_from_string(spec.boundary);
+    ro.re = unit.re_target;
+    ro.tolerance = spec.tolerance;
+    ro.max_steps = spec.max_steps;
+    ro.threads = threads;
+    ro.throw_on_failure = false;  // a failed unit is a result: recorded with its diagnosis
+    out.run = lbm::run(packing, unit.resolution, ro, [fraction](double f, const std::string&) {
+      fraction->store(std::clamp(f, 0.0, 1.0));
+    });
+    out.done = out.run.converged && std::isfinite(out.run.F);
+    out.diagnosis = out.run.converged ? "" : out.run.diagnosis;
+    if (out.run.converged && !std::isfinite(out.run.F)) out.diagnosis = "non-finite drag";
+    out.result = {{"spheres", packing.size()},
+                  {"box_length", packing.box_length},
+                  {"packing_seed", unit.seed},
+                  {"packing_wall_s", summary.wall_s},
+                  {"lbm_wall_s", out.run.wall_s},
+                  {"F_standard_error", out.run.F_standard_error},
+                  {"K", out.run.K},
+                  {"phi_lattice", out.run.phi_lattice},
+                  {"d", out.run.d},
+                  {"tau", out.run.tau},
+                  {"tau_minus", out.run.tau_minus},
+                  {"nu", out.run.nu},
+                  {"body_force", out.run.body_force},
+                  {"superficial_velocity", out.run.superficial_velocity},
+                  {"momentum_balance_rel", out.run.momentum_balance_rel},
+                  {"mach_max", out.run.mach_max},
+                  {"convergence_residual", out.run.convergence_residual},
+                  {"discretisation_error", out.run.discretisation_error},
+                  {"fluid_nodes", out.run.fluid_nodes},
+                  {"stokes_mode", out.run.stokes_mode},
+                  {"warnings", out.run.warnings},
+                  {"threads", threads},
+                  {"collision", spec.collision},
+                  {"boundary", spec.boundary}};
+    // JSON has no NaN: failed runs leave these null.
+    for (auto& [key, value] : out.result.items()) {
+      if (value.is_number_float() && !std::isfinite(value.get<double>())) value = nullptr;
+    }
+  } catch (const std::exception& e) {
+    // Bad geometry for this unit (gap too small, packing not found) or an engine refusal:
+    // recorded as a failed unit, the others go on.
+    out.done = false;
+    out.diagnosis = e.what();
+    out.result = {{"exception", e.what()}};
+  }
+  out.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return out;
+}
+
+void bind_or_null(Statement& s, int index, double x) {
+  if (std::isfinite(x)) {
+    s.bind(index, x);
+  } else {
+    s.bind_null(index);
+  }
+}
+
+/// Commits a unit's outcome; false if the unit was no longer ours (another process took it over
+/// after this one was presumed dead), in which case nothing is written.
+bool commit_unit(Database& db, const ClaimedUnit& unit, const std::string& token,
+                 const UnitOutcome& o) {
+  Transaction tx(db.handle(), Transaction::Kind::kWrite);
+  Statement s(db.handle(),
+              "UPDATE campaign_units SET status = ?, finished_at = ?, F = ?, beta_d2_over_mu = ?, "
+              "re = ?, error_estimate = ?, steps = ?, wall_s = ?, mflups = ?, converged = ?, "
+              "diagnosis = ?, packing_hash = ?, code_version = ?, result_json = ? "
+              "WHERE id = ? AND status = 'running' AND claimed_by = ?");
+  s.bind(1, o.done ? "done" : "failed").bind(2, now_iso8601_ms());
+  bind_or_null(s, 3, o.done ? o.run.F : NAN);
+  bind_or_null(s, 4, o.done ? o.run.beta_d2_over_mu : NAN);
+  bind_or_null(s, 5, o.done ? o.run.re : NAN);
+  bind_or_null(s, 6, o.done ? o.run.error_estimate : NAN);
+  s.bind(7, o.run.steps).bind(8, o.wall_s);
+  bind_or_null(s, 9, o.run.mflups);
+  s.bind(10, o.done ? 1 : 0).bind(11, o.diagnosis).bind(12, o.packing_hash);
+  s.bind(13, kDragDbVersion).bind(14, o.result.dump()).bind(15, unit.id).bind(16, token);
+  s.run();
+  const bool ours = sqlite3_changes(db.handle()) == 1;
+  tx.commit();
+  return ours;
+}
+
+std::int64_t find_campaign(const Database& db, const std::string& name, std::string* spec_hash) {
+  Statement s(db.handle(), "SELECT id, spec_hash FROM campaigns WHERE name = ?");
+  s.bind(1, name);
+  if (!s.step()) return 0;
+  if (spec_hash) *spec_hash = s.text(1);
+  return s.integer(0);
+}
+
+/// One unit to create, with its cost estimate (creation order: most expensive first).
+struct PlannedUnit {
+  int phi_index, re_index, realization, resolution_index;
+  double cost;
+};
+
+std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::string& spec_json,
+                             const std::string& spec_hash) {
+  std::vector<PlannedUnit> plan;
+  for (int i = 0; i < static_cast<int>(spec.phi.size()); ++i) {
+    for (int j = 0; j < static_cast<int>(spec.re.size()); ++j) {
+      for (int r = 0; r < spec.realizations; ++r) {
+        for (int k = 0; k < static_cast<int>(spec.resolutions.size()); ++k) {
+          plan.push_back(
+              {i, j, r, k,
+               internal::unit_cost_estimate(spec, spec.phi[i], spec.re[j], spec.resolutions[k])});
+        }
+      }
+    }
+  }
+  std::stable_sort(plan.begin(), plan.end(),
+                   [](const PlannedUnit& a, const PlannedUnit& b) { return a.cost > b.cost; });
+  Transaction tx(db.handle(), Transaction::Kind::kWrite);
+  Statement c(db.handle(),
+              "INSERT INTO campaigns (name, spec_json, spec_hash, created_at, code_version) "
+              "VALUES (?, ?, ?, ?, ?)");
+  c.bind(1, spec.name).bind(2, spec_json).bind(3, spec_hash).bind(4, db::utc_now_iso8601());
+  c.bind(5, kDragDbVersion);
+  c.run();
+  const std::int64_t id = sqlite3_last_insert_rowid(db.handle());
+  Statement u(db.handle(),
+              "INSERT INTO campaign_units (campaign_id, phi_index, re_index, realization, "
+              "resolution_index, phi, re_target, resolution, seed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, "
+              "?)");
+  for (const PlannedUnit& p : plan) {
+    u.reset();
+    u.bind(1, id).bind(2, p.phi_index).bind(3, p.re_index).bind(4, p.realization);
+    u.bind(5, p.resolution_index).bind(6, spec.phi[p.phi_index]).bind(7, spec.re[p.re_index]);
+    u.bind(8, spec.resolutions[p.resolution_index]);
+    u.bind(9, static_cast<std::int64_t>(
+                  internal::packing_seed(spec.seed, p.phi_index, p.realization)));
+    u.run();
+  }
+  tx.commit();
+  return id;
+}
+
+/// Memory of the largest unit times the workers, against the machine: refused before any work.
+void check_memory(const CampaignSpec& spec, int workers) {
+  const double d = *std::max_element(spec.resolutions.begin(), spec.resolutions.end());
+  double nodes = 0.0;
+  for (double phi : spec.phi) {
+    const int n = internal::packing_options(spec, phi, 1).n;
+    nodes = std::max(nodes, std::pow(std::cbrt(n * M_PI / (6.0 * phi)) * d, 3));
+  }
+  const double bytes = nodes * 200.0 * workers;  // populations, flags, links: generous
+  const double memory =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  if (memory > 0 && bytes > 0.8 * memory) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "[lbm] resolutions: the largest unit (d = %g) needs about %.1f GiB per worker, "
+                  "%.1f GiB for %d workers: more than 80 %% of this machine's %.1f GiB; lower the "
+                  "resolution, the spheres per box, or --jobs",
+                  d, bytes / workers / 1073741824.0, bytes / 1073741824.0, workers,
+                  memory / 1073741824.0);
+    throw Error(ErrorCode::kInvalidArgument, buf);
+  }
+}
+
+}  // namespace
+
+CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
+                            const RunCampaignOptions& options) {
+  std::string error;
+  if (!spec.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, error);
+  if (options.jobs < 0 || options.jobs > 1024) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "jobs = " + std::to_string(options.jobs) + " is outside [0, 1024] (0 = all cores)");
+  }
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  const int jobs = options.jobs == 0 ? cores : options.jobs;
+  check_memory(spec, jobs);
+
+  Database db(db_path);
+  require_campaign_tables(db);
+  const std::string spec_json = spec.to_json();
+  const std::string spec_hash = internal::sha256_hex(spec_json);
+  std::string stored_hash;
+  std::int64_t id = find_campaign(db, spec.name, &stored_hash);
+  if (id != 0 && !options.resume) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "campaign '" + spec.name + "' already exists (id " + std::to_string(id) +
+                    "): use --resume to continue it, or give the spec another [campaign] name");
+  }
+  if (id != 0 && stored_hash != spec_hash) {
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        "campaign '" + spec.name + "' (id " + std::to_string(id) +
+            ") was created from a different spec (spec hash " + stored_hash.substr(0, 12) +
+            ", this one " + spec_hash.substr(0, 12) +
+            "); a campaign's spec cannot change: give the new spec another [campaign] name");
+  }
+  if (id == 0) {
+    try {
+      id = create_campaign(db, spec, spec_json, spec_hash);
+    } catch (const Error&) {
+      // Another process created it at the same moment: continue only with --resume.
+      if (find_campaign(db, spec.name, nullptr) == 0) throw;
+      throw Error(ErrorCode::kInvalidArgument,
+                  "campaign '" + spec.name + "' was just created by another process");
+    }
+  }
+  const CampaignLock lock(db_path, id, spec.name);
+
+  // Units left 'running' by a process that died (the lock proves it is gone) run again.
+  {
+    Transaction tx(db.handle(), Transaction::Kind::kWrite);
+    Statement s(db.handle(),
+                "UPDATE campaign_units SET status = 'pending', claimed_by = NULL, started_at = "
+                "NULL WHERE campaign_id = ? AND status = 'running'");
+    s.bind(1, id).run();
+    tx.commit();
+  }
+
+  // The session's work: pending units and their estimated costs (for the ETA).
+  double session_cost = 0.0;
+  std::int64_t pending = 0, finished_before = 0, total = 0;
+  {
+    Statement s(db.handle(),
+                "SELECT status, phi, re_target, resolution FROM campaign_units "
+                "WHERE campaign_id = ?");
+    s.bind(1, id);
+    while (s.step()) {
+      ++total;
+      if (s.text(0) == "pending") {
+        ++pending;
+        session_cost += internal::unit_cost_estimate(spec, s.real(1), s.real(2), s.real(3));
+      } else {
+        ++finished_before;
+      }
+    }
+  }
+  const int workers = static_cast<int>(
+      std::max<std::int64_t>(1, std::min<std::int64_t>(jobs, std::max<std::int64_t>(pending, 1))));
+  const int threads = std::max(1, cores / workers);
+
+  std::mutex mutex;  // guards the counters below, the progress callback and first_error
+  std::int64_t finished = finished_before, failed_session = 0;
+  double cost_done = 0.0;
+  std::vector<std::atomic<double>> fractions(workers);
+  std::vector<double> in_flight_cost(workers, 0.0);
+  for (auto& f : fractions) f.store(0.0);
+  std::exception_ptr first_error;
+  std::atomic<bool> stop{false};
+  const auto start = Clock::now();
+  char host[256] = {0};
+  ::gethostname(host, sizeof host - 1);
+
+  auto report = [&](const std::string& event) {
+    // Caller holds `mutex`.
+    if (!options.progress) return;
+    double partial = cost_done;
+    for (int w = 0; w < workers; ++w) partial += in_flight_cost[w] * fractions[w].load();
+    const double fraction = session_cost > 0 ? std::min(1.0, partial / session_cost) : 1.0;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    const double eta = fraction > 0.005 ? elapsed * (1.0 - fraction) / fraction : NAN;
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "campaign %s: %lld/%lld units (%lld failed this run), %.1f %% of the work, "
+                  "elapsed %s, eta %s%s",
+                  spec.name.c_str(), static_cast<long long>(finished),
+                  static_cast<long long>(total), static_cast<long long>(failed_session),
+                  100.0 * fraction, format_duration(elapsed).c_str(), format_duration(eta).c_str(),
+                  event.empty() ? "" : ("; " + event).c_str());
+    options.progress(finished, total, buf);
+  };
+
+  auto worker = [&](int w) {
+    try {
+      Database wdb(db_path, worker_db_options());
+      const std::string token =
+          std::string(host) + ":" + std::to_string(::getpid()) + ":" + std::to_string(w);
+      ClaimedUnit unit;
+      while (!stop.load() && claim_next(wdb, id, token, &unit)) {
+        {
+          std::lock_guard<std::mutex> g(mutex);
+          fractions[w].store(0.0);
+          in_flight_cost[w] =
+              internal::unit_cost_estimate(spec, unit.phi, unit.re_target, unit.resolution);
+        }
+        std::atomic<double>& fraction = fractions[w];
+        // Engine progress also refreshes the line (the callback throttles).
+        const UnitOutcome o = execute_unit(spec, unit, threads, &fraction);
+        const bool ours = commit_unit(wdb, unit, token, o);
+        std::lock_guard<std::mutex> g(mutex);
+        cost_done += in_flight_cost[w];
+        in_flight_cost[w] = 0.0;
+        if (!ours) continue;
+        ++finished;
+        if (!o.done) ++failed_session;
+        char event[512];
+        std::snprintf(event, sizeof event, "phi = %g, Re = %g, d = %g, realization %d: %s",
+                      unit.phi, unit.re_target, unit.resolution, unit.realization,
+                      o.done ? "done" : ("FAILED: " + o.diagnosis).c_str());
+        report(event);
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> g(mutex);
+      if (!first_error) first_error = std::current_exception();
+      stop.store(true);
+    }
+  };
+  {
+    std::lock_guard<std::mutex> g(mutex);
+    report("");
+  }
+  std::vector<std::thread> pool;
+  for (int w = 0; w < workers; ++w) pool.emplace_back(worker, w);
+  // The main thread refreshes the progress line while the units run (ETA of long units).
+  std::atomic<bool> all_done{false};
+  std::thread ticker([&] {
+    while (!all_done.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      if (all_done.load()) break;
+      std::lock_guard<std::mutex> g(mutex);
+      report("");
+    }
+  });
+  for (auto& t : pool) t.join();
+  all_done.store(true);
+  ticker.join();
+  if (first_error) std::rethrow_exception(first_error);
+  return campaign_status(db, std::to_string(id));
+}
+
+std::string CampaignStatus::BriefReport() const {
+  std::ostringstream s;
+  s << "campaign " << name << " (id " << id << "): " << units_done << "/" << units_total
+    << " units done, " << units_failed << " failed, " << units_pending + units_running << " to run";
+  return s.str();
+}
+
+std::string CampaignStatus::FullReport() const {
+  std::ostringstream s;
+  s << BriefReport() << "\n";
+  s << "  spec hash   " << spec_hash << "\n";
+  s << "  created at  " << created_at << "\n";
+  s << "  pending     " << units_pending << ", running " << units_running << "\n";
+  s << "  LBM time    " << format_duration(wall_s) << " (sum over finished units)\n";
+  return s.str();
+}
+
+CampaignStatus campaign_status(const Database& db, const std::string& id_or_name) {
+  require_campaign_tables(db);
+  const bool numeric =
+      !id_or_name.empty() && id_or_name.find_first_not_of("0123456789") == std::string::npos;
+  Statement s(db.handle(), numeric ? "SELECT id, name, spec_hash, created_at FROM campaigns "
+                                     "WHERE id = ?"
+                                   : "SELECT id, name, spec_hash, created_at FROM campaigns "
+                                     "WHERE name = ?");
+  if (numeric) {
+    s.bind(1, static_cast<std::int64_t>(std::stoll(id_or_name)));
+  } else {
+    s.bind(1, id_or_name);
+  }
+  if (!s.step()) {
+    throw Error(ErrorCode::kNotFound, "no campaign with " + std::string(numeric ? "id" : "name") +
+                                          " '" + id_or_name + "' (see `draglab campaign status`)");
+  }
+  CampaignStatus st;
+  st.id = s.integer(0);
+  st.name = s.text(1);
+  st.spec_hash = s.text(2);
+  st.created_at = s.text(3);
+  Statement c(db.handle(),
+              "SELECT status, count(*), coalesce(sum(wall_s), 0) FROM campaign_units WHERE "
+              "campaign_id = ? GROUP BY status");
+  c.bind(1, st.id);
+  while (c.step()) {
+    const std::string status = c.text(0);
+    const std::int64_t n = c.integer(1);
+    st.units_total += n;
+    if (status == "done") st.units_done = n;
+    if (status == "failed") st.units_failed = n;
+    if (status == "pending") st.units_pending = n;
+    if (status == "running") st.units_running = n;
+    if (status == "done" || status == "failed") st.wall_s += c.real(2);
+  }
+  return st;
+}
+
+std::vector<CampaignStatus> list_campaigns(const Database& db) {
+  require_campaign_tables(db);
+  std::vector<std::string> ids;
+  {
+    Statement s(db.handle(), "SELECT id FROM campaigns ORDER BY id");
+    while (s.step()) ids.push_back(std::to_string(s.integer(0)));
+  }
+  std::vector<CampaignStatus> out;
+  for (const auto& i : ids) out.push_back(campaign_status(db, i));
+  return out;
+}
+
+std::vector<UnitRecord> list_units(const Database& db, std::int64_t campaign_id) {
+  require_campaign_tables(db);
+  Statement s(db.handle(),
+              "SELECT id, campaign_id, phi, re_target, realization, resolution, status, F, "
+              "beta_d2_over_mu, re, error_estimate, steps, wall_s, mflups, diagnosis, "
+              "packing_hash, code_version, finished_at FROM campaign_units WHERE campaign_id = ? "
+              "ORDER BY phi_index, re_index, realization, resolution_index");
+  s.bind(1, campaign_id);
+  std::vector<UnitRecord> out;
+  auto real_or_nan = [&s](int c) {
+    return s.is_null(c) ? std::numeric_limits<double>::quiet_NaN() : s.real(c);
+  };
+  while (s.step()) {
+    UnitRecord u;
+    u.id = s.integer(0);
+    u.campaign_id = s.integer(1);
+    u.phi = s.real(2);
+    u.re_target = s.real(3);
+    u.realization = static_cast<int>(s.integer(4));
+    u.resolution = s.real(5);
+    u.status = s.text(6);
+    u.F = real_or_nan(7);
+    u.beta_d2_over_mu = real_or_nan(8);
+    u.re = real_or_nan(9);
+    u.error_estimate = real_or_nan(10);
+    u.steps = s.is_null(11) ? 0 : s.integer(11);
+    u.wall_s = s.is_null(12) ? 0.0 : s.real(12);
+    u.mflups = s.is_null(13) ? 0.0 : s.real(13);
+    u.diagnosis = s.is_null(14) ? "" : s.text(14);
+    u.packing_hash = s.is_null(15) ? "" : s.text(15);
+    u.code_version = s.is_null(16) ? "" : s.text(16);
+    u.finished_at = s.is_null(17) ? "" : s.text(17);
+    out.push_back(u);
+  }
+  return out;
+}
+
+CampaignSpec stored_spec(const Database& db, std::int64_t campaign_id) {
+  require_campaign_tables(db);
+  Statement s(db.handle(), "SELECT spec_json FROM campaigns WHERE id = ?");
+  s.bind(1, campaign_id);
+  if (!s.step()) {
+    throw Error(ErrorCode::kNotFound, "no campaign with id " + std::to_string(campaign_id));
+  }
+  return internal::spec_from_json(s.text(0));
+}
+
+}  // namespace campaign
+}  // namespace draglab

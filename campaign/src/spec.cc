@@ -1,0 +1,397 @@
+// Campaign specs: TOML parsing (toml++), validation, canonical JSON (docs/campaigns.md).
+#include <cctype>
+#include <climits>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+#include <nlohmann/json.hpp>
+
+#include "campaign_internal.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+constexpr double kMinPhi = 0.05, kMaxPhi = 0.6;
+constexpr double kMaxRe = 1000.0;
+constexpr double kMinResolution = 4.0, kMaxResolution = 512.0;
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << x;
+  return s.str();
+}
+
+bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+// The keys each section accepts, in documentation order (error messages list them).
+const std::vector<std::pair<std::string, std::vector<std::string>>>& sections() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> s = {
+      {"campaign", {"name", "description"}},
+      {"grid", {"phi", "re", "realizations", "seed"}},
+      {"packing",
+       {"spheres", "box_size", "distribution", "size_ratio", "large_fraction", "sigma", "min_gap"}},
+      {"lbm", {"resolutions", "collision", "boundary", "tolerance", "max_steps"}},
+      {"dataset", {"extrapolation"}},
+  };
+  return s;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& i : items) out += (out.empty() ? "" : ", ") + i;
+  return out;
+}
+
+bool check_list(const std::vector<double>& values, const std::string& field, double lo, double hi,
+                const std::string& what, std::string* error) {
+  if (values.empty()) return fail(error, field + " has no values (give at least one " + what + ")");
+  std::set<double> seen;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double v = values[i];
+    if (!std::isfinite(v) || v < lo || v > hi) {
+      return fail(error, field + "[" + std::to_string(i) + "] = " + fmt(v) + " is outside [" +
+                             fmt(lo) + ", " + fmt(hi) + "] (" + what + ")");
+    }
+    if (!seen.insert(v).second) {
+      return fail(error, field + " lists " + fmt(v) + " twice (each value once)");
+    }
+  }
+  return true;
+}
+
+/// Where a TOML node was defined, for messages ("quick.toml:12").
+std::string where(const std::string& origin, const toml::node& node) {
+  const auto& src = node.source();
+  if (src.begin.line == 0) return origin;
+  return origin + ":" + std::to_string(src.begin.line);
+}
+
+[[noreturn]] void bad(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+/// Reads TOML values into the spec with type checks; the ranges are IsValid's job.
+class Reader {
+ public:
+  explicit Reader(std::string origin) : origin_(std::move(origin)) {}
+
+  double number(const toml::node& n, const std::string& field) const {
+    if (auto v = n.value_exact<double>()) return *v;
+    if (auto i = n.value_exact<std::int64_t>()) return static_cast<double>(*i);
+    bad(where(origin_, n) + ": " + field + " must be a number");
+  }
+  std::int64_t integer(const toml::node& n, const std::string& field) const {
+    if (auto i = n.value_exact<std::int64_t>()) return *i;
+    bad(where(origin_, n) + ": " + field + " must be an integer");
+  }
+  std::string text(const toml::node& n, const std::string& field) const {
+    if (auto s = n.value_exact<std::string>()) return *s;
+    bad(where(origin_, n) + ": " + field + " must be a string");
+  }
+  /// A list of numbers; a single number is accepted as a list of one.
+  std::vector<double> numbers(const toml::node& n, const std::string& field) const {
+    std::vector<double> out;
+    if (const toml::array* a = n.as_array()) {
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        out.push_back(number(*a->get(i), field + "[" + std::to_string(i) + "]"));
+      }
+      return out;
+    }
+    out.push_back(number(n, field));
+    return out;
+  }
+
+ private:
+  std::string origin_;
+};
+
+}  // namespace
+
+bool CampaignSpec::IsValid(std::string* error) const {
+  if (name.empty()) return fail(error, "[campaign] name is missing or empty");
+  for (char c : name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) {
+      return fail(error, "[campaign] name '" + name +
+                             "' may contain only letters, digits, '_', '-' and '.'");
+    }
+  }
+  if (name.find_first_not_of("0123456789") == std::string::npos) {
+    return fail(error, "[campaign] name '" + name + "' must not be all digits (ids are numbers)");
+  }
+  if (!check_list(phi, "[grid] phi", kMinPhi, kMaxPhi, "solids fraction", error)) return false;
+  if (!check_list(re, "[grid] re", 0.0, kMaxRe, "target Reynolds number, 0 = Stokes flow", error)) {
+    return false;
+  }
+  if (realizations < 1 || realizations > 100) {
+    return fail(error,
+                "[grid] realizations = " + std::to_string(realizations) + " is outside [1, 100]");
+  }
+  if (seed > static_cast<std::uint64_t>(INT64_MAX)) {
+    return fail(error, "[grid] seed is outside [0, 2^63 - 1]");
+  }
+  if (box_size > 0.0) {
+    if (!std::isfinite(box_size) || box_size < 1.5 || box_size > 100.0) {
+      return fail(error, "[packing] box_size = " + fmt(box_size) +
+                             " is outside [1.5, 100] sphere diameters");
+    }
+  } else if (box_size != 0.0) {
+    return fail(error, "[packing] box_size = " + fmt(box_size) + " must be > 0 (or left out)");
+  } else if (spheres < 1 || spheres > 100000) {
+    return fail(error,
+                "[packing] spheres = " + std::to_string(spheres) + " is outside [1, 100000]");
+  }
+  if (distribution != "mono" && distribution != "bi" && distribution != "lognormal") {
+    return fail(
+        error, "[packing] distribution = '" + distribution + "' is not one of mono, bi, lognormal");
+  }
+  if (!(size_ratio > 1.0 && size_ratio <= 4.0)) {
+    return fail(error, "[packing] size_ratio = " + fmt(size_ratio) + " is outside (1, 4]");
+  }
+  if (!(large_fraction >= 0.0 && large_fraction <= 1.0)) {
+    return fail(error, "[packing] large_fraction = " + fmt(large_fraction) + " is outside [0, 1]");
+  }
+  if (!(sigma > 0.0 && sigma <= 0.5)) {
+    return fail(error, "[packing] sigma = " + fmt(sigma) + " is outside (0, 0.5]");
+  }
+  if (!(min_gap >= 0.0 && min_gap <= 0.5)) {
+    return fail(error, "[packing] min_gap = " + fmt(min_gap) +
+                           " is outside [0, 0.5] diameters (0 = 1.2 lattice units at the coarsest "
+                           "resolution)");
+  }
+  if (!check_list(resolutions, "[lbm] resolutions", kMinResolution, kMaxResolution,
+                  "lattice units per diameter", error)) {
+    return false;
+  }
+  if (collision != "trt" && collision != "bgk" && collision != "rr") {
+    return fail(error, "[lbm] collision = '" + collision + "' is not one of trt, bgk, rr");
+  }
+  if (boundary != "ibb" && boundary != "bb") {
+    return fail(error, "[lbm] boundary = '" + boundary + "' is not one of ibb, bb");
+  }
+  if (!(tolerance >= 1e-9 && tolerance <= 1e-2)) {
+    return fail(error, "[lbm] tolerance = " + fmt(tolerance) + " is outside [1e-9, 1e-2]");
+  }
+  if (max_steps < 1 || max_steps > 100000000) {
+    return fail(error,
+                "[lbm] max_steps = " + std::to_string(max_steps) + " is outside [1, 100000000]");
+  }
+  if (extrapolation != "richardson" && extrapolation != "inverse_d" && extrapolation != "finest") {
+    return fail(error, "[dataset] extrapolation = '" + extrapolation +
+                           "' is not one of richardson, inverse_d, finest");
+  }
+  if (extrapolation != "finest" && resolutions.size() < 2) {
+    return fail(error, "[dataset] extrapolation = '" + extrapolation +
+                           "' needs at least 2 [lbm] resolutions (3 for the measured order of "
+                           "richardson); with one resolution use extrapolation = \"finest\"");
+  }
+  // The padded spheres must be packable, and (default gap) every gap must span >= 1 node.
+  const double gap = internal::effective_min_gap(*this);
+  for (double p : phi) {
+    if (distribution == "mono") {
+      const double padded = p * std::pow(1.0 + gap, 3);
+      if (padded > internal::kMaxPaddedPhi) {
+        const double max_gap = std::cbrt(internal::kMaxPaddedPhi / p) - 1.0;
+        return fail(
+            error,
+            "[grid] phi = " + fmt(p) + " with a minimum gap of " + fmt(gap) +
+                " diameters pads the spheres to a solids fraction " + fmt(padded) + " above " +
+                fmt(internal::kMaxPaddedPhi) +
+                " (random packings of padded spheres jam); the gap must be <= " + fmt(max_gap) +
+                (min_gap == 0.0 ? " diameters, i.e. the coarsest [lbm] resolution >= " +
+                                      fmt(std::ceil(internal::kDefaultGapNodes / max_gap))
+                                : " diameters ([packing] min_gap)"));
+      }
+      if (box_size == 0.0) {
+        const double edge = std::cbrt(spheres * M_PI / (6.0 * p));
+        if (edge < 1.0 + gap) {
+          return fail(error, "[packing] spheres = " + std::to_string(spheres) +
+                                 " at phi = " + fmt(p) + " gives a box of " + fmt(edge) +
+                                 " diameters, below one diameter plus the gap; use more spheres");
+        }
+      }
+    }
+    arrays::RandomPackingOptions o = internal::packing_options(*this, p, 1);
+    std::string e;
+    if (!o.IsValid(&e)) return fail(error, "[packing] at phi = " + fmt(p) + ": " + e);
+  }
+  return true;
+}
+
+std::string CampaignSpec::to_json() const {
+  // nlohmann's object keys are sorted and doubles print in shortest round-trip form: the text,
+  // and so the spec hash, is canonical.
+  nlohmann::json j = {
+      {"campaign", {{"name", name}, {"description", description}}},
+      {"grid", {{"phi", phi}, {"re", re}, {"realizations", realizations}, {"seed", seed}}},
+      {"packing",
+       {{"spheres", spheres},
+        {"box_size", box_size},
+        {"distribution", distribution},
+        {"size_ratio", size_ratio},
+        {"large_fraction", large_fraction},
+        {"sigma", sigma},
+        {"min_gap", min_gap}}},
+      {"lbm",
+       {{"resolutions", resolutions},
+        {"collision", collision},
+        {"boundary", boundary},
+        {"tolerance", tolerance},
+        {"max_steps", max_steps}}},
+      {"dataset", {{"extrapolation", extrapolation}}},
+  };
+  return j.dump();
+}
+
+CampaignSpec internal::spec_from_json(const std::string& text) {
+  const nlohmann::json j = nlohmann::json::parse(text);
+  CampaignSpec s;
+  s.name = j.at("campaign").at("name").get<std::string>();
+  s.description = j.at("campaign").at("description").get<std::string>();
+  s.phi = j.at("grid").at("phi").get<std::vector<double>>();
+  s.re = j.at("grid").at("re").get<std::vector<double>>();
+  s.realizations = j.at("grid").at("realizations").get<int>();
+  s.seed = j.at("grid").at("seed").get<std::uint64_t>();
+  const auto& p = j.at("packing");
+  s.spheres = p.at("spheres").get<int>();
+  s.box_size = p.at("box_size").get<double>();
+  s.distribution = p.at("distribution").get<std::string>();
+  s.size_ratio = p.at("size_ratio").get<double>();
+  s.large_fraction = p.at("large_fraction").get<double>();
+  s.sigma = p.at("sigma").get<double>();
+  s.min_gap = p.at("min_gap").get<double>();
+  const auto& l = j.at("lbm");
+  s.resolutions = l.at("resolutions").get<std::vector<double>>();
+  s.collision = l.at("collision").get<std::string>();
+  s.boundary = l.at("boundary").get<std::string>();
+  s.tolerance = l.at("tolerance").get<double>();
+  s.max_steps = l.at("max_steps").get<std::int64_t>();
+  s.extrapolation = j.at("dataset").at("extrapolation").get<std::string>();
+  return s;
+}
+
+CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::string& origin) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, origin);
+  } catch (const toml::parse_error& e) {
+    bad(origin + ":" + std::to_string(e.source().begin.line) +
+        ": not valid TOML: " + std::string(e.description()));
+  }
+  const Reader r(origin);
+  CampaignSpec s;
+  std::set<std::string> given;  // "section.key" present in the file
+  for (const auto& [section_key, section_node] : root) {
+    const std::string section(section_key.str());
+    const std::vector<std::string>* keys = nullptr;
+    std::vector<std::string> section_names;
+    for (const auto& [name, k] : sections()) {
+      section_names.push_back("[" + name + "]");
+      if (name == section) keys = &k;
+    }
+    if (!keys) {
+      bad(where(origin, section_node) + ": unknown section or key '" + section +
+          "' at the top level; valid sections: " + join(section_names));
+    }
+    const toml::table* table = section_node.as_table();
+    if (!table) bad(where(origin, section_node) + ": '" + section + "' must be a [section]");
+    for (const auto& [key_name, node] : *table) {
+      const std::string key(key_name.str());
+      bool known = false;
+      for (const auto& k : *keys) known = known || k == key;
+      if (!known) {
+        bad(where(origin, node) + ": unknown key '" + key + "' in [" + section +
+            "]; valid keys: " + join(*keys));
+      }
+      given.insert(section + "." + key);
+      const std::string field = "[" + section + "] " + key;
+      const std::string id = section + "." + key;
+      if (id == "campaign.name") s.name = r.text(node, field);
+      if (id == "campaign.description") s.description = r.text(node, field);
+      if (id == "grid.phi") s.phi = r.numbers(node, field);
+      if (id == "grid.re") s.re = r.numbers(node, field);
+      if (id == "grid.realizations") {
+        const std::int64_t v = r.integer(node, field);
+        if (v < 1 || v > 100) bad(field + " = " + std::to_string(v) + " is outside [1, 100]");
+        s.realizations = static_cast<int>(v);
+      }
+      if (id == "grid.seed") {
+        const std::int64_t v = r.integer(node, field);
+        if (v < 0) bad(field + " = " + std::to_string(v) + " is outside [0, 2^63 - 1]");
+        s.seed = static_cast<std::uint64_t>(v);
+      }
+      if (id == "packing.spheres") {
+        const std::int64_t v = r.integer(node, field);
+        if (v < 1 || v > 100000) bad(field + " = " + std::to_string(v) + " is outside [1, 100000]");
+        s.spheres = static_cast<int>(v);
+      }
+      if (id == "packing.box_size") s.box_size = r.number(node, field);
+      if (id == "packing.distribution") s.distribution = r.text(node, field);
+      if (id == "packing.size_ratio") s.size_ratio = r.number(node, field);
+      if (id == "packing.large_fraction") s.large_fraction = r.number(node, field);
+      if (id == "packing.sigma") s.sigma = r.number(node, field);
+      if (id == "packing.min_gap") s.min_gap = r.number(node, field);
+      if (id == "lbm.resolutions") s.resolutions = r.numbers(node, field);
+      if (id == "lbm.collision") s.collision = r.text(node, field);
+      if (id == "lbm.boundary") s.boundary = r.text(node, field);
+      if (id == "lbm.tolerance") s.tolerance = r.number(node, field);
+      if (id == "lbm.max_steps") {
+        const std::int64_t v = r.integer(node, field);
+        if (v < 1 || v > 100000000) {
+          bad(field + " = " + std::to_string(v) + " is outside [1, 100000000]");
+        }
+        s.max_steps = v;
+      }
+      if (id == "dataset.extrapolation") s.extrapolation = r.text(node, field);
+    }
+  }
+  // Required keys, then contradictions a default would hide.
+  for (const char* required : {"campaign.name", "grid.phi", "grid.re", "lbm.resolutions"}) {
+    if (!given.count(required)) {
+      const std::string id(required);
+      const std::size_t dot = id.find('.');
+      bad(origin + ": [" + id.substr(0, dot) + "] " + id.substr(dot + 1) + " is required");
+    }
+  }
+  if (given.count("packing.spheres") && given.count("packing.box_size")) {
+    bad(origin + ": [packing] spheres and box_size contradict each other: give one of them");
+  }
+  if (s.distribution != "bi" &&
+      (given.count("packing.size_ratio") || given.count("packing.large_fraction"))) {
+    bad(origin + ": [packing] size_ratio and large_fraction apply only to distribution = \"bi\" " +
+        "(distribution is \"" + s.distribution + "\")");
+  }
+  if (s.distribution != "lognormal" && given.count("packing.sigma")) {
+    bad(origin +
+        ": [packing] sigma applies only to distribution = \"lognormal\" (distribution is \"" +
+        s.distribution + "\")");
+  }
+  std::string error;
+  if (!s.IsValid(&error)) bad(origin + ": " + error);
+  return s;
+}
+
+CampaignSpec parse_campaign_spec(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    throw Error(ErrorCode::kInvalidArgument, "campaign spec '" + path + "' cannot be read");
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_campaign_spec_text(text.str(), path);
+}
+
+}  // namespace campaign
+}  // namespace draglab

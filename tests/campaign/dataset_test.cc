@@ -1,0 +1,193 @@
+// Resolution extrapolation on synthetic F(d) with known limits, and build_dataset on unit rows
+// with known values (realization mean, standard error, pairing, skipped points, stable hash).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "campaign_internal.h"
+#include "campaign_test_util.h"
+#include "db/sqlite_util.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/database.h"
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+using internal::extrapolate_inverse_d;
+using internal::extrapolate_richardson;
+
+TEST(Extrapolation, RichardsonRecoversSecondOrderOnUnevenResolutions) {
+  // F(d) = F_inf (1 + c/d^2): the interpolated bounce-back's asymptotic form. The three finest
+  // resolutions (12, 16, 24: ratios 4/3 and 3/2) determine p exactly, so p and F_inf must come
+  // back to bisection precision (1e-12 in p), far below 1e-9.
+  const double F_inf = 7.25, c = -3.0;
+  std::vector<double> d = {24, 8, 16, 12}, F;  // unsorted on purpose
+  for (double x : d) F.push_back(F_inf * (1.0 + c / (x * x)));
+  const auto e = extrapolate_richardson(d, F);
+  EXPECT_EQ(e.method, "richardson");
+  EXPECT_NEAR(e.order, 2.0, 1e-9);
+  EXPECT_NEAR(e.F_inf, F_inf, 1e-9 * F_inf);
+  EXPECT_NEAR(e.discretisation_error, std::fabs(F_inf * c / (24.0 * 24.0)), 1e-9);
+  EXPECT_TRUE(e.note.empty());
+}
+
+TEST(Extrapolation, RichardsonRecoversFirstOrder) {
+  std::vector<double> d = {10, 14, 20}, F;
+  for (double x : d) F.push_back(4.0 + 6.0 / x);
+  const auto e = extrapolate_richardson(d, F);
+  EXPECT_NEAR(e.order, 1.0, 1e-9);
+  EXPECT_NEAR(e.F_inf, 4.0, 1e-9);
+}
+
+TEST(Extrapolation, InverseDIsExactForItsModelAndLeastSquaresOtherwise) {
+  std::vector<double> d = {8, 12, 16}, F;
+  for (double x : d) F.push_back(3.5 + 2.0 / x);
+  auto e = extrapolate_inverse_d(d, F);
+  EXPECT_EQ(e.method, "inverse_d");
+  EXPECT_NEAR(e.F_inf, 3.5, 1e-12);
+  EXPECT_DOUBLE_EQ(e.order, 1.0);
+  EXPECT_NEAR(e.discretisation_error, 2.0 / 16.0, 1e-12);
+  // Two points: the line through them (hand calculation: F_inf = (16*F16 - 8*F8)/8).
+  e = extrapolate_inverse_d({8, 16}, {4.0, 3.0});
+  EXPECT_NEAR(e.F_inf, (16 * 3.0 - 8 * 4.0) / 8.0, 1e-12);
+}
+
+TEST(Extrapolation, RichardsonFallsBackWithANote) {
+  // Two resolutions: inverse_d.
+  auto e = extrapolate_richardson({8, 16}, {4.0, 3.0});
+  EXPECT_EQ(e.method, "inverse_d");
+  EXPECT_NE(e.note.find("2 resolutions"), std::string::npos);
+  // Non-monotone (noise larger than the discretisation error): inverse_d, said so.
+  e = extrapolate_richardson({8, 12, 16}, {4.0, 3.0, 3.5});
+  EXPECT_EQ(e.method, "inverse_d");
+  EXPECT_NE(e.note.find("not monotone"), std::string::npos) << e.note;
+  // One resolution: the value itself.
+  e = extrapolate_inverse_d({8}, {4.0});
+  EXPECT_EQ(e.method, "finest");
+  EXPECT_DOUBLE_EQ(e.F_inf, 4.0);
+}
+
+/// A database with a campaign whose unit rows are written by hand (no LBM): F known exactly.
+class SyntheticCampaign : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    db_path_ = dir_.file("synthetic.db");
+    DatabaseOptions o;
+    o.seed_literature = false;
+    db_ = std::make_unique<Database>(db_path_, o);
+    spec_.name = "synthetic";
+    spec_.phi = {0.1, 0.2};
+    spec_.re = {0.0};
+    spec_.realizations = 2;
+    spec_.resolutions = {8, 12, 16};
+    spec_.extrapolation = "richardson";
+    db::Statement c(db_->handle(),
+                    "INSERT INTO campaigns (name, spec_json, spec_hash, created_at, code_version) "
+                    "VALUES (?, ?, 'h', 't', 'v')");
+    c.bind(1, spec_.name).bind(2, spec_.to_json()).run();
+    campaign_id_ = sqlite3_last_insert_rowid(db_->handle());
+  }
+  /// Inserts a unit and finishes it as done (F) or failed (F NaN).
+  void unit(int phi_index, int realization, int resolution_index, double F) {
+    db::Statement s(db_->handle(),
+                    "INSERT INTO campaign_units (campaign_id, phi_index, re_index, realization, "
+                    "resolution_index, phi, re_target, resolution, seed, status, F, re, "
+                    "error_estimate, wall_s, converged, diagnosis, result_json) VALUES (?, ?, 0, "
+                    "?, ?, ?, 0, ?, 1, ?, ?, 0, 0.01, 1.0, ?, ?, ?)");
+    const bool done = std::isfinite(F);
+    s.bind(1, campaign_id_).bind(2, phi_index).bind(3, realization).bind(4, resolution_index);
+    s.bind(5, spec_.phi[phi_index]).bind(6, spec_.resolutions[resolution_index]);
+    s.bind(7, done ? "done" : "failed");
+    if (done) {
+      s.bind(8, F);
+    } else {
+      s.bind_null(8);
+    }
+    s.bind(9, done ? 1 : 0).bind(10, done ? "" : "Mach number above the limit");
+    s.bind(11, "{\"F_standard_error\": 0.05}");
+    s.run();
+  }
+  campaign_test::TempDir dir_;
+  std::string db_path_;
+  std::unique_ptr<Database> db_;
+  CampaignSpec spec_;
+  std::int64_t campaign_id_ = 0;
+};
+
+TEST_F(SyntheticCampaign, MeansStandardErrorsAndRichardson) {
+  // phi index 0: realizations with F_inf 5.0 and 5.4, both with F(d) = F_inf (1 + 2/d^2).
+  const double F_inf[2] = {5.0, 5.4};
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      const double d = spec_.resolutions[k];
+      unit(0, r, k, F_inf[r] * (1.0 + 2.0 / (d * d)));
+    }
+  }
+  // phi index 1: every unit failed -> skipped, named.
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < 3; ++k) unit(1, r, k, NAN);
+  }
+  std::vector<std::string> skipped;
+  const Dataset d = build_dataset(*db_, campaign_id_, &skipped);
+  ASSERT_EQ(d.points.size(), 1u);
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NE(skipped[0].find("phi = 0.2"), std::string::npos) << skipped[0];
+  EXPECT_NE(skipped[0].find("Mach"), std::string::npos) << skipped[0];
+  const DatasetPoint& p = d.points[0];
+  EXPECT_EQ(p.extrapolation, "richardson");
+  EXPECT_NEAR(p.order, 2.0, 1e-8);
+  EXPECT_NEAR(p.F, 5.2, 1e-9);  // mean of the limits: the extrapolation is linear in F
+  EXPECT_EQ(p.realizations, 2);
+  // Standard error over 2 realizations at d = 16: |F1 - F2|/2, scaled by F_inf/F(16).
+  const double scale = 1.0 + 2.0 / 256.0;
+  const double se_finest = std::fabs(5.4 - 5.0) * scale / 2.0;
+  EXPECT_NEAR(p.F_standard_error, se_finest / scale, 1e-12);
+  EXPECT_NEAR(p.F_discretisation_error, 5.2 * 2.0 / 256.0, 1e-9);
+  EXPECT_NEAR(p.F_uncertainty, std::hypot(p.F_standard_error, p.F_discretisation_error), 1e-12);
+  EXPECT_EQ(p.F_at_resolution.size(), 3u);
+  EXPECT_DOUBLE_EQ(p.wall_s, 6.0);
+  // The same campaign built twice is the same dataset (content hash identity).
+  const Dataset again = build_dataset(*db_, campaign_id_);
+  EXPECT_EQ(again.id, d.id);
+  EXPECT_EQ(again.hash, d.hash);
+  EXPECT_EQ(dataset_hash(again.points), d.hash);
+  campaign_test::RawDb raw(db_path_);
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM datasets"), 1);
+}
+
+TEST_F(SyntheticCampaign, UnpairedRealizationsDropTheCoarseResolution) {
+  // Realization 1 failed at d = 8 only: pairing keeps d = 12, 16 for both realizations, and
+  // with 2 resolutions richardson falls back to inverse_d.
+  for (int r = 0; r < 2; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      const double d = spec_.resolutions[k];
+      unit(0, r, k, (r == 1 && k == 0) ? NAN : 4.0 + 1.0 / d);
+    }
+  }
+  const Dataset d = build_dataset(*db_, campaign_id_);
+  ASSERT_EQ(d.points.size(), 1u);
+  EXPECT_EQ(d.points[0].resolutions, (std::vector<double>{12, 16}));
+  EXPECT_EQ(d.points[0].extrapolation, "inverse_d");
+  EXPECT_NEAR(d.points[0].F, 4.0, 1e-12);
+  EXPECT_NE(d.method.find("resolution(s) left out"), std::string::npos) << d.method;
+}
+
+TEST_F(SyntheticCampaign, NoConvergedUnitIsAnError) {
+  unit(0, 0, 0, NAN);
+  try {
+    build_dataset(*db_, campaign_id_);
+    FAIL() << "expected Error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("no (phi, Re) point with a converged unit"),
+              std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace campaign
+}  // namespace draglab

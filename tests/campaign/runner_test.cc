@@ -1,0 +1,308 @@
+// The campaign runner end to end on tiny Stokes campaigns (8 spheres, d = 10, ~0.3 s a unit):
+// SIGKILL mid-run then --resume (nothing lost, nothing duplicated, finished units untouched),
+// deterministic packings, a diverging unit recorded as failed with its diagnosis, the
+// one-process lock, and bad specs that exit 2 and write nothing.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/file.h>
+
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "campaign_test_util.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/database.h"
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+using campaign_test::RawDb;
+using campaign_test::run_cli;
+using campaign_test::TempDir;
+using campaign_test::write_file;
+
+const char* kTinySpec = R"(# 8 Stokes units of ~0.3 s (tests/campaign/runner_test.cc)
+[campaign]
+name = "tiny"
+[grid]
+phi = [0.1, 0.2, 0.3, 0.4]
+re = [0]
+realizations = 2
+seed = 11
+[packing]
+spheres = 8
+[lbm]
+resolutions = [10]
+[dataset]
+extrapolation = "finest"
+)";
+
+/// Starts `draglab --db DB campaign run SPEC --jobs 1 [extra]` as a child process.
+pid_t spawn_campaign(const std::string& db, const std::string& spec) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, 1);
+    dup2(null, 2);
+    execl(DRAGLAB_CLI, DRAGLAB_CLI, "--db", db.c_str(), "campaign", "run", spec.c_str(), "--jobs",
+          "1", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Units in `status`, or -1 while the database or its tables do not exist yet.
+long long count_status(const std::string& db, const std::string& status) {
+  if (!campaign_test::exists(db)) return -1;
+  try {
+    RawDb raw(db);
+    return raw.integer("SELECT count(*) FROM campaign_units WHERE status = '" + status + "'");
+  } catch (const std::exception&) {
+    return -1;
+  }
+}
+
+TEST(CampaignRunner, SigkillThenResumeLosesNothingAndDuplicatesNothing) {
+  TempDir dir;
+  const std::string db = dir.file("kill.db"), spec = dir.file("tiny.toml");
+  write_file(spec, kTinySpec);
+  const pid_t child = spawn_campaign(db, spec);
+  ASSERT_GT(child, 0);
+  // Kill as soon as two units are committed (the others take ~2 s more).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (count_status(db, "done") < 2 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(kill(child, SIGKILL), 0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the campaign finished before it could be killed";
+
+  std::vector<std::string> before;
+  long long running_at_kill = 0;
+  {
+    RawDb raw(db);
+    EXPECT_EQ(raw.integer("SELECT count(*) FROM campaign_units"), 8);
+    const long long done = raw.integer("SELECT count(*) FROM campaign_units WHERE status='done'");
+    running_at_kill = raw.integer("SELECT count(*) FROM campaign_units WHERE status='running'");
+    EXPECT_GE(done, 2);
+    EXPECT_LE(running_at_kill, 1);  // --jobs 1: at most the unit in flight
+    ASSERT_LT(done, 8) << "nothing left to resume: make the units slower";
+    before = raw.rows(
+        "SELECT id, phi_index, realization, F, finished_at, packing_hash, steps FROM "
+        "campaign_units WHERE status = 'done' ORDER BY id");
+  }
+
+  // Without --resume the existing campaign is refused (bad input), and nothing changes.
+  std::string out, err;
+  EXPECT_EQ(run_cli({"--db", db, "campaign", "run", spec, "--jobs", "1"}, dir.path(), &out, &err),
+            2);
+  EXPECT_NE(err.find("use --resume"), std::string::npos) << err;
+
+  ASSERT_EQ(run_cli({"--db", db, "--json", "campaign", "run", spec, "--resume", "--jobs", "1"},
+                    dir.path(), &out, &err),
+            0)
+      << err;
+  const auto j = nlohmann::json::parse(out);
+  EXPECT_EQ(j["units_total"], 8);
+  EXPECT_EQ(j["units_done"], 8);
+  EXPECT_EQ(j["units_failed"], 0);
+  EXPECT_TRUE(j.contains("dataset_id"));
+  EXPECT_EQ(j["dataset_points"], 4);
+
+  RawDb raw(db);
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM campaign_units"), 8);
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM campaign_units WHERE status = 'done'"), 8);
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM (SELECT DISTINCT phi_index, re_index, realization, "
+                        "resolution_index FROM campaign_units)"),
+            8);
+  // Units finished before the kill are untouched (same F, time, packing); the one in flight ran
+  // once more (attempts 2); every other unit ran exactly once.
+  const std::vector<std::string> after = raw.rows(
+      "SELECT id, phi_index, realization, F, finished_at, packing_hash, steps FROM campaign_units "
+      "ORDER BY id");
+  std::map<std::string, std::string> by_id;
+  for (const auto& row : after) by_id[row.substr(0, row.find('|'))] = row;
+  for (const auto& row : before) EXPECT_EQ(by_id[row.substr(0, row.find('|'))], row);
+  EXPECT_EQ(raw.integer("SELECT sum(attempts) FROM campaign_units"), 8 + running_at_kill);
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM campaigns"), 1);
+
+  // Status: the documented JSON fields.
+  ASSERT_EQ(run_cli({"--db", db, "--json", "campaign", "status", "tiny"}, dir.path(), &out, &err),
+            0);
+  const auto s = nlohmann::json::parse(out);
+  EXPECT_EQ(s["units_total"], 8);
+  EXPECT_EQ(s["units_done"], 8);
+  EXPECT_EQ(s["units_failed"], 0);
+
+  // The dataset survives CSV export and import into another database unchanged (same points,
+  // so the same content hash and id), and `dataset show --json` lists its points.
+  const std::string dataset_id = j["dataset_id"].get<std::string>();
+  ASSERT_EQ(run_cli({"--db", db, "dataset", "export", dataset_id, "--out", dir.file("d.csv")},
+                    dir.path(), &out, &err),
+            0)
+      << err;
+  ASSERT_EQ(
+      run_cli({"--db", dir.file("import.db"), "--json", "dataset", "import", dir.file("d.csv")},
+              dir.path(), &out, &err),
+      0)
+      << err;
+  EXPECT_EQ(nlohmann::json::parse(out)["id"], dataset_id);
+  ASSERT_EQ(run_cli({"--db", db, "--json", "dataset", "show", dataset_id}, dir.path(), &out, &err),
+            0);
+  EXPECT_EQ(nlohmann::json::parse(out)["points"].size(), 4u);
+
+  // Deterministic seeds: the same spec in a fresh database, with 2 workers instead of 1, builds
+  // the same packings (bit-identical hashes) and the same drag up to the convergence tolerance
+  // (the thread count changes the rounding of reductions, and so possibly the stopping step;
+  // tolerance 1e-5 per characteristic time bounds the difference well below 1e-4).
+  const std::string db2 = dir.file("again.db");
+  ASSERT_EQ(run_cli({"--db", db2, "campaign", "run", spec, "--jobs", "2"}, dir.path(), &out, &err),
+            0)
+      << err;
+  RawDb raw2(db2);
+  const std::string key =
+      "SELECT phi_index || '/' || realization, packing_hash, F FROM campaign_units ORDER BY "
+      "phi_index, realization";
+  const auto a = raw.rows(key), b = raw2.rows(key);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto split = [](const std::string& r) {
+      const std::size_t p = r.rfind('|');
+      return std::make_pair(r.substr(0, p), std::stod(r.substr(p + 1)));
+    };
+    EXPECT_EQ(split(a[i]).first, split(b[i]).first);
+    EXPECT_NEAR(split(a[i]).second, split(b[i]).second, 1e-4 * split(a[i]).second);
+  }
+}
+
+TEST(CampaignRunner, DivergingUnitIsRecordedFailedAndTheOthersComplete) {
+  TempDir dir;
+  const std::string db_path = dir.file("fail.db");
+  // Re = 300 at phi = 0.3 and d = 8 exceeds the Mach limit within a few hundred steps (the
+  // engine stops it); the Stokes unit of the same packing converges.
+  CampaignSpec spec;
+  spec.name = "diverge";
+  spec.phi = {0.3};
+  spec.re = {300, 0};
+  spec.spheres = 8;
+  spec.resolutions = {8};
+  spec.extrapolation = "finest";
+  RunCampaignOptions options;
+  options.jobs = 1;
+  std::vector<std::string> lines;
+  options.progress = [&lines](std::int64_t, std::int64_t, const std::string& line) {
+    lines.push_back(line);
+  };
+  const CampaignStatus st = run_campaign(db_path, spec, options);
+  EXPECT_EQ(st.units_total, 2);
+  EXPECT_EQ(st.units_done, 1);
+  EXPECT_EQ(st.units_failed, 1);
+  EXPECT_EQ(st.units_pending + st.units_running, 0);
+  bool reported = false;
+  for (const auto& l : lines) reported = reported || l.find("FAILED: Mach") != std::string::npos;
+  EXPECT_TRUE(reported);
+
+  Database db(db_path);
+  const auto units = list_units(db, st.id);
+  ASSERT_EQ(units.size(), 2u);
+  for (const auto& u : units) {
+    if (u.re_target == 300) {
+      EXPECT_EQ(u.status, "failed");
+      EXPECT_NE(u.diagnosis.find("Mach number"), std::string::npos) << u.diagnosis;
+      EXPECT_TRUE(std::isnan(u.F));  // never a drag value from a diverged run
+    } else {
+      EXPECT_EQ(u.status, "done");
+      EXPECT_GT(u.F, 1.0);
+      EXPECT_EQ(u.packing_hash.size(), 64u);
+    }
+  }
+  // Same packing at both Re (seed from phi index and realization only).
+  EXPECT_EQ(RawDb(db_path).integer("SELECT count(DISTINCT seed) FROM campaign_units"), 1);
+  std::vector<std::string> skipped;
+  const Dataset d = build_dataset(db, st.id, &skipped);
+  EXPECT_EQ(d.points.size(), 1u);
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NE(skipped[0].find("Re = 300"), std::string::npos);
+  // Resuming a finished campaign runs nothing again (failed units stay failed: a diagnosis is
+  // a result, not a retry).
+  RunCampaignOptions again;
+  again.resume = true;
+  again.jobs = 1;
+  const CampaignStatus st2 = run_campaign(db_path, spec, again);
+  EXPECT_EQ(st2.units_done, 1);
+  EXPECT_EQ(st2.units_failed, 1);
+  EXPECT_EQ(RawDb(db_path).integer("SELECT sum(attempts) FROM campaign_units"), 2);
+}
+
+TEST(CampaignRunner, SecondProcessOnTheSameCampaignIsRefused) {
+  TempDir dir;
+  const std::string db = dir.file("lock.db"), spec = dir.file("tiny.toml");
+  write_file(spec, kTinySpec);
+  {
+    // An existing database; --resume creates the campaign (id 1) and then needs its lock.
+    std::string out, err;
+    ASSERT_EQ(run_cli({"--db", db, "db", "info"}, dir.path(), &out, &err), 0) << err;
+  }
+  const int fd = open((db + ".campaign-1.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
+  ASSERT_EQ(write(fd, "pid 1 on testhost\n", 18), 18);
+  std::string out, err;
+  EXPECT_EQ(run_cli({"--db", db, "campaign", "run", spec, "--resume"}, dir.path(), &out, &err), 1);
+  EXPECT_NE(err.find("is being run by another process (pid 1 on testhost)"), std::string::npos)
+      << err;
+  close(fd);
+  // The campaign was created but no unit ran.
+  RawDb raw(db);
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM campaign_units WHERE status != 'pending'"), 0);
+}
+
+TEST(CampaignCli, BadSpecExitsTwoAndWritesNothing) {
+  TempDir dir;
+  const std::string db = dir.file("bad.db");
+  std::string out, err;
+  ASSERT_EQ(run_cli({"--db", db, "db", "info"}, dir.path(), &out, &err), 0) << err;
+  const std::string bytes = campaign_test::read_file(db);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"phi = [0.1, 0.2, 0.3, 0.4]", "phi = [0.1, 0.9]"},
+      {"re = [0]", "re = [-1]"},
+      {"re = [0]", "re = []"},
+      {"seed = 11", "seed = 11\nspeed = 3"},
+      {"spheres = 8", "spheres = 8\nbox_size = 3.0"},
+  };
+  const std::vector<std::string> expected = {
+      "[grid] phi[1] = 0.9 is outside [0.05, 0.6]", "[grid] re[0] = -1 is outside [0, 1000]",
+      "[grid] re has no values", "unknown key 'speed' in [grid]",
+      "spheres and box_size contradict"};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    std::string spec = kTinySpec;
+    spec.replace(spec.find(cases[i].first), cases[i].first.size(), cases[i].second);
+    write_file(dir.file("bad.toml"), spec);
+    EXPECT_EQ(
+        run_cli({"--db", db, "campaign", "run", dir.file("bad.toml")}, dir.path(), &out, &err), 2)
+        << cases[i].second;
+    EXPECT_NE(err.find(expected[i]), std::string::npos) << err;
+  }
+  EXPECT_EQ(campaign_test::read_file(db), bytes);  // not a byte changed
+  EXPECT_EQ(RawDb(db).integer("SELECT count(*) FROM campaigns"), 0);
+  // A database that does not exist is not created for a bad spec.
+  EXPECT_EQ(run_cli({"--db", dir.file("new.db"), "campaign", "run", dir.file("bad.toml")},
+                    dir.path(), &out, &err),
+            2);
+  EXPECT_FALSE(campaign_test::exists(dir.file("new.db")));
+  // Unknown campaign and dataset: exit 2 (not found is bad input).
+  EXPECT_EQ(run_cli({"--db", db, "campaign", "status", "nope"}, dir.path(), &out, &err), 2);
+  EXPECT_NE(err.find("no campaign with name 'nope'"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace campaign
+}  // namespace draglab

@@ -1,0 +1,190 @@
+// Campaign spec parsing and validation: every bad-input case names the field (and the allowed
+// range or the valid keys); the presets in data/campaigns parse and are big enough for a fit.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "campaign_internal.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+const char* kValid = R"(
+[campaign]
+name = "unit-test"
+description = "a small grid"
+[grid]
+phi = [0.1, 0.3]
+re = [0, 20]
+realizations = 2
+seed = 42
+[packing]
+spheres = 16
+[lbm]
+resolutions = [10, 14, 20]
+collision = "trt"
+boundary = "ibb"
+tolerance = 1e-5
+max_steps = 50000
+[dataset]
+extrapolation = "richardson"
+)";
+
+/// The message of the Error(kInvalidArgument) that parsing `text` throws ("" if none).
+std::string parse_error(const std::string& text) {
+  try {
+    parse_campaign_spec_text(text, "spec.toml");
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument) << e.what();
+    EXPECT_TRUE(e.is_bad_input());
+    return e.what();
+  }
+  return "";
+}
+
+/// kValid with `from` replaced by `to` (the replaced text must occur).
+std::string edit(const std::string& from, const std::string& to) {
+  std::string s = kValid;
+  const std::size_t at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return s.replace(at, from.size(), to);
+}
+
+TEST(CampaignSpec, ParsesEveryField) {
+  const CampaignSpec s = parse_campaign_spec_text(kValid, "spec.toml");
+  EXPECT_EQ(s.name, "unit-test");
+  EXPECT_EQ(s.description, "a small grid");
+  EXPECT_EQ(s.phi, (std::vector<double>{0.1, 0.3}));
+  EXPECT_EQ(s.re, (std::vector<double>{0.0, 20.0}));  // integers accepted as numbers
+  EXPECT_EQ(s.realizations, 2);
+  EXPECT_EQ(s.seed, 42u);
+  EXPECT_EQ(s.spheres, 16);
+  EXPECT_EQ(s.resolutions, (std::vector<double>{10.0, 14.0, 20.0}));
+  EXPECT_EQ(s.max_steps, 50000);
+  EXPECT_DOUBLE_EQ(s.tolerance, 1e-5);
+  EXPECT_EQ(s.extrapolation, "richardson");
+  std::string error;
+  EXPECT_TRUE(s.IsValid(&error)) << error;
+  // Default gap: 1.2 lattice units at the coarsest resolution.
+  EXPECT_DOUBLE_EQ(internal::effective_min_gap(s), 0.12);
+}
+
+TEST(CampaignSpec, JsonRoundTripIsCanonical) {
+  const CampaignSpec s = parse_campaign_spec_text(kValid, "spec.toml");
+  const CampaignSpec back = internal::spec_from_json(s.to_json());
+  EXPECT_EQ(back.to_json(), s.to_json());
+  // Formatting and comments in the TOML do not change the canonical text (nor the spec hash).
+  const CampaignSpec again =
+      parse_campaign_spec_text(std::string("# comment\n") + kValid + "\n\n", "other.toml");
+  EXPECT_EQ(again.to_json(), s.to_json());
+}
+
+TEST(CampaignSpec, UnknownKeyIsNamedWithTheValidOnes) {
+  const std::string m = parse_error(edit("seed = 42", "seed = 42\nrealisations = 3"));
+  EXPECT_NE(m.find("unknown key 'realisations' in [grid]"), std::string::npos) << m;
+  EXPECT_NE(m.find("phi, re, realizations, seed"), std::string::npos) << m;
+  EXPECT_NE(m.find("spec.toml:"), std::string::npos) << m;  // with the line
+  const std::string s = parse_error(std::string(kValid) + "\n[solver]\nx = 1\n");
+  EXPECT_NE(s.find("'solver'"), std::string::npos) << s;
+  EXPECT_NE(s.find("[campaign], [grid], [packing], [lbm], [dataset]"), std::string::npos) << s;
+}
+
+TEST(CampaignSpec, PhiOutOfRangeNamesFieldAndRange) {
+  const std::string m = parse_error(edit("phi = [0.1, 0.3]", "phi = [0.1, 0.7]"));
+  EXPECT_NE(m.find("[grid] phi[1] = 0.7 is outside [0.05, 0.6]"), std::string::npos) << m;
+  EXPECT_NE(parse_error(edit("phi = [0.1, 0.3]", "phi = [0.0]")).find("[grid] phi[0]"),
+            std::string::npos);
+}
+
+TEST(CampaignSpec, NegativeReynoldsIsRefused) {
+  const std::string m = parse_error(edit("re = [0, 20]", "re = [0, -5]"));
+  EXPECT_NE(m.find("[grid] re[1] = -5 is outside [0, 1000]"), std::string::npos) << m;
+}
+
+TEST(CampaignSpec, EmptyListsAndMissingKeysAreRefused) {
+  EXPECT_NE(parse_error(edit("phi = [0.1, 0.3]", "phi = []")).find("[grid] phi has no values"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("re = [0, 20]", "re = []")).find("[grid] re has no values"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("resolutions = [10, 14, 20]", "resolutions = []"))
+                .find("[lbm] resolutions has no values"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("re = [0, 20]", "")).find("[grid] re is required"), std::string::npos);
+  EXPECT_NE(parse_error(edit("name = \"unit-test\"", "")).find("[campaign] name is required"),
+            std::string::npos);
+}
+
+TEST(CampaignSpec, ContradictionsAreRefused) {
+  const std::string both = parse_error(edit("spheres = 16", "spheres = 16\nbox_size = 4.0"));
+  EXPECT_NE(both.find("spheres and box_size contradict"), std::string::npos) << both;
+  const std::string ratio = parse_error(edit("spheres = 16", "spheres = 16\nsize_ratio = 2.0"));
+  EXPECT_NE(ratio.find("size_ratio and large_fraction apply only to distribution = \"bi\""),
+            std::string::npos)
+      << ratio;
+  const std::string one = parse_error(edit("resolutions = [10, 14, 20]", "resolutions = [10]"));
+  EXPECT_NE(one.find("extrapolation = 'richardson' needs at least 2 [lbm] resolutions"),
+            std::string::npos)
+      << one;
+  const std::string twice = parse_error(edit("re = [0, 20]", "re = [20, 20]"));
+  EXPECT_NE(twice.find("[grid] re lists 20 twice"), std::string::npos) << twice;
+}
+
+TEST(CampaignSpec, OtherRangesAndTypes) {
+  EXPECT_NE(parse_error(edit("realizations = 2", "realizations = 0"))
+                .find("[grid] realizations = 0 is outside [1, 100]"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("realizations = 2", "realizations = 2.5"))
+                .find("[grid] realizations must be an integer"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("collision = \"trt\"", "collision = \"mrt\""))
+                .find("[lbm] collision = 'mrt' is not one of trt, bgk, rr"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("resolutions = [10, 14, 20]", "resolutions = [3, 14, 20]"))
+                .find("[lbm] resolutions[0] = 3 is outside [4, 512]"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("tolerance = 1e-5", "tolerance = 0.5"))
+                .find("[lbm] tolerance = 0.5 is outside [1e-9, 1e-2]"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("phi = [0.1, 0.3]", "phi = \"dense\"")).find("must be a number"),
+            std::string::npos);
+  EXPECT_NE(parse_error("[campaign\nname = 1").find("not valid TOML"), std::string::npos);
+  EXPECT_NE(parse_error(edit("name = \"unit-test\"", "name = \"a b\"")).find("[campaign] name"),
+            std::string::npos);
+}
+
+TEST(CampaignSpec, GapThatCannotBeResolvedIsRefusedWithTheRemedy) {
+  // phi = 0.5 with the default gap 1.2/10: padded solids fraction 0.70 > 0.62; the gap may be
+  // at most (0.62/0.5)^(1/3) - 1 = 0.0743, i.e. 1.2 nodes need d >= 16.2.
+  const std::string m = parse_error(edit("phi = [0.1, 0.3]", "phi = [0.1, 0.5]"));
+  EXPECT_NE(m.find("[grid] phi = 0.5"), std::string::npos) << m;
+  EXPECT_NE(m.find("coarsest [lbm] resolution >= 17"), std::string::npos) << m;
+}
+
+TEST(CampaignSpec, PresetsParseAndAreFitWorthy) {
+  for (const char* name : {"quick", "standard", "paper"}) {
+    const std::string path = std::string(DRAGLAB_DATA_DIR) + "/campaigns/" + name + ".toml";
+    SCOPED_TRACE(path);
+    const CampaignSpec s = parse_campaign_spec(path);
+    EXPECT_EQ(s.name, name);
+    // Eq. 6's five C0/C1 coefficients need more (phi, Re) points than parameters, with Re > 0.
+    EXPECT_GE(s.phi.size() * s.re.size(), 12u);
+    bool finite_re = false;
+    for (double re : s.re) finite_re = finite_re || re > 0.0;
+    EXPECT_TRUE(finite_re);
+    EXPECT_GE(s.realizations, 2);
+  }
+}
+
+TEST(CampaignSpec, SeedsAreDeterministicAndIndependent) {
+  EXPECT_EQ(internal::packing_seed(1, 2, 3), internal::packing_seed(1, 2, 3));
+  EXPECT_NE(internal::packing_seed(1, 2, 3), internal::packing_seed(1, 3, 2));
+  EXPECT_NE(internal::packing_seed(1, 2, 3), internal::packing_seed(2, 2, 3));
+  EXPECT_LT(internal::packing_seed(~0ull, 7, 9), 1ull << 63);  // fits SQLite's INTEGER
+}
+
+}  // namespace
+}  // namespace campaign
+}  // namespace draglab
