@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "cli/progress.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
@@ -133,25 +134,10 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
   campaign::RunCampaignOptions options;
   options.jobs = c.jobs;
   options.resume = c.resume;
-  const bool tty = isatty(STDERR_FILENO) != 0;
-  auto last = std::chrono::steady_clock::now() - std::chrono::hours(1);
-  bool printed = false;
-  if (!ctx.quiet) {
-    options.progress = [&](std::int64_t finished, std::int64_t total, const std::string& line) {
-      const auto now = std::chrono::steady_clock::now();
-      const bool failure = line.find("FAILED") != std::string::npos;
-      const double since = std::chrono::duration<double>(now - last).count();
-      if (!failure && finished < total && since < (tty ? 0.2 : 10.0)) return;
-      last = now;
-      if (tty) {
-        std::fprintf(stderr, "\r\033[K%s", line.c_str());
-        if (failure) std::fputc('\n', stderr);
-      } else {
-        std::fprintf(stderr, "%s\n", line.c_str());
-      }
-      printed = true;
-    };
-  }
+  auto printer = std::make_shared<CampaignProgressPrinter>(!ctx.quiet);
+  options.progress = [printer](std::int64_t finished, std::int64_t total, const std::string& line) {
+    (*printer)(finished, total, line);
+  };
   const std::string db_path = ctx.resolved_db_path();
   ctx.info(fmt::format(
       "campaign {}: {} phi x {} Re x {} realizations x {} resolutions = {} units "
@@ -160,7 +146,7 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
       spec.phi.size() * spec.re.size() * spec.realizations * spec.resolutions.size(), db_path));
   const auto start = std::chrono::steady_clock::now();
   const campaign::CampaignStatus st = campaign::run_campaign(db_path, spec, options);
-  if (printed && tty) std::fputc('\n', stderr);
+  printer->finish();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

@@ -165,15 +165,12 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
       if (c.name == spec.name) run_options.resume = true;  // same name: continue it
     }
   }
-  ProgressLine progress(!ctx.quiet);
-  run_options.progress = [&progress](std::int64_t finished, std::int64_t total,
-                                     const std::string& line) {
-    progress.update(total > 0 ? static_cast<double>(finished) / static_cast<double>(total) : 1.0,
-                    "campaign " + line);
-  };
+  auto printer = std::make_shared<CampaignProgressPrinter>(!ctx.quiet);
+  run_options.progress = [printer](std::int64_t finished, std::int64_t total,
+                                   const std::string& line) { (*printer)(finished, total, line); };
   const auto campaign_start = Clock::now();
   const campaign::CampaignStatus status = campaign::run_campaign(db_path, spec, run_options);
-  progress.finish();
+  printer->finish();
   const double campaign_s = std::chrono::duration<double>(Clock::now() - campaign_start).count();
   ctx.info(status.BriefReport());
 
@@ -306,7 +303,43 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
   if (fit.cv_rms_rel_err >= 0) {
     out << fmt::format(", {}-fold CV {:.2f} %", fit_options.cv_folds, 100 * fit.cv_rms_rel_err);
   }
-  out << "\n  NLopt global search: "
+  out << "\n";
+  {
+    // Say plainly which coefficients these data do not pin down (95 % half-width above the
+    // value), and the strongest correlation between free parameters (the usual reason).
+    std::vector<std::string> weak;
+    const std::size_t n = fit.names.size();
+    double worst = 0.0;
+    std::string pair;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!fit.is_free[i]) continue;
+      const char* label = fit.form == "vdh2004" && i < 8 ? seed_names[i] : fit.names[i].c_str();
+      if (0.5 * (fit.ci95_high[i] - fit.ci95_low[i]) > std::abs(fit.values[i])) {
+        weak.push_back(label);
+      }
+      for (std::size_t j = i + 1; j < n; ++j) {
+        if (!fit.is_free[j]) continue;
+        const double cii = fit.covariance[i * n + i], cjj = fit.covariance[j * n + j];
+        if (!(cii > 0.0 && cjj > 0.0)) continue;
+        const double r = fit.covariance[i * n + j] / std::sqrt(cii * cjj);
+        if (std::abs(r) > std::abs(worst)) {
+          worst = r;
+          pair = std::string(label) + " and " +
+                 (fit.form == "vdh2004" && j < 8 ? seed_names[j] : fit.names[j].c_str());
+        }
+      }
+    }
+    if (!weak.empty()) {
+      std::string list;
+      for (const std::string& w : weak) list += (list.empty() ? "" : ", ") + w;
+      out << "  Not determined by these data (95 % interval wider than the value): " << list
+          << fmt::format(
+                 ";\n  strongest correlation {:.3f} ({}). Fix some (draglab fit --free) or add "
+                 "data over a wider phi and Re range (--preset standard).\n",
+                 worst, pair);
+    }
+  }
+  out << "  NLopt global search: "
       << (fit.global_checked ? (fit.global_agrees ? "agrees" : "found a different optimum")
                              : "not run")
       << "; constraints F > 0, dF/dRe >= 0: "

@@ -106,8 +106,9 @@ double force_for_velocity(double u, double nu, double d, double phi, double re) 
   return 18.0 * nu * u * f * phi / ((1.0 - phi) * d * d);
 }
 
+/// One run. `velocity_scale` (<= 1) scales the Mach budget of the velocity (see run_checked).
 RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
-                   Fields* fields, const ProgressCallback& progress) {
+                   Fields* fields, const ProgressCallback& progress, double velocity_scale) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   auto seconds_since = [](Clock::time_point t) {
@@ -142,8 +143,8 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   // Relaxation times and the velocity scale.
   // Re = 0 asks for creeping flow: a small velocity also with the full equilibrium (so that its
   // u.u terms are negligible, not merely its Re undefined).
-  const double budget_u =
-      (target_re == 0.0 ? kStokesMaxSpeed : kBudgetMaxSpeed) * (1.0 - phi) / kPoreSpeedFactor;
+  const double budget_u = velocity_scale * (target_re == 0.0 ? kStokesMaxSpeed : kBudgetMaxSpeed) *
+                          (1.0 - phi) / kPoreSpeedFactor;
   const double stokes_tau = options.collision == Collision::kTrt ? 1.5 : 1.0;
   double tau = options.tau;
   if (tau == 0.0) {
@@ -474,17 +475,62 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   return result;
 }
 
+/// run_impl with one remedy applied automatically: a finite-Re run whose relaxation time the
+/// engine chose (tau == 0) and that stops at the Mach limit is repeated with half the velocity
+/// (hence a smaller tau at the same Re), at most twice. The velocity budget assumes pore speeds
+/// of about 2.5 U/(1 - phi); narrow throats of dense random packings exceed that (phi = 0.4,
+/// d = 10: Mach 0.32 in the start-up). The retries are reported in the warnings, and their time
+/// is included in wall_s; any other failure, or a Mach stop with a user-given tau, is returned
+/// (or thrown) as it is.
+RunResult run_checked(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
+                      Fields* fields, const ProgressCallback& progress) {
+  RunOptions attempt_options = options;
+  attempt_options.throw_on_failure = false;
+  const bool may_retry = options.tau == 0.0 && options.re > 0.0;
+  double scale = 1.0, earlier_wall_s = 0.0;
+  std::vector<std::string> notes;
+  RunResult previous;
+  auto finish = [&](RunResult r) {
+    r.wall_s += earlier_wall_s;
+    r.warnings.insert(r.warnings.begin(), notes.begin(), notes.end());
+    if (!r.converged && options.throw_on_failure) {
+      throw Error(ErrorCode::kOutOfValidity, "lbm run: " + r.diagnosis);
+    }
+    return r;
+  };
+  for (int attempt = 0;; ++attempt) {
+    RunResult r = run_impl(grid, phi_exact, attempt_options, fields, progress, scale);
+    if (attempt > 0 && !r.converged && r.steps == 0) {
+      // The slower run is refused up front (tau too close to 1/2): the Mach stop stands.
+      notes.pop_back();
+      earlier_wall_s -= previous.wall_s;
+      return finish(previous);
+    }
+    const bool mach_stop = !r.converged && r.diagnosis.rfind("Mach number", 0) == 0;
+    if (mach_stop && may_retry && attempt < 2) {
+      notes.push_back("attempt " + std::to_string(attempt + 1) + " (tau = " + fmt("%.4g", r.tau) +
+                      ") stopped at the Mach limit after " + std::to_string(r.steps) +
+                      " steps; repeated with half the velocity");
+      earlier_wall_s += r.wall_s;
+      scale *= 0.5;
+      previous = r;
+      continue;
+    }
+    return finish(r);
+  }
+}
+
 }  // namespace
 
 RunResult run(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
               const ProgressCallback& progress) {
-  return run_impl(grid, phi_exact, options, nullptr, progress);
+  return run_checked(grid, phi_exact, options, nullptr, progress);
 }
 
 RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
                           const RunOptions& options, Fields* fields,
                           const ProgressCallback& progress) {
-  return run_impl(grid, phi_exact, options, fields, progress);
+  return run_checked(grid, phi_exact, options, fields, progress);
 }
 
 RunResult run(const arrays::Packing& packing, double resolution, const RunOptions& options,
@@ -518,7 +564,7 @@ RunResult run(const arrays::Packing& packing, double resolution, const RunOption
   arrays::VoxelizationOptions vox;
   vox.resolution = resolution;
   const arrays::VoxelGrid grid = arrays::voxelize(packing, vox);
-  return run_impl(grid, packing.phi(), options, nullptr, progress);
+  return run_checked(grid, packing.phi(), options, nullptr, progress);
 }
 
 }  // namespace lbm
