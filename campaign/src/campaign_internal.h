@@ -39,8 +39,6 @@ Extrapolation extrapolate_inverse_d(const std::vector<double>& d, const std::vec
 /// Re and resolution of a realization sees the same geometry.
 std::uint64_t packing_seed(std::uint64_t spec_seed, int phi_index, int realization);
 
-/// SHA-256 (hex) of `text` (OpenSSL).
-std::string sha256_hex(const std::string& text);
 
 /// SHA-256 of the packing's box, centres and diameters written as %.17g.
 std::string packing_hash(const arrays::Packing& packing);

@@ -1,5 +1,4 @@
 // Resolution extrapolation, deterministic seeds, content hashes and the unit cost model.
-#include <openssl/evp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +6,7 @@
 #include <numeric>
 
 #include "campaign_internal.h"
+#include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -113,21 +113,6 @@ std::uint64_t packing_seed(std::uint64_t spec_seed, int phi_index, int realizati
   return z & 0x7FFFFFFFFFFFFFFFull;
 }
 
-std::string sha256_hex(const std::string& text) {
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  if (EVP_Digest(text.data(), text.size(), digest, &length, EVP_sha256(), nullptr) != 1) {
-    throw Error(ErrorCode::kInternal, "SHA-256 failed (OpenSSL)");
-  }
-  static const char* hex = "0123456789abcdef";
-  std::string out;
-  for (unsigned int i = 0; i < length; ++i) {
-    out += hex[digest[i] >> 4];
-    out += hex[digest[i] & 15];
-  }
-  return out;
-}
-
 std::string packing_hash(const arrays::Packing& packing) {
   std::string text;
   char buf[64];
@@ -142,7 +127,7 @@ std::string packing_hash(const arrays::Packing& packing) {
     add(2.0 * packing.radii[i]);
     text += '\n';
   }
-  return sha256_hex(text);
+  return draglab::sha256_hex(text);
 }
 
 double effective_min_gap(const CampaignSpec& spec) {

@@ -356,7 +356,7 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
   Database db(db_path);
   require_campaign_tables(db);
   const std::string spec_json = spec.to_json();
-  const std::string spec_hash = internal::sha256_hex(spec_json);
+  const std::string spec_hash = draglab::sha256_hex(spec_json);
   std::string stored_hash;
   std::int64_t id = find_campaign(db, spec.name, &stored_hash);
   if (id != 0 && !options.resume) {

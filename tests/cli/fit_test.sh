@@ -9,24 +9,10 @@
 # provenance, `law publish` freezes it, and bad input exits 2 writing nothing.
 set -u
 draglab="$1"
-py=/usr/bin/python3
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 db="$work/fit.db"
-failures=0; passed=0
-check() {  # check NAME EXPECTED_EXIT CMD...
-  local name="$1" expected="$2"; shift 2
-  "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  if [ "$rc" -ne "$expected" ]; then
-    echo "FAIL $name: exit $rc, expected $expected"; sed 's/^/  stderr: /' "$work/err" | head -8
-    failures=$((failures + 1))
-  else passed=$((passed + 1)); fi
-}
-pycheck() {  # pycheck NAME PYTHON_SOURCE; argv[1] = $work
-  if "$py" -c "$2" "$work"; then passed=$((passed + 1)); else
-    echo "FAIL $1"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/harness.sh"
 
 "$py" - "$work/eq6.csv" <<'PY'
 import math, sys
@@ -103,5 +89,4 @@ after="$(md5sum "$db" | cut -d" " -f1)"
 if [ "$before" = "$after" ]; then passed=$((passed + 1)); else
   echo "FAIL bad input changed the database"; failures=$((failures + 1)); fi
 
-echo "fit_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish fit_test

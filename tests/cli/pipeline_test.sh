@@ -8,24 +8,10 @@
 # and writes nothing.
 set -u
 draglab="$1"
-py=/usr/bin/python3
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 db="$work/p.db"
-failures=0; passed=0
-check() {  # check NAME EXPECTED_EXIT CMD...
-  local name="$1" expected="$2"; shift 2
-  "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  if [ "$rc" -ne "$expected" ]; then
-    echo "FAIL $name: exit $rc, expected $expected"; sed 's/^/  stderr: /' "$work/err" | tail -8
-    failures=$((failures + 1))
-  else passed=$((passed + 1)); fi
-}
-pycheck() {  # pycheck NAME PYTHON_SOURCE; argv[1] = $work
-  if "$py" -c "$2" "$work"; then passed=$((passed + 1)); else
-    echo "FAIL $1"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/harness.sh"
 cat > "$work/tiny.toml" <<'TOML'
 [campaign]
 name = "tiny"
@@ -109,5 +95,4 @@ after="$(md5sum "$db" | cut -d" " -f1)"
 if [ "$before" = "$after" ]; then passed=$((passed + 1)); else
   echo "FAIL bad input changed the database"; failures=$((failures + 1)); fi
 
-echo "pipeline_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish pipeline_test

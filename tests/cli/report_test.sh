@@ -8,32 +8,10 @@
 # not from a law, so every law differs from them.
 set -u
 draglab="$1"
-py=/usr/bin/python3
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 export DRAGLAB_DB="$work/default.db"
-failures=0; passed=0
-
-check() {  # check NAME EXPECTED_EXIT CMD...
-  local name="$1" expected="$2"; shift 2
-  "$@" >"$work/out" 2>"$work/err"
-  local rc=$?
-  if [ "$rc" -ne "$expected" ]; then
-    echo "FAIL $name: exit $rc, expected $expected"; sed 's/^/  stderr: /' "$work/err" | head -8
-    failures=$((failures + 1))
-  else
-    passed=$((passed + 1))
-  fi
-}
-ok() {  # ok NAME COMMAND...: passes if the command succeeds
-  local name="$1"; shift
-  if "$@"; then passed=$((passed + 1)); else echo "FAIL $name"; failures=$((failures + 1)); fi
-}
-pycheck() {  # pycheck NAME PYTHON_SOURCE (exit 0 = pass); $work is argv[1]
-  local name="$1"
-  if "$py" -c "$2" "$work"; then passed=$((passed + 1)); else
-    echo "FAIL $name"; failures=$((failures + 1)); fi
-}
+. "$(dirname "$0")/harness.sh"
 
 # Synthetic dataset: 4 phi x 3 Re (Re = 0 included), 2 % uncertainty.
 "$py" - "$work/data.csv" <<'EOF'
@@ -150,5 +128,4 @@ ok "message names phi" grep -q "phi" "$work/err"
 ok "nothing written (bad CSV)" test ! -e "$work/bad7"
 ok "database untouched by bad input" test "$(md5sum < "$work/t.db")" = "$db_sum_before"
 
-echo "report_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish report_test
