@@ -8,6 +8,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "draglab/drag_db/error.h"
@@ -119,6 +121,8 @@ TEST(Fit, IntervalsCoverTheTruthAtAbout95Percent) {
   ASSERT_EQ(free_index.size(), 5u);
   for (int k : free_index) {
     const double rate = static_cast<double>(covered[k]) / draws;
+    std::printf("coverage of the 95 %% interval, parameter %zu: %.3f over %d draws\n",
+                static_cast<std::size_t>(k), rate, static_cast<int>(draws));
     EXPECT_GE(rate, 0.904) << "parameter " << k;
     EXPECT_LE(rate, 0.996) << "parameter " << k;
   }
@@ -179,6 +183,8 @@ TEST(Fit, CovarianceAgreesWithBootstrap) {
       continue;
     }
     const double expected = sd(r, static_cast<int>(k)) * factor;
+    std::printf("bootstrap / covariance stddev, %s: %.3f\n", r.names[k].c_str(),
+                r.bootstrap_stddev[k] / expected);
     EXPECT_NEAR(r.bootstrap_stddev[k] / expected, 1.0, 0.25) << r.names[k];
   }
 }
