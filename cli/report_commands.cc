@@ -212,7 +212,7 @@ nlohmann::json law_json(const ReportLaw& rl, const Dataset& ds, LawStats* stats_
         nlohmann::json::parse(r.provenance.fitter_settings, nullptr, /*allow_exceptions=*/false);
     if (settings.is_object()) {
       nlohmann::json fitter = nlohmann::json::object();
-      for (const char* key : {"free_parameters", "statistics"}) {
+      for (const char* key : {"free_parameters", "statistics", "ci95"}) {
         if (settings.contains(key)) fitter[key] = settings[key];
       }
       if (!fitter.empty()) j["fitter"] = fitter;
@@ -228,6 +228,17 @@ nlohmann::json law_json(const ReportLaw& rl, const Dataset& ds, LawStats* stats_
       ci.push_back({r.parameters[i].value - half, r.parameters[i].value + half});
     }
     j["ci95"] = ci;
+    j["ci95_method"] = "normal";
+    // Prefer the fitter's own (Student t) intervals where its record has them.
+    if (j.contains("fitter") && j["fitter"].contains("ci95") && j["fitter"]["ci95"].is_object()) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto& fitted = j["fitter"]["ci95"];
+        if (fitted.contains(r.parameters[i].name)) {
+          j["ci95"][i] = fitted[r.parameters[i].name];
+          j["ci95_method"] = "student_t";
+        }
+      }
+    }
   }
 
   // Curves for the seed figure: per phi of the data, Re on a log grid over the data's Re > 0.

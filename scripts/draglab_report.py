@@ -343,9 +343,15 @@ def write_markdown(bundle, out_dir, drawn, work_note):
                           fmt(stats.get("chi2_per_dof")), fmt(stats.get("rms_rel_err")),
                           fmt(stats.get("max_rel_err")), fmt(stats.get("cv_rms_rel_err"))))
             md.append("")
-        md.append("95 % intervals: value +- 1.96 sqrt(covariance diagonal) (normal quantile); "
-                  "'fixed' = not fitted, '-' = no covariance stored." if law.get("ci95") else
-                  "No covariance stored with this version: no intervals.")
+        if not law.get("ci95"):
+            md.append("No covariance stored with this version: no intervals.")
+        elif law.get("ci95_method") == "student_t":
+            md.append("95 % intervals: the fitter's own (Student t with the fit's degrees of "
+                      "freedom, covariance scaled by chi^2/dof when above 1); 'fixed' = not "
+                      "fitted.")
+        else:
+            md.append("95 % intervals: value +- 1.96 sqrt(covariance diagonal) (normal "
+                      "quantile); 'fixed' = not fitted, '-' = no covariance stored.")
         md.append("")
     md += ["## Laws against the data", "",
            "Relative difference |F_law/F_data - 1| over the %d data points." % len(points), "",

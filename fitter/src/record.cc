@@ -96,6 +96,13 @@ LawRecord fitted_record(const FitResult& result, const FitOptions& options, cons
     if (result.is_free[k]) free.push_back(result.names[k]);
   }
   settings["free_parameters"] = free;
+  // The fit's own 95 % intervals (Student t with the fit's dof), so that reports show exactly
+  // what the fitter reported rather than re-deriving them from the covariance.
+  nlohmann::json ci95 = nlohmann::json::object();
+  for (std::size_t k = 0; k < result.names.size(); ++k) {
+    if (result.is_free[k]) ci95[result.names[k]] = {result.ci95_low[k], result.ci95_high[k]};
+  }
+  settings["ci95"] = ci95;
   settings["statistics"] = {{"num_points", result.num_points},
                             {"dof", result.dof},
                             {"chi2", result.chi2},
