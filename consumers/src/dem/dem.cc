@@ -1,0 +1,802 @@
+// Soft-sphere DEM: contact forces, velocity-Verlet integration, linked cells, settling helper.
+#include "draglab/consumers/dem.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <sstream>
+
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Slots of tangential history per particle: 12 touching equal spheres + 3 walls + margin.
+constexpr int kMaxContacts = 20;
+
+std::string Num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
+[[noreturn]] void Fail(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+bool Finite(const std::array<double, 3>& a) {
+  return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
+}
+
+// Damping factor c(e) with eta_n = c(e) sqrt(k_n m_eff): the closed form that makes the
+// linear spring-dashpot rebound with exactly e, c = 2 |ln e| / sqrt(pi^2 + ln^2 e).
+double DampingFactor(double e) {
+  const double l = std::log(e);
+  return 2.0 * std::fabs(l) / std::sqrt(kPi * kPi + l * l);
+}
+
+// Contact time pi / sqrt(k/m - gamma^2), gamma = eta / (2 m).
+double ContactTime(double k, double m_eff, double e) {
+  const double eta = DampingFactor(e) * std::sqrt(k * m_eff);
+  const double gamma = eta / (2.0 * m_eff);
+  return kPi / std::sqrt(k / m_eff - gamma * gamma);
+}
+
+}  // namespace
+
+// ---- Particles ---------------------------------------------------------------------------------
+
+void Particles::add(double px, double py, double pz, double d, double rho, double pvx, double pvy,
+                    double pvz) {
+  id.push_back(static_cast<std::int64_t>(x.size()));
+  x.push_back(px);
+  y.push_back(py);
+  z.push_back(pz);
+  vx.push_back(pvx);
+  vy.push_back(pvy);
+  vz.push_back(pvz);
+  wx.push_back(0.0);
+  wy.push_back(0.0);
+  wz.push_back(0.0);
+  fx_ext.push_back(0.0);
+  fy_ext.push_back(0.0);
+  fz_ext.push_back(0.0);
+  diameter.push_back(d);
+  density.push_back(rho);
+}
+
+double Particles::volume(std::size_t i) const {
+  return kPi / 6.0 * diameter[i] * diameter[i] * diameter[i];
+}
+double Particles::mass(std::size_t i) const { return density[i] * volume(i); }
+double Particles::moment_of_inertia(std::size_t i) const {
+  return 0.1 * mass(i) * diameter[i] * diameter[i];
+}
+
+bool Particles::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error != nullptr) *error = m;
+    return false;
+  };
+  const std::size_t n = x.size();
+  for (const auto* v :
+       {&y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx_ext, &fy_ext, &fz_ext, &diameter, &density}) {
+    if (v->size() != n)
+      return fail("Particles: all arrays must have the same size (" + std::to_string(n) +
+                  " positions)");
+  }
+  if (id.size() != n) return fail("Particles.id: size must equal the number of particles");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(diameter[i] > 0.0) || !std::isfinite(diameter[i])) {
+      return fail("Particles.diameter[" + std::to_string(i) + "] = " + Num(diameter[i]) +
+                  " m: must be finite and > 0");
+    }
+    if (!(density[i] > 0.0) || !std::isfinite(density[i])) {
+      return fail("Particles.density[" + std::to_string(i) + "] = " + Num(density[i]) +
+                  " kg/m^3: must be finite and > 0");
+    }
+    if (!std::isfinite(x[i]) || !std::isfinite(y[i]) || !std::isfinite(z[i]) ||
+        !std::isfinite(vx[i]) || !std::isfinite(vy[i]) || !std::isfinite(vz[i])) {
+      return fail("Particles: position/velocity of particle " + std::to_string(i) +
+                  " is not finite");
+    }
+  }
+  return true;
+}
+
+// ---- Options -----------------------------------------------------------------------------------
+
+bool DemOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error != nullptr) *error = "DemOptions." + m;
+    return false;
+  };
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(box_min[a]) || !std::isfinite(box_max[a]) || !(box_max[a] > box_min[a])) {
+      return fail("box_max[" + std::to_string(a) + "] = " + Num(box_max[a]) +
+                  " m must be finite and > box_min[" + std::to_string(a) +
+                  "] = " + Num(box_min[a]) + " m");
+    }
+  }
+  if (!Finite(gravity)) return fail("gravity: must be finite");
+  if (!(normal_stiffness > 0.0) || !std::isfinite(normal_stiffness)) {
+    return fail("normal_stiffness = " + Num(normal_stiffness) + " N/m: must be > 0");
+  }
+  if (!(restitution > 0.0 && restitution <= 1.0)) {
+    return fail("restitution = " + Num(restitution) + ": must be in (0, 1]");
+  }
+  if (!(wall_restitution > 0.0 && wall_restitution <= 1.0)) {
+    return fail("wall_restitution = " + Num(wall_restitution) + ": must be in (0, 1]");
+  }
+  if (!(friction >= 0.0) || !std::isfinite(friction)) {
+    return fail("friction = " + Num(friction) + ": must be finite and >= 0");
+  }
+  if (!(wall_friction >= 0.0) || !std::isfinite(wall_friction)) {
+    return fail("wall_friction = " + Num(wall_friction) + ": must be finite and >= 0");
+  }
+  if (!(tangential_stiffness_ratio > 0.0 && tangential_stiffness_ratio <= 1.0)) {
+    return fail("tangential_stiffness_ratio = " + Num(tangential_stiffness_ratio) +
+                ": must be in (0, 1]");
+  }
+  if (!(tangential_damping_ratio >= 0.0 && tangential_damping_ratio <= 1.0)) {
+    return fail("tangential_damping_ratio = " + Num(tangential_damping_ratio) +
+                ": must be in [0, 1]");
+  }
+  if (!(dt >= 0.0) || !std::isfinite(dt)) {
+    return fail("dt = " + Num(dt) + " s: must be 0 (automatic) or > 0");
+  }
+  if (!(min_steps_per_contact >= 4.0 && min_steps_per_contact <= 1e4)) {
+    return fail("min_steps_per_contact = " + Num(min_steps_per_contact) +
+                ": must be in [4, 10000]");
+  }
+  if (!(max_overlap_fraction > 0.0 && max_overlap_fraction <= 0.5)) {
+    return fail("max_overlap_fraction = " + Num(max_overlap_fraction) + ": must be in (0, 0.5]");
+  }
+  return true;
+}
+
+// ---- DemSystem ---------------------------------------------------------------------------------
+
+DemSystem::DemSystem(const DemOptions& options, Particles particles)
+    : options_(options), p_(std::move(particles)) {
+  std::string error;
+  if (!options_.IsValid(&error)) Fail(error);
+  if (p_.id.empty() && !p_.x.empty()) {
+    p_.id.resize(p_.x.size());
+    std::iota(p_.id.begin(), p_.id.end(), std::int64_t{0});
+  }
+  if (!p_.IsValid(&error)) Fail(error);
+  const std::size_t n = p_.size();
+  if (n == 0) Fail("Particles: at least one particle is needed");
+  d_max_ = *std::max_element(p_.diameter.begin(), p_.diameter.end());
+  d_min_ = *std::min_element(p_.diameter.begin(), p_.diameter.end());
+  double m_min = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) m_min = std::min(m_min, p_.mass(i));
+  // The lightest pair (m_eff = m/2) and the lightest particle on a wall (m_eff = m) bound t_c.
+  contact_time_ =
+      std::min(ContactTime(options_.normal_stiffness, 0.5 * m_min, options_.restitution),
+               ContactTime(options_.normal_stiffness, m_min, options_.wall_restitution));
+  if (options_.dt > 0.0) {
+    if (options_.dt > max_time_step() * (1.0 + 1e-12)) {
+      Fail("DemOptions.dt = " + Num(options_.dt) + " s is above the stability limit t_c / " +
+           Num(options_.min_steps_per_contact) + " = " + Num(max_time_step()) +
+           " s (contact time t_c = " + Num(contact_time_) + " s for normal_stiffness " +
+           Num(options_.normal_stiffness) + " N/m and the lightest particle); remedy: dt <= " +
+           Num(max_time_step()) + " s, dt = 0 (automatic), or a softer normal_stiffness");
+    }
+    dt_ = options_.dt;
+  } else {
+    dt_ = max_time_step();
+  }
+  // Linked cells: edge >= largest diameter, so contacts are within the 27 neighbouring cells.
+  for (int a = 0; a < 3; ++a) {
+    const double length = options_.box_max[a] - options_.box_min[a];
+    ncell_[a] = std::max(1, static_cast<int>(std::floor(length / d_max_)));
+    if (options_.periodic[a] && ncell_[a] < 3) {
+      Fail("DemOptions.box_max[" + std::to_string(a) + "]: a periodic axis must be at least 3 " +
+           "largest diameters long (" + Num(3 * d_max_) + " m), got " + Num(length) + " m");
+    }
+    if (!options_.periodic[a] && length < d_max_) {
+      Fail("DemOptions.box_max[" + std::to_string(a) + "]: the box (" + Num(length) +
+           " m) is narrower than the largest particle (" + Num(d_max_) + " m)");
+    }
+    cell_size_[a] = length / ncell_[a];
+  }
+  reset_contacts();
+}
+
+void DemSystem::reset_contacts() {
+  const std::size_t n = p_.size();
+  mass_.resize(n);
+  inv_mass_.resize(n);
+  inv_inertia_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    mass_[i] = p_.mass(i);
+    inv_mass_[i] = 1.0 / mass_[i];
+    inv_inertia_[i] = 1.0 / p_.moment_of_inertia(i);
+  }
+  for (auto* v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_, &elastic_}) v->assign(n, 0.0);
+  for (int b = 0; b < 2; ++b) {
+    hist_count_[b].assign(n, 0);
+    hist_partner_[b].assign(n * kMaxContacts, 0);
+    hist_xi_[b].assign(n * kMaxContacts * 3, 0.0);
+  }
+  build_cells();
+  compute_forces(0.0);
+  check_state(0.0);
+}
+
+void DemSystem::build_cells() {
+  const int n = static_cast<int>(p_.size());
+  const int ncells = ncell_[0] * ncell_[1] * ncell_[2];
+  cell_of_.resize(n);
+  cell_start_.assign(ncells + 1, 0);
+  cell_particles_.resize(n);
+  const double* pos[3] = {p_.x.data(), p_.y.data(), p_.z.data()};
+  for (int i = 0; i < n; ++i) {
+    int c[3];
+    for (int a = 0; a < 3; ++a) {
+      const int k = static_cast<int>(std::floor((pos[a][i] - options_.box_min[a]) / cell_size_[a]));
+      c[a] = std::min(std::max(k, 0), ncell_[a] - 1);  // particles touching a wall: edge cell
+    }
+    cell_of_[i] = (c[2] * ncell_[1] + c[1]) * ncell_[0] + c[0];
+    ++cell_start_[cell_of_[i] + 1];
+  }
+  for (int c = 0; c < ncells; ++c) cell_start_[c + 1] += cell_start_[c];
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (int i = 0; i < n; ++i) cell_particles_[fill[cell_of_[i]]++] = i;
+}
+
+// Contact forces, torques and elastic energy of every particle at the current positions. The
+// relative velocities are the current (half-step) velocities; the tangential spring grows by
+// g_t dt. Each particle computes all its own contacts and writes only its own slots.
+void DemSystem::compute_forces(double dt) {
+  const int n = static_cast<int>(p_.size());
+  const int prev = hist_cur_, next = 1 - hist_cur_;
+  const double kn = options_.normal_stiffness;
+  const double kt = kn * options_.tangential_stiffness_ratio;
+  const double ce = DampingFactor(options_.restitution);
+  const double ce_wall = DampingFactor(options_.wall_restitution);
+  const double mu = options_.friction, mu_wall = options_.wall_friction;
+  const double eta_t_ratio = options_.tangential_damping_ratio;
+  const double* X = p_.x.data();
+  const double* Y = p_.y.data();
+  const double* Z = p_.z.data();
+  const double* VX = p_.vx.data();
+  const double* VY = p_.vy.data();
+  const double* VZ = p_.vz.data();
+  const double* WX = p_.wx.data();
+  const double* WY = p_.wy.data();
+  const double* WZ = p_.wz.data();
+  const double* D = p_.diameter.data();
+  std::int64_t contacts = 0, wall_contacts = 0;
+  double max_overlap = 0.0;
+  double wf[18] = {0.0};
+  int overflow = -1;
+
+#pragma omp parallel for schedule(static) if (n >= 512) reduction(+ : contacts, wall_contacts, wf[:18]) \
+    reduction(max : max_overlap, overflow)
+  for (int i = 0; i < n; ++i) {
+    const double xi = X[i], yi = Y[i], zi = Z[i];
+    const double vxi = VX[i], vyi = VY[i], vzi = VZ[i];
+    const double wxi = WX[i], wyi = WY[i], wzi = WZ[i];
+    const double ri = 0.5 * D[i], mi = mass_[i];
+    const int old_count = hist_count_[prev][i];
+    const int* old_partner = &hist_partner_[prev][static_cast<std::size_t>(i) * kMaxContacts];
+    const double* old_xi = &hist_xi_[prev][static_cast<std::size_t>(i) * kMaxContacts * 3];
+    int* new_partner = &hist_partner_[next][static_cast<std::size_t>(i) * kMaxContacts];
+    double* new_xi = &hist_xi_[next][static_cast<std::size_t>(i) * kMaxContacts * 3];
+    int count = 0;
+    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0, energy = 0;
+
+    // One contact of i with unit normal (nx,ny,nz) from i towards the partner, overlap delta,
+    // partner contact-point velocity (px,py,pz) relative to lab, partner lever rj (0 for walls).
+    auto contact = [&](int partner, double nx, double ny, double nz, double delta, double m_eff,
+                       double c_e, double mu_f, double vjx, double vjy, double vjz, double rj,
+                       double wjx, double wjy, double wjz, double share, double* wall_out) {
+      const double eta_n = c_e * std::sqrt(kn * m_eff);
+      const double eta_t = eta_t_ratio * eta_n;
+      // Velocity of i's contact point relative to the partner's: g = v_i - v_j + (r_i w_i +
+      // r_j w_j) x n.
+      const double sx = ri * wxi + rj * wjx, sy = ri * wyi + rj * wjy, sz = ri * wzi + rj * wjz;
+      const double gx = vxi - vjx + (sy * nz - sz * ny);
+      const double gy = vyi - vjy + (sz * nx - sx * nz);
+      const double gz = vzi - vjz + (sx * ny - sy * nx);
+      const double gn = gx * nx + gy * ny + gz * nz;  // > 0: approaching
+      // Normal force magnitude (repulsive > 0). Not clipped at zero: the small tensile force
+      // at the end of a contact is what makes the rebound exactly e (closed-form damping).
+      const double fn = kn * delta + eta_n * gn;
+      const double gtx = gx - gn * nx, gty = gy - gn * ny, gtz = gz - gn * nz;
+      // Tangential spring: previous value rotated into the current tangent plane, then grown.
+      double xix = 0, xiy = 0, xiz = 0;
+      for (int s = 0; s < old_count; ++s) {
+        if (old_partner[s] == partner) {
+          xix = old_xi[3 * s];
+          xiy = old_xi[3 * s + 1];
+          xiz = old_xi[3 * s + 2];
+          const double along = xix * nx + xiy * ny + xiz * nz;
+          xix -= along * nx;
+          xiy -= along * ny;
+          xiz -= along * nz;
+          break;
+        }
+      }
+      xix += gtx * dt;
+      xiy += gty * dt;
+      xiz += gtz * dt;
+      double ftx = -kt * xix - eta_t * gtx;
+      double fty = -kt * xiy - eta_t * gty;
+      double ftz = -kt * xiz - eta_t * gtz;
+      const double ft = std::sqrt(ftx * ftx + fty * fty + ftz * ftz);
+      const double limit = mu_f * std::fabs(fn);
+      if (ft > limit) {
+        // Sliding: force on the Coulomb cone, spring truncated to be consistent with it.
+        const double scale = ft > 0.0 ? limit / ft : 0.0;
+        ftx *= scale;
+        fty *= scale;
+        ftz *= scale;
+        xix = -(ftx + eta_t * gtx) / kt;
+        xiy = -(fty + eta_t * gty) / kt;
+        xiz = -(ftz + eta_t * gtz) / kt;
+      }
+      const double fcx = -fn * nx + ftx, fcy = -fn * ny + fty, fcz = -fn * nz + ftz;
+      fx += fcx;
+      fy += fcy;
+      fz += fcz;
+      // Torque (r_i n) x F_t.
+      tx += ri * (ny * ftz - nz * fty);
+      ty += ri * (nz * ftx - nx * ftz);
+      tz += ri * (nx * fty - ny * ftx);
+      energy += share * 0.5 * (kn * delta * delta + kt * (xix * xix + xiy * xiy + xiz * xiz));
+      if (wall_out != nullptr) {
+        wall_out[0] -= fcx;
+        wall_out[1] -= fcy;
+        wall_out[2] -= fcz;
+      }
+      if (count < kMaxContacts) {
+        new_partner[count] = partner;
+        new_xi[3 * count] = xix;
+        new_xi[3 * count + 1] = xiy;
+        new_xi[3 * count + 2] = xiz;
+        ++count;
+      } else {
+        overflow = std::max(overflow, i);
+      }
+    };
+
+    // Particle-particle contacts from the 27 neighbouring cells.
+    const int c = cell_of_[i];
+    const int cx = c % ncell_[0], cy = (c / ncell_[0]) % ncell_[1],
+              cz = c / (ncell_[0] * ncell_[1]);
+    for (int oz = -1; oz <= 1; ++oz) {
+      int kz = cz + oz;
+      double shz = 0.0;
+      if (kz < 0 || kz >= ncell_[2]) {
+        if (!options_.periodic[2]) continue;
+        shz = kz < 0 ? -(options_.box_max[2] - options_.box_min[2])
+                     : (options_.box_max[2] - options_.box_min[2]);
+        kz = (kz + ncell_[2]) % ncell_[2];
+      }
+      for (int oy = -1; oy <= 1; ++oy) {
+        int ky = cy + oy;
+        double shy = 0.0;
+        if (ky < 0 || ky >= ncell_[1]) {
+          if (!options_.periodic[1]) continue;
+          shy = ky < 0 ? -(options_.box_max[1] - options_.box_min[1])
+                       : (options_.box_max[1] - options_.box_min[1]);
+          ky = (ky + ncell_[1]) % ncell_[1];
+        }
+        for (int ox = -1; ox <= 1; ++ox) {
+          int kx = cx + ox;
+          double shx = 0.0;
+          if (kx < 0 || kx >= ncell_[0]) {
+            if (!options_.periodic[0]) continue;
+            shx = kx < 0 ? -(options_.box_max[0] - options_.box_min[0])
+                         : (options_.box_max[0] - options_.box_min[0]);
+            kx = (kx + ncell_[0]) % ncell_[0];
+          }
+          const int cell = (kz * ncell_[1] + ky) * ncell_[0] + kx;
+          for (int s = cell_start_[cell]; s < cell_start_[cell + 1]; ++s) {
+            const int j = cell_particles_[s];
+            if (j == i) continue;
+            // Periodic image of j next to i: the shift of the wrapped cell.
+            const double dx = X[j] + shx - xi, dy = Y[j] + shy - yi, dz = Z[j] + shz - zi;
+            const double rsum = ri + 0.5 * D[j];
+            const double dist2 = dx * dx + dy * dy + dz * dz;
+            if (dist2 >= rsum * rsum || dist2 == 0.0) continue;
+            const double dist = std::sqrt(dist2);
+            const double inv = 1.0 / dist;
+            const double delta = rsum - dist;
+            const double mj = mass_[j];
+            contact(j, dx * inv, dy * inv, dz * inv, delta, mi * mj / (mi + mj), ce, mu, VX[j],
+                    VY[j], VZ[j], 0.5 * D[j], WX[j], WY[j], WZ[j], 0.5, nullptr);
+            ++contacts;
+            max_overlap = std::max(max_overlap, delta / std::min(D[i], D[j]));
+          }
+        }
+      }
+    }
+    // Walls: planes of the box on non-periodic axes; static, so the partner velocity is zero.
+    const double pos[3] = {xi, yi, zi};
+    for (int a = 0; a < 3; ++a) {
+      if (options_.periodic[a]) continue;
+      for (int side = 0; side < 2; ++side) {
+        const double delta =
+            side == 0 ? ri - (pos[a] - options_.box_min[a]) : ri - (options_.box_max[a] - pos[a]);
+        if (delta <= 0.0) continue;
+        double nrm[3] = {0.0, 0.0, 0.0};
+        nrm[a] = side == 0 ? -1.0 : 1.0;  // from the particle towards the wall
+        contact(-1 - (2 * a + side), nrm[0], nrm[1], nrm[2], delta, mi, ce_wall, mu_wall, 0.0, 0.0,
+                0.0, 0.0, 0.0, 0.0, 0.0, 1.0, &wf[3 * (2 * a + side)]);
+        ++wall_contacts;
+        max_overlap = std::max(max_overlap, delta / D[i]);
+      }
+    }
+    hist_count_[next][i] = count;
+    fx_[i] = fx;
+    fy_[i] = fy;
+    fz_[i] = fz;
+    tx_[i] = tx;
+    ty_[i] = ty;
+    tz_[i] = tz;
+    elastic_[i] = energy;
+  }
+  hist_cur_ = next;
+  contacts_ = contacts / 2;  // each pair was seen from both sides
+  wall_contacts_ = wall_contacts;
+  max_overlap_ = max_overlap;
+  std::copy(wf, wf + 18, wall_force_.begin());
+  overflow_particle_ = overflow;
+}
+
+void DemSystem::check_state(double dt) const {
+  if (overflow_particle_ >= 0) {
+    Fail("DEM: particle " + std::to_string(overflow_particle_) + " has more than " +
+         std::to_string(kMaxContacts) + " contacts (limit of the contact history); overlaps are " +
+         "too large or the size ratio too wide; remedy: raise normal_stiffness or narrow the " +
+         "size distribution");
+  }
+  if (max_overlap_ > options_.max_overlap_fraction || !std::isfinite(max_overlap_)) {
+    Fail("DEM diverged at t = " + Num(time_) + " s: overlap " + Num(max_overlap_) +
+         " of a diameter exceeds max_overlap_fraction = " + Num(options_.max_overlap_fraction) +
+         "; remedy: raise normal_stiffness (k_n = " + Num(options_.normal_stiffness) +
+         " N/m) or lower the impact velocities / external forces");
+  }
+  const int n = static_cast<int>(p_.size());
+  const double tol = 0.5 * d_max_;
+  double vmax2 = 0.0;
+  int bad = -1;
+  for (int i = 0; i < n; ++i) {
+    const double v2 = p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i];
+    const double pos[3] = {p_.x[i], p_.y[i], p_.z[i]};
+    bool ok = std::isfinite(v2) && std::isfinite(fx_[i] + fy_[i] + fz_[i]);
+    for (int a = 0; a < 3 && ok; ++a) {
+      ok = std::isfinite(pos[a]) && (options_.periodic[a] || (pos[a] > options_.box_min[a] - tol &&
+                                                              pos[a] < options_.box_max[a] + tol));
+    }
+    if (!ok) {
+      bad = i;
+      break;
+    }
+    vmax2 = std::max(vmax2, v2);
+  }
+  if (bad >= 0) {
+    Fail("DEM diverged at t = " + Num(time_) + " s: particle " + std::to_string(bad) +
+         " is non-finite or outside the box (limit: half a diameter beyond a wall); remedy: " +
+         "lower dt (now " + Num(dt_) +
+         " s), raise normal_stiffness, or check the external "
+         "forces");
+  }
+  if (dt > 0.0 && std::sqrt(vmax2) * dt > 0.25 * d_min_) {
+    Fail("DEM diverged at t = " + Num(time_) + " s: a particle moves " +
+         Num(std::sqrt(vmax2) * dt / d_min_) + " diameters per step (limit 0.25; contacts " +
+         "would be missed); remedy: lower dt (now " + Num(dt) + " s) or check the external forces");
+  }
+}
+
+void DemSystem::step(double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    Fail("DemSystem::step: dt = " + Num(dt) + " s must be > 0");
+  if (dt > max_time_step() * (1.0 + 1e-12)) {
+    Fail("DemSystem::step: dt = " + Num(dt) + " s is above the stability limit t_c / " +
+         Num(options_.min_steps_per_contact) + " = " + Num(max_time_step()) +
+         " s (t_c = " + Num(contact_time_) +
+         " s); remedy: sub-step with advance() or dt <= " + Num(max_time_step()) + " s");
+  }
+  const int n = static_cast<int>(p_.size());
+  const double gx = options_.gravity[0], gy = options_.gravity[1], gz = options_.gravity[2];
+  const double h = 0.5 * dt;
+  double* X = p_.x.data();
+  double* Y = p_.y.data();
+  double* Z = p_.z.data();
+  // Kick (half) and drift.
+#pragma omp parallel for schedule(static) if (n >= 512)
+  for (int i = 0; i < n; ++i) {
+    const double im = inv_mass_[i], ii = inv_inertia_[i];
+    p_.vx[i] += h * ((fx_[i] + p_.fx_ext[i]) * im + gx);
+    p_.vy[i] += h * ((fy_[i] + p_.fy_ext[i]) * im + gy);
+    p_.vz[i] += h * ((fz_[i] + p_.fz_ext[i]) * im + gz);
+    p_.wx[i] += h * tx_[i] * ii;
+    p_.wy[i] += h * ty_[i] * ii;
+    p_.wz[i] += h * tz_[i] * ii;
+    X[i] += dt * p_.vx[i];
+    Y[i] += dt * p_.vy[i];
+    Z[i] += dt * p_.vz[i];
+  }
+  // Periodic axes: wrap into [min, max).
+  double* pos[3] = {X, Y, Z};
+  for (int a = 0; a < 3; ++a) {
+    if (!options_.periodic[a]) continue;
+    const double lo = options_.box_min[a], len = options_.box_max[a] - options_.box_min[a];
+    for (int i = 0; i < n; ++i) {
+      double& q = pos[a][i];
+      if (q < lo || q >= lo + len) {
+        q -= len * std::floor((q - lo) / len);
+        if (q >= lo + len) q = lo;  // rounding
+      }
+    }
+  }
+  build_cells();
+  compute_forces(dt);
+  // Kick (half) with the new forces.
+#pragma omp parallel for schedule(static) if (n >= 512)
+  for (int i = 0; i < n; ++i) {
+    const double im = inv_mass_[i], ii = inv_inertia_[i];
+    p_.vx[i] += h * ((fx_[i] + p_.fx_ext[i]) * im + gx);
+    p_.vy[i] += h * ((fy_[i] + p_.fy_ext[i]) * im + gy);
+    p_.vz[i] += h * ((fz_[i] + p_.fz_ext[i]) * im + gz);
+    p_.wx[i] += h * tx_[i] * ii;
+    p_.wy[i] += h * ty_[i] * ii;
+    p_.wz[i] += h * tz_[i] * ii;
+  }
+  time_ += dt;
+  ++steps_;
+  check_state(dt);
+}
+
+std::int64_t DemSystem::advance(double duration) {
+  if (!(duration >= 0.0) || !std::isfinite(duration)) {
+    Fail("DemSystem::advance: duration = " + Num(duration) + " s must be >= 0");
+  }
+  if (duration == 0.0) return 0;
+  const std::int64_t k = static_cast<std::int64_t>(std::ceil(duration / dt_ * (1.0 - 1e-12)));
+  const double h = duration / static_cast<double>(std::max<std::int64_t>(k, 1));
+  for (std::int64_t s = 0; s < k; ++s) step(h);
+  return k;
+}
+
+DemEnergy DemSystem::energy() const {
+  DemEnergy e;
+  const std::size_t n = p_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double m = mass_[i];
+    e.kinetic_translational +=
+        0.5 * m * (p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i]);
+    e.kinetic_rotational +=
+        0.5 / inv_inertia_[i] * (p_.wx[i] * p_.wx[i] + p_.wy[i] * p_.wy[i] + p_.wz[i] * p_.wz[i]);
+    e.elastic += elastic_[i];
+    e.gravitational -= m * (options_.gravity[0] * p_.x[i] + options_.gravity[1] * p_.y[i] +
+                            options_.gravity[2] * p_.z[i]);
+  }
+  return e;
+}
+
+std::array<double, 3> DemSystem::wall_force(Wall w) const {
+  const int k = static_cast<int>(w);
+  return {wall_force_[3 * k], wall_force_[3 * k + 1], wall_force_[3 * k + 2]};
+}
+
+void DemSystem::sort_particles() {
+  const int n = static_cast<int>(p_.size());
+  build_cells();
+  // order[new] = old, in cell order.
+  std::vector<int> order(cell_particles_.begin(), cell_particles_.end());
+  std::vector<int> new_index(n);
+  for (int k = 0; k < n; ++k) new_index[order[k]] = k;
+  auto permute = [&](auto& v) {
+    auto copy = v;
+    for (int k = 0; k < n; ++k) v[k] = copy[order[k]];
+  };
+  for (auto* v : {&p_.x,        &p_.y,       &p_.z,     &p_.vx,     &p_.vy,     &p_.vz,
+                  &p_.wx,       &p_.wy,      &p_.wz,    &p_.fx_ext, &p_.fy_ext, &p_.fz_ext,
+                  &p_.diameter, &p_.density, &fx_,      &fy_,       &fz_,       &tx_,
+                  &ty_,         &tz_,        &elastic_, &mass_,     &inv_mass_, &inv_inertia_}) {
+    permute(*v);
+  }
+  permute(p_.id);
+  // Contact history: move each particle's slots and renumber particle partners.
+  const int cur = hist_cur_;
+  std::vector<int> count(n), partner(static_cast<std::size_t>(n) * kMaxContacts);
+  std::vector<double> xi(static_cast<std::size_t>(n) * kMaxContacts * 3);
+  for (int k = 0; k < n; ++k) {
+    const int o = order[k];
+    count[k] = hist_count_[cur][o];
+    for (int s = 0; s < count[k]; ++s) {
+      const int q = hist_partner_[cur][static_cast<std::size_t>(o) * kMaxContacts + s];
+      partner[static_cast<std::size_t>(k) * kMaxContacts + s] = q >= 0 ? new_index[q] : q;
+      for (int c = 0; c < 3; ++c) {
+        xi[(static_cast<std::size_t>(k) * kMaxContacts + s) * 3 + c] =
+            hist_xi_[cur][(static_cast<std::size_t>(o) * kMaxContacts + s) * 3 + c];
+      }
+    }
+  }
+  hist_count_[cur] = std::move(count);
+  hist_partner_[cur] = std::move(partner);
+  hist_xi_[cur] = std::move(xi);
+  build_cells();
+}
+
+// ---- Settling ----------------------------------------------------------------------------------
+
+bool SettleOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error != nullptr) *error = "SettleOptions." + m;
+    return false;
+  };
+  if (n < 1) return fail("n = " + std::to_string(n) + ": must be >= 1");
+  if (!(diameter > 0.0) || !std::isfinite(diameter)) {
+    return fail("diameter = " + Num(diameter) + " m: must be > 0");
+  }
+  if (!(density > 0.0) || !std::isfinite(density)) {
+    return fail("density = " + Num(density) + " kg/m^3: must be > 0");
+  }
+  if (!(insertion_solids_fraction > 0.0 && insertion_solids_fraction <= 0.35)) {
+    return fail("insertion_solids_fraction = " + Num(insertion_solids_fraction) +
+                ": must be in (0, 0.35]");
+  }
+  if (!(kinetic_energy_tolerance > 0.0 && kinetic_energy_tolerance <= 1e-2)) {
+    return fail("kinetic_energy_tolerance = " + Num(kinetic_energy_tolerance) +
+                ": must be in (0, 1e-2]");
+  }
+  if (!(max_time > 0.0) || !std::isfinite(max_time)) {
+    return fail("max_time = " + Num(max_time) + " s: must be > 0");
+  }
+  return true;
+}
+
+std::string SettleResult::BriefReport() const {
+  std::ostringstream s;
+  s << "settled " << particles.size() << " particles in " << Num(simulated_time_s) << " s ("
+    << steps << " steps, " << Num(wall_s) << " s wall): bed height " << Num(bed_height_m)
+    << " m, KE/(m g d) " << Num(kinetic_energy_ratio) << ", floor force/weight "
+    << Num(weight_n > 0 ? floor_force_n / weight_n : 0.0);
+  return s.str();
+}
+
+SettleResult settle_particles(const DemOptions& options, const SettleOptions& settle,
+                              const DemProgress& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string error;
+  if (!options.IsValid(&error)) Fail(error);
+  if (!settle.IsValid(&error)) Fail(error);
+  const double g =
+      std::sqrt(options.gravity[0] * options.gravity[0] + options.gravity[1] * options.gravity[1] +
+                options.gravity[2] * options.gravity[2]);
+  if (!(options.gravity[1] < 0.0) || std::fabs(options.gravity[0]) > 1e-12 * g ||
+      std::fabs(options.gravity[2]) > 1e-12 * g) {
+    Fail("DemOptions.gravity: settle_particles needs gravity along -y");
+  }
+  const double d = settle.diameter;
+  const double lx = options.box_max[0] - options.box_min[0];
+  const double lz = options.box_max[2] - options.box_min[2];
+  if (lx < d || lz < d) {
+    Fail("SettleOptions.diameter = " + Num(d) + " m: wider than the box cross-section");
+  }
+  // Insertion column: cross-section of the box, height from the target insertion fraction; it
+  // may extend above the box top (the real top wall applies after settling).
+  const double vp = kPi / 6.0 * d * d * d;
+  const double cross = lx * lz;
+  const double column = std::max(d, settle.n * vp / (settle.insertion_solids_fraction * cross));
+  DemOptions run = options;
+  run.box_max[1] = options.box_min[1] + column + 2.0 * d;
+  // Random sequential insertion on a coarse hash grid (cell = d): reject overlaps.
+  std::mt19937_64 rng(settle.seed);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double r = 0.5 * d, gap = 0.01 * d;
+  const double lo[3] = {options.box_min[0] + (options.periodic[0] ? 0.0 : r + gap),
+                        options.box_min[1] + r + gap,
+                        options.box_min[2] + (options.periodic[2] ? 0.0 : r + gap)};
+  const double hi[3] = {options.box_max[0] - (options.periodic[0] ? 0.0 : r + gap),
+                        options.box_min[1] + column + r,
+                        options.box_max[2] - (options.periodic[2] ? 0.0 : r + gap)};
+  const double len[3] = {lx, 0.0, lz};
+  const int hx = std::max(1, static_cast<int>(lx / d)), hz = std::max(1, static_cast<int>(lz / d));
+  const int hy = std::max(1, static_cast<int>((hi[1] - lo[1]) / d) + 1);
+  const double cx = lx / hx, cz = lz / hz;
+  std::vector<std::vector<int>> hash(static_cast<std::size_t>(hx) * hy * hz);
+  Particles parts;
+  const std::int64_t max_tries = 2000LL * settle.n + 100000;
+  std::int64_t tries = 0;
+  while (static_cast<int>(parts.size()) < settle.n) {
+    if (++tries > max_tries) {
+      Fail("SettleOptions.n = " + std::to_string(settle.n) + ": random insertion failed; the " +
+           "particles do not fit at insertion_solids_fraction " +
+           Num(settle.insertion_solids_fraction) + " in the box cross-section");
+    }
+    const double q[3] = {lo[0] + (hi[0] - lo[0]) * u01(rng), lo[1] + (hi[1] - lo[1]) * u01(rng),
+                         lo[2] + (hi[2] - lo[2]) * u01(rng)};
+    const int ix = std::min(hx - 1, static_cast<int>((q[0] - options.box_min[0]) / cx));
+    const int iy = std::min(hy - 1, static_cast<int>((q[1] - lo[1]) / d));
+    const int iz = std::min(hz - 1, static_cast<int>((q[2] - options.box_min[2]) / cz));
+    bool free = true;
+    for (int oz = -1; oz <= 1 && free; ++oz) {
+      for (int oy = -1; oy <= 1 && free; ++oy) {
+        for (int ox = -1; ox <= 1 && free; ++ox) {
+          int kx = ix + ox, ky = iy + oy, kz = iz + oz;
+          if (ky < 0 || ky >= hy) continue;
+          if (kx < 0 || kx >= hx) {
+            if (!options.periodic[0] || hx < 3) continue;
+            kx = (kx + hx) % hx;
+          }
+          if (kz < 0 || kz >= hz) {
+            if (!options.periodic[2] || hz < 3) continue;
+            kz = (kz + hz) % hz;
+          }
+          for (int j : hash[(static_cast<std::size_t>(kz) * hy + ky) * hx + kx]) {
+            double dd[3] = {parts.x[j] - q[0], parts.y[j] - q[1], parts.z[j] - q[2]};
+            for (int a : {0, 2}) {
+              if (options.periodic[a]) dd[a] -= len[a] * std::round(dd[a] / len[a]);
+            }
+            if (dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2] < (d + gap) * (d + gap)) free = false;
+          }
+        }
+      }
+    }
+    if (!free) continue;
+    hash[(static_cast<std::size_t>(iz) * hy + iy) * hx + ix].push_back(
+        static_cast<int>(parts.size()));
+    parts.add(q[0], q[1], q[2], d, settle.density);
+  }
+  DemSystem dem(run, std::move(parts));
+  dem.sort_particles();
+  const double m = settle.density * vp;
+  const double ke_scale = m * g * d;
+  // Fall time from the column top plus relaxation; check every ~1 ms of simulated time.
+  const double check = std::max(dem.time_step(), 1e-3);
+  double ratio = std::numeric_limits<double>::infinity();
+  while (dem.time() < settle.max_time) {
+    dem.advance(check);
+    ratio = dem.kinetic_energy() / settle.n / ke_scale;
+    if (progress) {
+      progress(std::min(1.0, dem.time() / settle.max_time), "settling: KE/(m g d) = " + Num(ratio));
+    }
+    // At rest: small kinetic energy, and the top particle has landed (not still in free fall).
+    if (ratio < settle.kinetic_energy_tolerance && dem.time() > 0.05) break;
+  }
+  if (!(ratio < settle.kinetic_energy_tolerance)) {
+    Fail("settle_particles: not at rest after SettleOptions.max_time = " + Num(settle.max_time) +
+         " s (KE/(m g d) = " + Num(ratio) + " > kinetic_energy_tolerance = " +
+         Num(settle.kinetic_energy_tolerance) + "); remedy: raise max_time or lower restitution");
+  }
+  SettleResult result;
+  result.particles = dem.particles();
+  const auto& p = result.particles;
+  double top = options.box_min[1];
+  for (std::size_t i = 0; i < p.size(); ++i) top = std::max(top, p.y[i] + 0.5 * p.diameter[i]);
+  result.bed_height_m = top - options.box_min[1];
+  if (top > options.box_max[1]) {
+    Fail("SettleOptions.n = " + std::to_string(settle.n) + ": the settled bed (" +
+         Num(result.bed_height_m) + " m) does not fit in the box (height " +
+         Num(options.box_max[1] - options.box_min[1]) + " m)");
+  }
+  for (auto* v : {&result.particles.vx, &result.particles.vy, &result.particles.vz,
+                  &result.particles.wx, &result.particles.wy, &result.particles.wz}) {
+    std::fill(v->begin(), v->end(), 0.0);
+  }
+  result.simulated_time_s = dem.time();
+  result.steps = dem.steps();
+  result.kinetic_energy_ratio = ratio;
+  result.floor_force_n = -dem.wall_force(Wall::kYMin)[1];
+  result.weight_n = settle.n * m * g;
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace consumers
+}  // namespace draglab
