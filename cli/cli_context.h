@@ -63,6 +63,8 @@ void add_fit_commands(CLI::App& app, CliContext& ctx);
 void add_report_commands(CLI::App& app, CliContext& ctx);
 /// Registers `draglab pipeline` (pipeline_commands.cc).
 void add_pipeline_commands(CLI::App& app, CliContext& ctx);
+/// Registers `draglab scene ...` (scene_commands.cc).
+void add_scene_commands(CLI::App& app, CliContext& ctx);
 
 /// Parses "a,b,c" into doubles; throws UsageError naming `field`.
 std::vector<double> parse_double_list(const std::string& text, const std::string& field);

@@ -1,0 +1,198 @@
+// `draglab scene ...`: scene files (docs/scenes.md) -> minimum fluidization per law and the
+// numbers a scene implies.
+//   draglab scene umf data/scenes/dpm_bubble.toml [--law ergun@1,bvk2007@1] [--json]
+//   draglab scene check data/scenes/dpm_bubble.toml [--json]
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "cli/cli_context.h"
+#include "draglab/consumers/scene.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace cli {
+namespace {
+
+using consumers::Scene;
+
+struct SceneArgs {
+  std::string scene_path;
+  std::string laws;  // --law a,b,c
+};
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item.empty()) throw UsageError("--law: empty entry in '" + text + "' (expected a,b,c)");
+    out.push_back(item);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+/// The laws to evaluate: --law, else the scene's plus the five reference laws' version 1 that
+/// exist in the database.
+std::vector<std::string> laws_for(const Scene& scene, const SceneArgs& args, const Database& db) {
+  if (!args.laws.empty()) return split_list(args.laws);
+  std::vector<std::string> laws = scene.laws;
+  for (const char* name : {"gidaspow", "ergun", "hill_koch_ladd", "vdh2004", "bvk2007"}) {
+    const std::string ref = std::string(name) + "@1";
+    bool listed = false;
+    for (const auto& l : laws) listed = listed || l == ref;
+    if (listed) continue;
+    try {
+      db.resolve(ref);
+      laws.push_back(ref);
+    } catch (const Error& e) {
+      if (e.code() != ErrorCode::kNotFound) throw;
+    }
+  }
+  return laws;
+}
+
+nlohmann::json umf_json(const consumers::MinFluidizationResult& r) {
+  return {{"law", r.law},         {"umf_m_s", r.umf_m_s},       {"re_mf", r.re_mf},
+          {"eps_mf", r.eps_mf},   {"archimedes", r.archimedes}, {"F_mf", r.F_mf},
+          {"beta_mf", r.beta_mf}, {"iterations", r.iterations}};
+}
+
+void run_umf(const CliContext& ctx, const SceneArgs& args) {
+  const Scene scene = consumers::load_scene(args.scene_path);
+  auto db = ctx.open_database();  // created and seeded on first use, as every command
+  consumers::MinFluidizationOptions options;
+  options.eps_mf = scene.eps_mf;
+  nlohmann::json rows = nlohmann::json::array();
+  std::vector<consumers::MinFluidizationResult> results;
+  for (const auto& ref : laws_for(scene, args, *db)) {
+    std::string warning;
+    auto law = db->load(ref, RangePolicy::kError, &warning);
+    if (!warning.empty()) ctx.warn(warning);
+    results.push_back(consumers::minimum_fluidization(*law, scene.particles, scene.gas, options));
+    rows.push_back(umf_json(results.back()));
+  }
+  if (ctx.json) {
+    ctx.print_json({{"scene", scene.name}, {"scene_hash", scene.hash()}, {"laws", rows}});
+    return;
+  }
+  std::cout << fmt::format(
+      "Minimum fluidization, scene {} (d = {} m, rho_p = {} kg/m^3, "
+      "eps_mf = {}, Ar = {}):\n",
+      scene.name, format_number(scene.particles.diameter_m),
+      format_number(scene.particles.density_kg_m3), scene.eps_mf,
+      format_number(results.front().archimedes, 4));
+  std::cout << fmt::format("{:<24} {:>10} {:>9} {:>10} {:>12}\n", "law", "U_mf m/s", "Re_mf",
+                           "F_mf", "beta kg/m3/s");
+  for (const auto& r : results) {
+    std::cout << fmt::format("{:<24} {:>10.4f} {:>9.2f} {:>10.4g} {:>12.4g}\n", r.law, r.umf_m_s,
+                             r.re_mf, r.F_mf, r.beta_mf);
+  }
+}
+
+void run_check(const CliContext& ctx, const SceneArgs& args) {
+  const Scene scene = consumers::load_scene(args.scene_path);
+  auto db = ctx.open_database();  // created and seeded on first use, as every command
+  nlohmann::json per_law = nlohmann::json::array();
+  std::vector<consumers::SceneDerived> derived;
+  for (const auto& ref : args.laws.empty() ? scene.laws : split_list(args.laws)) {
+    std::string warning;
+    auto law = db->load(ref, RangePolicy::kError, &warning);
+    if (!warning.empty()) ctx.warn(warning);
+    derived.push_back(consumers::derive_scene(scene, *law));
+    const auto& r = derived.back();
+    per_law.push_back({{"law", r.umf.law},
+                       {"umf_m_s", r.umf.umf_m_s},
+                       {"re_mf", r.umf.re_mf},
+                       {"eps_mf", r.umf.eps_mf},
+                       {"background_m_s", r.background_m_s},
+                       {"stokes_number", r.stokes_number},
+                       {"gas_drag_relaxation_s", r.gas_drag_relaxation_s},
+                       {"solids_drag_relaxation_s", r.solids_drag_relaxation_s},
+                       {"recommended_gas_dt_s", r.recommended_gas_dt_s},
+                       {"leakage_bubble_diameter_m", r.leakage_bubble_diameter_m}});
+  }
+  const auto& first = derived.front();
+  if (ctx.json) {
+    ctx.print_json({{"scene", scene.name},
+                    {"scene_hash", scene.hash()},
+                    {"valid", true},
+                    {"particle_count", first.particle_count},
+                    {"bed_height_mf_m", first.bed_height_mf_m},
+                    {"archimedes", first.archimedes},
+                    {"particle_response_s", first.particle_response_s},
+                    {"contact_time_s", first.contact_time_s},
+                    {"recommended_dem_dt_s", first.recommended_dem_dt_s},
+                    {"jet_area_rate_m2_s", first.jet_area_rate_m2_s},
+                    {"background", consumers::to_string(scene.distributor.mode)},
+                    {"laws", per_law}});
+    return;
+  }
+  std::cout << fmt::format("scene {} ({}): valid\n", scene.name, scene.origin);
+  std::cout << fmt::format(
+      "  particles: {} of d = {} m (H_mf = {} m at eps_mf = {}); Ar = {}\n"
+      "  contact time t_c = {} s -> DEM step {} s (t_c/{}); Stokes response {} s\n"
+      "  jet q = {} m^2/s through {} m at {} m/s; background: {}\n",
+      first.particle_count, format_number(scene.particles.diameter_m),
+      format_number(first.bed_height_mf_m, 4), scene.eps_mf, format_number(first.archimedes, 4),
+      format_number(first.contact_time_s, 3), format_number(first.recommended_dem_dt_s, 3),
+      scene.time.contact_steps, format_number(first.particle_response_s, 3),
+      format_number(first.jet_area_rate_m2_s, 3), format_number(scene.jet.slot_width_m),
+      format_number(scene.jet.velocity_m_s), consumers::to_string(scene.distributor.mode));
+  std::cout << fmt::format("{:<20} {:>8} {:>7} {:>10} {:>6} {:>10} {:>10} {:>10} {:>8}\n", "law",
+                           "U_mf m/s", "Re_mf", "backgr m/s", "St", "tau_gas s", "tau_sol s",
+                           "gas dt s", "D* m");
+  for (const auto& r : derived) {
+    std::cout << fmt::format(
+        "{:<20} {:>8.4f} {:>7.1f} {:>10.4f} {:>6.0f} {:>10.3g} {:>10.3g} {:>10.3g} {:>8.4f}\n",
+        r.umf.law, r.umf.umf_m_s, r.umf.re_mf, r.background_m_s, r.stokes_number,
+        r.gas_drag_relaxation_s, r.solids_drag_relaxation_s, r.recommended_gas_dt_s,
+        r.leakage_bubble_diameter_m);
+  }
+  std::cout << "  tau_gas = eps rho_g/beta at U_mf: the gas solver couples drag implicitly, so its "
+               "step is not limited by it; D* = q/(pi U_mf) (Davidson-Harrison with leakage).\n";
+}
+
+}  // namespace
+
+void add_scene_commands(CLI::App& app, CliContext& ctx) {
+  auto* scene = app.add_subcommand(
+      "scene", "Fluidized-bed scenes (TOML, docs/scenes.md): minimum fluidization, checks");
+  scene->require_subcommand(1);
+
+  auto umf_args = std::make_shared<SceneArgs>();
+  auto* umf = scene->add_subcommand(
+      "umf",
+      "Minimum fluidization velocity per law for the scene's particles, gas and eps_mf: solves "
+      "18 Re F(1 - eps_mf, Re) = eps_mf Ar (drag on the bed = its buoyant weight)");
+  umf->add_option("SCENE", umf_args->scene_path, "Scene file (TOML)")->required();
+  umf->add_option("--law", umf_args->laws,
+                  "Laws NAME@V,... (default: the scene's plus gidaspow, ergun, hill_koch_ladd, "
+                  "vdh2004, bvk2007 @1 where present)");
+  umf->footer(
+      "Examples:\n  draglab scene umf data/scenes/dpm_bubble.toml\n"
+      "  draglab scene umf data/scenes/dpm_bubble.toml --law ergun@1,bvk2007@1 --json");
+  umf->callback([&ctx, umf_args] { ctx.action = [&ctx, umf_args] { run_umf(ctx, *umf_args); }; });
+
+  auto check_args = std::make_shared<SceneArgs>();
+  auto* check = scene->add_subcommand(
+      "check",
+      "Validate a scene file and print its derived numbers (particle count, Archimedes and Stokes "
+      "numbers, drag relaxation times at U_mf, recommended DEM and gas time steps)");
+  check->add_option("SCENE", check_args->scene_path, "Scene file (TOML)")->required();
+  check->add_option("--law", check_args->laws, "Laws NAME@V,... (default: the scene's)");
+  check->footer("Example:\n  draglab scene check data/scenes/dpm_bubble_quick.toml --json");
+  check->callback(
+      [&ctx, check_args] { ctx.action = [&ctx, check_args] { run_check(ctx, *check_args); }; });
+}
+
+}  // namespace cli
+}  // namespace draglab

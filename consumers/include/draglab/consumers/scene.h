@@ -1,0 +1,223 @@
+// draglab/consumers/scene.h: fluidized-bed scenes (TOML files, docs/scenes.md), the minimum
+// fluidization velocity of a loaded drag law, and the numbers derived from a scene.
+//
+// A Scene is what a scene file declares: a pseudo-2D box (width x height x depth), monodisperse
+// particles, the gas, the distributor (background) flow, a central jet that injects one bubble,
+// the times, the gas grid, the bubble criterion, the outputs and the drag law(s) by reference
+// "name@version". Units are SI throughout (m, s, kg/m^3, Pa s, m/s). Parsing checks types and
+// unknown keys; Scene::IsValid checks every range and names the field and its allowed range.
+//
+// Minimum fluidization (minimum_fluidization): at U_mf the drag on the particles of a bed at
+// eps_mf carries their buoyant weight. With the canonical drag-only F (drag per particle
+// F_d = 3 pi mu d U F, U superficial) and the mean pressure gradient of the bed acting on the
+// particles' volume, the particle and mixture momentum balances give
+//     n F_d = phi eps (rho_p - rho_g) g      (n = phi / V_p particles per volume)
+//  <=> 18 Re F(phi, Re) = eps Ar,  Re = rho_g U d / mu (superficial), Ar = rho_g (rho_p - rho_g)
+//      g d^3 / mu^2,
+// which for Ergun's F = (150 phi + 1.75 Re)/(18 eps^2) is the Kunii-Levenspiel quadratic
+// 1.75 Re^2/eps^3 + 150 phi Re/eps^3 = Ar. It is solved for Re by bracketing inside the law's
+// validity range of Re and Brent's method.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "draglab/drag_db/law.h"
+
+namespace draglab {
+namespace consumers {
+
+/// Standard gravity [m/s^2], the default of SceneGas::gravity_m_s2.
+constexpr double kStandardGravity = 9.81;
+
+/// Box of the pseudo-2D bed [m]: x across the width, y up, z across the (thin) depth.
+struct SceneGeometry {
+  double width_m = 0.0;
+  double height_m = 0.0;
+  double depth_m = 0.0;
+};
+
+/// Monodisperse spheres and their contact model (linear spring-dashpot, Coulomb friction; the
+/// same coefficients for particle-wall contacts). Give exactly one of count and bed_height_mf_m.
+struct SceneParticles {
+  double diameter_m = 0.0;
+  double density_kg_m3 = 0.0;
+  double restitution = 0.97;             ///< Normal restitution coefficient, (0, 1].
+  double friction = 0.1;                 ///< Coulomb friction coefficient, [0, 1].
+  double spring_stiffness_n_m = 7000.0;  ///< Normal spring k_n [N/m] (consumers.md §3.5).
+  std::int64_t count = 0;                ///< Number of particles, or 0: from bed_height_mf_m.
+  double bed_height_mf_m = 0.0;          ///< Bed height at eps_mf, or 0: from count.
+};
+
+/// The gas (incompressible in the consumers: Mach << 0.1 at the jet velocities used).
+struct SceneGas {
+  double density_kg_m3 = 0.0;
+  double viscosity_pa_s = 0.0;
+  double gravity_m_s2 = kStandardGravity;
+};
+
+/// How the background velocity through the porous plate is set.
+enum class BackgroundMode {
+  kUmf,    ///< umf_factor times the loaded law's own U_mf (each law at its own incipient state).
+  kFixed,  ///< velocity_m_s for every law (as the experiment did with one measured U_mf).
+};
+const char* to_string(BackgroundMode mode);
+
+/// Distributor (porous plate) flow, superficial.
+struct SceneDistributor {
+  BackgroundMode mode = BackgroundMode::kUmf;
+  double umf_factor = 1.0;    ///< kUmf: multiple of the law's U_mf, (0, 10].
+  double velocity_m_s = 0.0;  ///< kFixed: superficial velocity [m/s], > 0.
+};
+
+/// Central slot jet through the bottom that injects one bubble (superficial velocity in the
+/// slot; the slot replaces the porous plate over its width while the jet is on).
+struct SceneJet {
+  double slot_width_m = 0.0;
+  double velocity_m_s = 0.0;
+  double center_m = -1.0;  ///< Slot centre from the left wall; < 0 in the file: width / 2.
+  double start_s = 0.0;    ///< Jet start, after the settled bed has been fluidized from t = 0.
+  double duration_s = 0.0;
+};
+
+/// Times [s]. t = 0 is when the background flow starts through the settled bed.
+struct SceneTime {
+  double duration_s = 0.0;  ///< Simulated time after t = 0.
+  double t_ref_s = 0.3;     ///< Snapshot time after jet start (the seed's 0.3 s).
+  double settle_s = 0.3;    ///< Settling under gravity (no gas flow) before t = 0.
+  double dem_dt_s = 0.0;    ///< DEM step, or 0: t_c / contact_steps.
+  int contact_steps = 20;   ///< DEM steps per contact time, >= 20.
+  double gas_dt_s = 0.0;    ///< Gas step, or 0: recommended_gas_dt_s (SceneDerived).
+};
+
+/// Gas grid: cells across the width and the height, one cell across the depth.
+struct SceneGrid {
+  int cells_x = 0;
+  int cells_y = 0;
+};
+
+/// Bubble criterion: cells with eps_g above the threshold that are connected to the jet's bubble.
+struct SceneBubble {
+  double eps_threshold = 0.8;       ///< (eps_mf, 1).
+  double sample_interval_s = 0.01;  ///< Time-series spacing, (0, duration].
+};
+
+/// What is written besides the JSON result (nothing unless asked for).
+struct SceneOutputs {
+  std::string directory;    ///< Where files go; empty: next to the working directory as out/<name>.
+  bool fields = false;      ///< Gas fields to HDF5 + XDMF.
+  bool particles = false;   ///< Particles to HDF5 + XDMF (Polyvertex).
+  double interval_s = 0.0;  ///< Output spacing; 0: only the snapshot at t_ref.
+};
+
+/// A scene file, parsed. Built by parse_scene / load_scene; IsValid checks every range.
+struct Scene {
+  std::string name;
+  std::string description;
+  std::string solver = "dpm";  ///< "dpm" (this issue); "tfm", "dbm" later.
+  std::uint64_t seed = 1;      ///< Initial packing realization.
+  SceneGeometry geometry;
+  SceneParticles particles;
+  SceneGas gas;
+  SceneDistributor distributor;
+  SceneJet jet;
+  SceneTime time;
+  SceneGrid grid;
+  SceneBubble bubble;
+  SceneOutputs outputs;
+  std::vector<std::string> laws;  ///< "name@version" references, at least one.
+  double eps_mf = 0.42;           ///< Gas fraction of the bed at minimum fluidization.
+  /// Range policy the solver uses for drag evaluations outside a law's validity box during a
+  /// run (void fractions near 1 in the bubble): "clamp" (default), "extrapolate" or "error".
+  std::string range_policy = "clamp";
+  std::string origin;       ///< File (or label) it was read from, for messages.
+  std::string source_text;  ///< The TOML text, for the scene hash.
+
+  /// Checks every field; on failure *error names the field and the allowed range.
+  bool IsValid(std::string* error) const;
+  /// Throws Error(kInvalidArgument) with IsValid's message.
+  void Validate() const;
+
+  /// Particle volume pi d^3/6 [m^3] and mass [kg].
+  double particle_volume_m3() const;
+  double particle_mass_kg() const;
+  /// Particle count: `count`, or (1 - eps_mf) W D H_mf / V_p rounded.
+  std::int64_t particle_count() const;
+  /// Bed height at eps_mf: `bed_height_mf_m`, or N V_p / ((1 - eps_mf) W D).
+  double bed_height_mf_m() const;
+  /// Slot centre [m] (jet.center_m, or width/2).
+  double jet_center_m() const;
+  /// SHA-256 (hex) of the scene text: identifies the scene in stored consumer results.
+  std::string hash() const;
+};
+
+/// Parses TOML text (origin names it in messages). Throws Error(kInvalidArgument) for invalid
+/// TOML, an unknown section or key (named, with the valid ones), a wrong type, or a range error
+/// (Scene::IsValid).
+Scene parse_scene(const std::string& toml_text, const std::string& origin = "<scene>");
+/// Reads and parses a scene file; a missing file is Error(kNotFound).
+Scene load_scene(const std::string& path);
+
+/// Options of minimum_fluidization.
+struct MinFluidizationOptions {
+  double eps_mf = 0.42;               ///< Bed gas fraction at minimum fluidization, (0.2, 0.9).
+  double relative_tolerance = 1e-12;  ///< On Re_mf, (0, 1e-3].
+  int max_iterations = 200;           ///< Brent iterations, [10, 10000].
+  bool IsValid(std::string* error) const;
+};
+
+/// U_mf of one law for one particle/gas pair.
+struct MinFluidizationResult {
+  std::string law;  ///< "name@version".
+  double eps_mf = 0.0;
+  double umf_m_s = 0.0;     ///< Superficial U_mf [m/s].
+  double re_mf = 0.0;       ///< rho_g U_mf d / mu (= canonical Re at U_mf).
+  double archimedes = 0.0;  ///< Ar = rho_g (rho_p - rho_g) g d^3 / mu^2.
+  double F_mf = 0.0;        ///< Canonical F at (1 - eps_mf, Re_mf).
+  double beta_mf = 0.0;     ///< beta at U_mf [kg m^-3 s^-1].
+  double residual = 0.0;    ///< (18 Re F - eps Ar) / (eps Ar) at the solution.
+  int iterations = 0;       ///< Brent iterations (bracketing excluded).
+  std::string BriefReport() const;
+};
+
+/// Solves 18 Re F(1 - eps_mf, Re) = eps_mf Ar for Re inside the law's validity range of Re.
+/// Throws Error(kInvalidArgument) for bad particle/gas values or options, Error(kOutOfValidity)
+/// when 1 - eps_mf is outside the law's phi range or no root lies inside its Re range (the
+/// message names the law, the range and a remedy), Error(kInternal) if Brent does not converge.
+MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles& particles,
+                                           const SceneGas& gas,
+                                           const MinFluidizationOptions& options);
+
+/// Numbers derived from a scene and one law (draglab scene check).
+struct SceneDerived {
+  std::int64_t particle_count = 0;
+  double bed_height_mf_m = 0.0;
+  double archimedes = 0.0;
+  MinFluidizationResult umf;
+  double background_m_s = 0.0;             ///< Background velocity used with this law.
+  double stokes_number = 0.0;              ///< Collision Stokes number rho_p U_mf d / (9 mu).
+  double particle_response_s = 0.0;        ///< Stokes response time rho_p d^2 / (18 mu).
+  double gas_drag_relaxation_s = 0.0;      ///< eps_mf rho_g / beta at U_mf: gas side.
+  double solids_drag_relaxation_s = 0.0;   ///< (1 - eps_mf) rho_p / beta at U_mf.
+  double contact_time_s = 0.0;             ///< Linear spring-dashpot contact time t_c.
+  double recommended_dem_dt_s = 0.0;       ///< t_c / contact_steps.
+  double recommended_gas_dt_s = 0.0;       ///< Convective limit 0.5 min(dx, dy) / u_max, u_max the
+                                           ///< interstitial jet velocity (or background if larger).
+  double jet_area_rate_m2_s = 0.0;         ///< q = v_jet w_slot.
+  double leakage_bubble_diameter_m = 0.0;  ///< Davidson-Harrison D* = q / (pi U_mf).
+  std::string BriefReport() const;
+};
+
+/// Linear spring-dashpot normal contact time between two equal particles (reduced mass m/2):
+/// t_c = pi / sqrt(k/m_eff - eta^2/(4 m_eff^2)), eta = 2 sqrt(k m_eff) |ln e| / sqrt(pi^2 +
+/// ln^2 e).
+double contact_time_s(const SceneParticles& particles);
+
+/// Derives SceneDerived for `law`; throws as minimum_fluidization does, and Error
+/// (kInvalidArgument) if the scene's explicit time steps exceed their stability limits.
+SceneDerived derive_scene(const Scene& scene, const Law& law);
+
+}  // namespace consumers
+}  // namespace draglab

@@ -1,0 +1,494 @@
+// Scene files: TOML parsing (toml++), validation and the quantities a scene implies
+// (docs/scenes.md).
+#include "draglab/consumers/scene.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s.precision(6);
+  s << x;
+  return s.str();
+}
+
+bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+[[noreturn]] void bad(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+/// lo < x <= hi (open_lo) or lo <= x <= hi, finite; else a message naming field and range.
+bool in_range(double x, double lo, double hi, bool open_lo, bool open_hi, const std::string& field,
+              const std::string& unit, std::string* error) {
+  const bool ok = std::isfinite(x) && (open_lo ? x > lo : x >= lo) && (open_hi ? x < hi : x <= hi);
+  if (ok) return true;
+  return fail(error, field + " = " + fmt(x) + " is outside " + (open_lo ? "(" : "[") + fmt(lo) +
+                         ", " + fmt(hi) + (open_hi ? ")" : "]") + (unit.empty() ? "" : " " + unit));
+}
+
+std::string where(const std::string& origin, const toml::node& node) {
+  const auto& src = node.source();
+  if (src.begin.line == 0) return origin;
+  return origin + ":" + std::to_string(src.begin.line);
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& i : items) out += (out.empty() ? "" : ", ") + i;
+  return out;
+}
+
+/// One key of a section and how to store it into the Scene.
+struct Key {
+  std::string name;
+  std::function<void(Scene&, const toml::node&, const std::string& field, const std::string& at)>
+      read;
+};
+
+double as_number(const toml::node& n, const std::string& field, const std::string& at) {
+  if (auto v = n.value_exact<double>()) return *v;
+  if (auto i = n.value_exact<std::int64_t>()) return static_cast<double>(*i);
+  bad(at + ": " + field + " must be a number");
+}
+std::int64_t as_integer(const toml::node& n, const std::string& field, const std::string& at) {
+  if (auto i = n.value_exact<std::int64_t>()) return *i;
+  bad(at + ": " + field + " must be an integer");
+}
+std::string as_text(const toml::node& n, const std::string& field, const std::string& at) {
+  if (auto s = n.value_exact<std::string>()) return *s;
+  bad(at + ": " + field + " must be a string");
+}
+bool as_bool(const toml::node& n, const std::string& field, const std::string& at) {
+  if (auto b = n.value_exact<bool>()) return *b;
+  bad(at + ": " + field + " must be true or false");
+}
+
+template <typename Member>
+Key num(const std::string& name, Member member) {
+  return {name, [member](Scene& s, const toml::node& n, const std::string& f,
+                         const std::string& at) { member(s) = as_number(n, f, at); }};
+}
+
+// The sections and keys a scene file accepts, in documentation order.
+const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
+  using S = Scene;
+  static const std::vector<std::pair<std::string, std::vector<Key>>>
+      table =
+          {
+              {"scene",
+               {{"name", [](S& s, const toml::node& n, const std::string& f,
+                            const std::string& at) { s.name = as_text(n, f, at); }},
+                {"description", [](S& s, const toml::node& n, const std::string& f,
+                                   const std::string& at) { s.description = as_text(n, f, at); }},
+                {"solver", [](S& s, const toml::node& n, const std::string& f,
+                              const std::string& at) { s.solver = as_text(n, f, at); }},
+                {"seed",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   const std::int64_t v = as_integer(n, f, at);
+                   if (v < 0)
+                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [0, 2^63 - 1]");
+                   s.seed = static_cast<std::uint64_t>(v);
+                 }}}},
+              {"geometry",
+               {num("width_m", [](S& s) -> double& { return s.geometry.width_m; }),
+                num("height_m", [](S& s) -> double& { return s.geometry.height_m; }),
+                num("depth_m", [](S& s) -> double& { return s.geometry.depth_m; })}},
+              {"particles",
+               {num("diameter_m", [](S& s) -> double& { return s.particles.diameter_m; }),
+                num("density_kg_m3", [](S& s) -> double& { return s.particles.density_kg_m3; }),
+                num("restitution", [](S& s) -> double& { return s.particles.restitution; }),
+                num("friction", [](S& s) -> double& { return s.particles.friction; }),
+                num("spring_stiffness_n_m",
+                    [](S& s) -> double& { return s.particles.spring_stiffness_n_m; }),
+                {"count",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.particles.count = as_integer(n, f, at);
+                   if (s.particles.count <= 0) {
+                     bad(at + ": " + f + " = " + std::to_string(s.particles.count) +
+                         " is outside [1, 10000000]");
+                   }
+                 }},
+                num("bed_height_mf_m",
+                    [](S& s) -> double& { return s.particles.bed_height_mf_m; })}},
+              {"gas",
+               {num("density_kg_m3", [](S& s) -> double& { return s.gas.density_kg_m3; }),
+                num("viscosity_pa_s", [](S& s) -> double& { return s.gas.viscosity_pa_s; }),
+                num("gravity_m_s2", [](S& s) -> double& { return s.gas.gravity_m_s2; })}},
+              {"distributor",
+               {{"background",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   const std::string v = as_text(n, f, at);
+                   if (v == "umf") {
+                     s.distributor.mode = BackgroundMode::kUmf;
+                   } else if (v == "fixed") {
+                     s.distributor.mode = BackgroundMode::kFixed;
+                   } else {
+                     bad(at + ": " + f + " = '" + v + "' is not one of umf, fixed");
+                   }
+                 }},
+                num("umf_factor", [](S& s) -> double& { return s.distributor.umf_factor; }),
+                num("velocity_m_s", [](S& s) -> double& { return s.distributor.velocity_m_s; })}},
+              {"jet",
+               {num("slot_width_m", [](S& s) -> double& { return s.jet.slot_width_m; }),
+                num("velocity_m_s", [](S& s) -> double& { return s.jet.velocity_m_s; }),
+                num("center_m", [](S& s) -> double& { return s.jet.center_m; }),
+                num("start_s", [](S& s) -> double& { return s.jet.start_s; }),
+                num("duration_s", [](S& s) -> double& { return s.jet.duration_s; })}},
+              {"time",
+               {num("duration_s", [](S& s) -> double& { return s.time.duration_s; }),
+                num("t_ref_s", [](S& s) -> double& { return s.time.t_ref_s; }),
+                num("settle_s", [](S& s) -> double& { return s.time.settle_s; }),
+                num("dem_dt_s", [](S& s) -> double& { return s.time.dem_dt_s; }),
+                {"contact_steps",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   const std::int64_t v = as_integer(n, f, at);
+                   if (v < 20 || v > 1000) {
+                     bad(at + ": " + f + " = " + std::to_string(v) +
+                         " is outside [20, 1000] (DEM steps per contact time)");
+                   }
+                   s.time.contact_steps = static_cast<int>(v);
+                 }},
+                num("gas_dt_s", [](S& s) -> double& { return s.time.gas_dt_s; })}},
+              {"grid",
+               {{"cells_x",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   const std::int64_t v = as_integer(n, f, at);
+                   if (v < 1 || v > 100000)
+                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100000]");
+                   s.grid.cells_x = static_cast<int>(v);
+                 }},
+                {"cells_y",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   const std::int64_t v = as_integer(n, f, at);
+                   if (v < 1 || v > 100000)
+                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100000]");
+                   s.grid.cells_y = static_cast<int>(v);
+                 }}}},
+              {"bubble",
+               {num("eps_threshold", [](S& s) -> double& { return s.bubble.eps_threshold; }),
+                num("sample_interval_s",
+                    [](S& s) -> double& { return s.bubble.sample_interval_s; })}},
+              {"outputs",
+               {{"directory",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.outputs.directory = as_text(n, f, at);
+                 }},
+                {"fields", [](S& s, const toml::node& n, const std::string& f,
+                              const std::string& at) { s.outputs.fields = as_bool(n, f, at); }},
+                {"particles",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.outputs.particles = as_bool(n, f, at);
+                 }},
+                num("interval_s", [](S& s) -> double& { return s.outputs.interval_s; })}},
+              {"drag",
+               {{"laws",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.laws.clear();
+                   if (const toml::array* a = n.as_array()) {
+                     for (std::size_t i = 0; i < a->size(); ++i) {
+                       s.laws.push_back(as_text(*a->get(i), f + "[" + std::to_string(i) + "]", at));
+                     }
+                   } else {
+                     s.laws.push_back(as_text(n, f, at));
+                   }
+                 }},
+                num("eps_mf", [](S& s) -> double& { return s.eps_mf; }),
+                {"range_policy",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.range_policy = as_text(n, f, at);
+                 }}}},
+          };
+  return table;
+}
+
+}  // namespace
+
+const char* to_string(BackgroundMode mode) {
+  return mode == BackgroundMode::kUmf ? "umf" : "fixed";
+}
+
+Scene parse_scene(const std::string& toml_text, const std::string& origin) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, origin);
+  } catch (const toml::parse_error& e) {
+    bad(origin + ":" + std::to_string(e.source().begin.line) +
+        ": not valid TOML: " + std::string(e.description()));
+  }
+  Scene s;
+  s.origin = origin;
+  s.source_text = toml_text;
+  std::vector<std::string> section_names;
+  for (const auto& [name, keys] : sections()) section_names.push_back("[" + name + "]");
+  for (const auto& [section_key, section_node] : root) {
+    const std::string section(section_key.str());
+    const std::vector<Key>* keys = nullptr;
+    for (const auto& [name, k] : sections()) {
+      if (name == section) keys = &k;
+    }
+    if (!keys) {
+      bad(where(origin, section_node) + ": unknown section or key '" + section +
+          "' at the top level; valid sections: " + join(section_names));
+    }
+    const toml::table* table = section_node.as_table();
+    if (!table) bad(where(origin, section_node) + ": '" + section + "' must be a [section]");
+    for (const auto& [key_name, node] : *table) {
+      const std::string key(key_name.str());
+      const Key* found = nullptr;
+      std::vector<std::string> names;
+      for (const auto& k : *keys) {
+        names.push_back(k.name);
+        if (k.name == key) found = &k;
+      }
+      if (!found) {
+        bad(where(origin, node) + ": unknown key '" + key + "' in [" + section +
+            "]; valid keys: " + join(names));
+      }
+      found->read(s, node, "[" + section + "] " + key, where(origin, node));
+    }
+  }
+  std::string error;
+  if (!s.IsValid(&error)) bad(origin + ": " + error);
+  return s;
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(ErrorCode::kNotFound, "scene file '" + path + "' cannot be read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path);
+}
+
+bool Scene::IsValid(std::string* error) const {
+  if (name.empty()) return fail(error, "[scene] name is missing or empty");
+  for (char c : name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) {
+      return fail(error,
+                  "[scene] name '" + name + "' may contain only letters, digits, '_', '-' and '.'");
+    }
+  }
+  if (solver != "dpm") {
+    return fail(error, "[scene] solver = '" + solver + "' is not one of dpm (tfm, dbm: later)");
+  }
+  // Geometry: a laboratory pseudo-2D bed, millimetres to metres.
+  if (!in_range(geometry.width_m, 0.0, 10.0, true, false, "[geometry] width_m", "m", error) ||
+      !in_range(geometry.height_m, 0.0, 10.0, true, false, "[geometry] height_m", "m", error) ||
+      !in_range(geometry.depth_m, 0.0, 10.0, true, false, "[geometry] depth_m", "m", error)) {
+    return false;
+  }
+  const double d = particles.diameter_m;
+  if (!in_range(d, 0.0, 0.1, true, false, "[particles] diameter_m", "m", error)) return false;
+  if (!in_range(particles.density_kg_m3, 0.0, 30000.0, true, false, "[particles] density_kg_m3",
+                "kg/m^3", error) ||
+      !in_range(particles.restitution, 0.0, 1.0, true, false, "[particles] restitution", "",
+                error) ||
+      !in_range(particles.friction, 0.0, 1.0, false, false, "[particles] friction", "", error) ||
+      !in_range(particles.spring_stiffness_n_m, 0.0, 1e9, true, false,
+                "[particles] spring_stiffness_n_m", "N/m", error)) {
+    return false;
+  }
+  const double min_box = std::min({geometry.width_m, geometry.height_m, geometry.depth_m});
+  if (d > min_box) {
+    return fail(error, "[particles] diameter_m = " + fmt(d) +
+                           " does not fit the box: it must be <= the smallest box size " +
+                           fmt(min_box) + " m");
+  }
+  if (!in_range(gas.density_kg_m3, 0.0, 1000.0, true, false, "[gas] density_kg_m3", "kg/m^3",
+                error) ||
+      !in_range(gas.viscosity_pa_s, 0.0, 1.0, true, false, "[gas] viscosity_pa_s", "Pa s", error) ||
+      !in_range(gas.gravity_m_s2, 0.0, 100.0, true, false, "[gas] gravity_m_s2", "m/s^2", error)) {
+    return false;
+  }
+  if (!(particles.density_kg_m3 > gas.density_kg_m3)) {
+    return fail(error, "[particles] density_kg_m3 = " + fmt(particles.density_kg_m3) +
+                           " must exceed [gas] density_kg_m3 = " + fmt(gas.density_kg_m3) +
+                           " (the bed would not settle)");
+  }
+  if (!in_range(eps_mf, 0.26, 0.9, false, true, "[drag] eps_mf", "(random packings: 0.36-0.5)",
+                error)) {
+    return false;
+  }
+  const bool has_count = particles.count > 0;
+  const bool has_height = particles.bed_height_mf_m != 0.0;
+  if (has_count == has_height) {
+    return fail(error, "[particles] give exactly one of count and bed_height_mf_m");
+  }
+  if (has_height && !in_range(particles.bed_height_mf_m, 0.0, geometry.height_m, true, false,
+                              "[particles] bed_height_mf_m", "m (the box height)", error)) {
+    return false;
+  }
+  if (has_count && particles.count > 10000000) {
+    return fail(error, "[particles] count = " + std::to_string(particles.count) +
+                           " is outside [1, 10000000]");
+  }
+  const double h_mf = bed_height_mf_m();
+  if (h_mf > geometry.height_m) {
+    return fail(error, "[particles] count = " + std::to_string(particles.count) + " makes a bed " +
+                           fmt(h_mf) + " m high at eps_mf = " + fmt(eps_mf) +
+                           ": it does not fit the box ([geometry] height_m = " +
+                           fmt(geometry.height_m) + " m)");
+  }
+  if (h_mf < d) {
+    return fail(error, "[particles] the bed at eps_mf is " + fmt(h_mf) +
+                           " m high, less than one particle diameter (give more particles)");
+  }
+  // Distributor.
+  if (distributor.mode == BackgroundMode::kUmf) {
+    if (!in_range(distributor.umf_factor, 0.0, 10.0, false, false, "[distributor] umf_factor", "",
+                  error)) {
+      return false;
+    }
+  } else if (!in_range(distributor.velocity_m_s, 0.0, 100.0, true, false,
+                       "[distributor] velocity_m_s", "m/s (background = \"fixed\")", error)) {
+    return false;
+  }
+  // Jet.
+  if (!in_range(jet.slot_width_m, 0.0, geometry.width_m, true, false, "[jet] slot_width_m",
+                "m (0 < slot <= the bed width)", error) ||
+      !in_range(jet.velocity_m_s, 0.0, 300.0, false, false, "[jet] velocity_m_s",
+                "m/s (incompressible gas: Mach < 0.9)", error) ||
+      !in_range(jet.start_s, 0.0, 1e4, false, false, "[jet] start_s", "s", error) ||
+      !in_range(jet.duration_s, 0.0, 1e4, false, false, "[jet] duration_s", "s", error)) {
+    return false;
+  }
+  if (jet.center_m != -1.0) {  // -1: the default, the bed's centre line
+    const double half = 0.5 * jet.slot_width_m;
+    if (!in_range(jet.center_m, half, geometry.width_m - half, false, false, "[jet] center_m",
+                  "m (the slot must lie inside the bottom)", error)) {
+      return false;
+    }
+  }
+  // Times.
+  if (!in_range(time.duration_s, 0.0, 1e4, true, false, "[time] duration_s", "s", error) ||
+      !in_range(time.t_ref_s, 0.0, 1e4, false, false, "[time] t_ref_s", "s", error) ||
+      !in_range(time.settle_s, 0.0, 1e4, false, false, "[time] settle_s", "s", error) ||
+      !in_range(time.dem_dt_s, 0.0, 1.0, false, false, "[time] dem_dt_s", "s (0 = auto)", error) ||
+      !in_range(time.gas_dt_s, 0.0, 1.0, false, false, "[time] gas_dt_s", "s (0 = auto)", error)) {
+    return false;
+  }
+  if (time.contact_steps < 20 || time.contact_steps > 1000) {
+    return fail(error, "[time] contact_steps = " + std::to_string(time.contact_steps) +
+                           " is outside [20, 1000]");
+  }
+  if (jet.start_s + time.t_ref_s > time.duration_s * (1.0 + 1e-12)) {
+    return fail(error, "[time] t_ref_s = " + fmt(time.t_ref_s) + " after the jet start " +
+                           fmt(jet.start_s) + " s is beyond [time] duration_s = " +
+                           fmt(time.duration_s) + " s (t_ref_s <= duration_s - jet.start_s)");
+  }
+  if (time.dem_dt_s > 0.0) {
+    const double limit = contact_time_s(particles) / 20.0;
+    if (time.dem_dt_s > limit) {
+      return fail(error, "[time] dem_dt_s = " + fmt(time.dem_dt_s) +
+                             " s is above the stability limit t_c/20 = " + fmt(limit) +
+                             " s of the contact model (use 0 = auto, or a smaller step)");
+    }
+  }
+  // Grid: the void fraction needs cells at least one particle wide.
+  if (grid.cells_x < 1 || grid.cells_y < 1) {
+    return fail(error, "[grid] cells_x and cells_y must be >= 1 (got " +
+                           std::to_string(grid.cells_x) + ", " + std::to_string(grid.cells_y) +
+                           ")");
+  }
+  const double dx = geometry.width_m / grid.cells_x, dy = geometry.height_m / grid.cells_y;
+  if (dx < d || dy < d) {
+    return fail(
+        error,
+        "[grid] cells of " + fmt(dx) + " x " + fmt(dy) + " m are smaller than a particle (" +
+            fmt(d) +
+            " m): use at most width/d = " + std::to_string(static_cast<int>(geometry.width_m / d)) +
+            " cells_x and height/d = " + std::to_string(static_cast<int>(geometry.height_m / d)) +
+            " cells_y");
+  }
+  if (!in_range(bubble.eps_threshold, eps_mf, 1.0, true, true, "[bubble] eps_threshold",
+                "(eps_mf, 1)", error) ||
+      !in_range(bubble.sample_interval_s, 0.0, time.duration_s, true, false,
+                "[bubble] sample_interval_s", "s (0, duration_s]", error) ||
+      !in_range(outputs.interval_s, 0.0, time.duration_s, false, false, "[outputs] interval_s",
+                "s [0, duration_s]", error)) {
+    return false;
+  }
+  if (laws.empty()) return fail(error, "[drag] laws is missing or empty (e.g. [\"ergun@1\"])");
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < laws.size(); ++i) {
+    if (laws[i].empty() || laws[i].find_first_of(" \t,") != std::string::npos) {
+      return fail(error, "[drag] laws[" + std::to_string(i) + "] = '" + laws[i] +
+                             "' is not a law reference (name@version, e.g. ergun@1)");
+    }
+    if (!seen.insert(laws[i]).second) {
+      return fail(error, "[drag] laws lists '" + laws[i] + "' twice");
+    }
+  }
+  if (range_policy != "clamp" && range_policy != "extrapolate" && range_policy != "error") {
+    return fail(error, "[drag] range_policy = '" + range_policy +
+                           "' is not one of clamp, extrapolate, error");
+  }
+  return true;
+}
+
+void Scene::Validate() const {
+  std::string error;
+  if (!IsValid(&error)) bad((origin.empty() ? "" : origin + ": ") + error);
+}
+
+double Scene::particle_volume_m3() const {
+  const double d = particles.diameter_m;
+  return kPi * d * d * d / 6.0;
+}
+
+double Scene::particle_mass_kg() const { return particles.density_kg_m3 * particle_volume_m3(); }
+
+std::int64_t Scene::particle_count() const {
+  if (particles.count > 0) return particles.count;
+  const double solids =
+      (1.0 - eps_mf) * geometry.width_m * geometry.depth_m * particles.bed_height_mf_m;
+  return static_cast<std::int64_t>(std::llround(solids / particle_volume_m3()));
+}
+
+double Scene::bed_height_mf_m() const {
+  if (particles.count <= 0) return particles.bed_height_mf_m;
+  return static_cast<double>(particles.count) * particle_volume_m3() /
+         ((1.0 - eps_mf) * geometry.width_m * geometry.depth_m);
+}
+
+double Scene::jet_center_m() const {
+  return jet.center_m == -1.0 ? 0.5 * geometry.width_m : jet.center_m;
+}
+
+std::string Scene::hash() const { return sha256_hex(source_text); }
+
+double contact_time_s(const SceneParticles& p) {
+  const double d = p.diameter_m;
+  const double m_eff = 0.5 * p.density_kg_m3 * kPi * d * d * d / 6.0;
+  const double k = p.spring_stiffness_n_m;
+  const double log_e = std::log(p.restitution);
+  const double eta =
+      2.0 * std::sqrt(k * m_eff) * std::fabs(log_e) / std::sqrt(kPi * kPi + log_e * log_e);
+  return kPi / std::sqrt(k / m_eff - eta * eta / (4.0 * m_eff * m_eff));
+}
+
+}  // namespace consumers
+}  // namespace draglab

@@ -1,0 +1,163 @@
+// Scene files (consumers/scene.h): the shipped scenes parse to the values they declare, and every
+// bad input is refused with a message naming the field (and the range where one applies).
+// Set-up: data/scenes/dpm_bubble.toml (the seed's bed, consumers.md 2.1: 15 x 45 x 1.5 cm,
+// 2.5 mm glass, H_mf 22 cm at eps_mf 0.42 -> ~35 100 particles) and edits of it.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "draglab/consumers/scene.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+std::string read(const std::string& name) {
+  std::ifstream in(std::string(DRAGLAB_DATA_DIR) + "/scenes/" + name);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Replaces the first line starting with `key` (after the [section] header) by `line`.
+std::string edit(std::string text, const std::string& section, const std::string& key,
+                 const std::string& line) {
+  const std::size_t sec = text.find("[" + section + "]");
+  EXPECT_NE(sec, std::string::npos) << section;
+  const std::size_t at = text.find("\n" + key + " ", sec);
+  EXPECT_NE(at, std::string::npos) << key;
+  const std::size_t end = text.find('\n', at + 1);
+  return text.substr(0, at + 1) + line + text.substr(end);
+}
+
+/// Parses and expects kInvalidArgument whose message contains every `needle`.
+void expect_bad(const std::string& text, std::initializer_list<const char*> needles) {
+  try {
+    parse_scene(text, "edited.toml");
+    ADD_FAILURE() << "accepted; expected an error with " << *needles.begin();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_TRUE(e.is_bad_input());
+    for (const char* n : needles) {
+      EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << e.what() << " lacks " << n;
+    }
+  }
+}
+
+TEST(SceneParse, SeedSceneDeclaresTheSeedBed) {
+  const Scene s = load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_bubble.toml");
+  EXPECT_EQ(s.name, "dpm_bubble");
+  EXPECT_DOUBLE_EQ(s.geometry.width_m, 0.15);
+  EXPECT_DOUBLE_EQ(s.geometry.height_m, 0.45);
+  EXPECT_DOUBLE_EQ(s.geometry.depth_m, 0.015);
+  EXPECT_DOUBLE_EQ(s.particles.diameter_m, 2.5e-3);
+  EXPECT_DOUBLE_EQ(s.particles.density_kg_m3, 2526.0);
+  EXPECT_DOUBLE_EQ(s.particles.restitution, 0.97);
+  EXPECT_DOUBLE_EQ(s.particles.friction, 0.1);
+  EXPECT_DOUBLE_EQ(s.gas.density_kg_m3, 1.2);
+  EXPECT_DOUBLE_EQ(s.gas.viscosity_pa_s, 1.8e-5);
+  EXPECT_DOUBLE_EQ(s.bed_height_mf_m(), 0.22);
+  // N = (1 - eps_mf) W D H / (pi d^3/6) = 0.58 * 0.15 * 0.015 * 0.22 / 8.181e-9 = 35 093.
+  EXPECT_NEAR(static_cast<double>(s.particle_count()), 35093.0, 1.0);
+  EXPECT_EQ(s.distributor.mode, BackgroundMode::kUmf);
+  EXPECT_DOUBLE_EQ(s.time.t_ref_s, 0.3);
+  EXPECT_DOUBLE_EQ(s.jet_center_m(), 0.075);
+  EXPECT_DOUBLE_EQ(s.bubble.eps_threshold, 0.8);
+  EXPECT_EQ(s.laws.size(), 5u);
+  EXPECT_EQ(s.hash().size(), 64u);
+  const Scene q = load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_bubble_quick.toml");
+  EXPECT_LT(q.particle_count(), 5000);
+  EXPECT_NE(q.hash(), s.hash());
+}
+
+TEST(SceneParse, CountAndHeightAreInterchangeable) {
+  std::string text = read("dpm_bubble.toml");
+  text = edit(text, "particles", "bed_height_mf_m", "count = 35093");
+  const Scene s = parse_scene(text);
+  EXPECT_NEAR(s.bed_height_mf_m(), 0.22, 1e-5);
+  EXPECT_EQ(s.particle_count(), 35093);
+}
+
+TEST(SceneParse, FixedBackground) {
+  const Scene s = parse_scene(
+      edit(read("dpm_bubble.toml"), "distributor", "background", "background = \"fixed\""));
+  EXPECT_EQ(s.distributor.mode, BackgroundMode::kFixed);
+  EXPECT_DOUBLE_EQ(s.distributor.velocity_m_s, 1.26);
+}
+
+TEST(SceneParse, EveryBadInputIsNamed) {
+  const std::string base = read("dpm_bubble.toml");
+  expect_bad(base + "\n[extra]\nx = 1\n", {"unknown section", "extra", "[geometry]"});
+  expect_bad(edit(base, "geometry", "width_m", "widht_m = 0.15"),
+             {"unknown key", "widht_m", "width_m"});
+  expect_bad(edit(base, "geometry", "width_m", "width_m = \"wide\""),
+             {"[geometry] width_m", "number"});
+  expect_bad("[scene\nname=1", {"not valid TOML"});
+  expect_bad(edit(base, "particles", "diameter_m", "diameter_m = 0.0"),
+             {"[particles] diameter_m", "(0, "});
+  expect_bad(edit(base, "particles", "diameter_m", "diameter_m = -2.5e-3"),
+             {"[particles] diameter_m"});
+  expect_bad(edit(base, "particles", "density_kg_m3", "density_kg_m3 = 0"),
+             {"[particles] density_kg_m3", "(0, "});
+  expect_bad(edit(base, "particles", "density_kg_m3", "density_kg_m3 = -2526"),
+             {"[particles] density_kg_m3"});
+  expect_bad(edit(base, "gas", "density_kg_m3", "density_kg_m3 = 0"),
+             {"[gas] density_kg_m3", "(0, "});
+  expect_bad(edit(base, "gas", "viscosity_pa_s", "viscosity_pa_s = -1e-5"),
+             {"[gas] viscosity_pa_s"});
+  expect_bad(edit(base, "particles", "density_kg_m3", "density_kg_m3 = 1.0"), {"must exceed"});
+  expect_bad(edit(base, "particles", "restitution", "restitution = 1.2"),
+             {"[particles] restitution", "(0, 1]"});
+  expect_bad(edit(base, "particles", "friction", "friction = -0.1"),
+             {"[particles] friction", "[0, 1]"});
+  expect_bad(edit(base, "particles", "diameter_m", "diameter_m = 0.02"), {"does not fit the box"});
+  // A jet wider than the bed; a slot that sticks out of the bottom.
+  expect_bad(edit(base, "jet", "slot_width_m", "slot_width_m = 0.2"),
+             {"[jet] slot_width_m", "width"});
+  expect_bad(edit(base, "jet", "slot_width_m", "slot_width_m = 0.01\ncenter_m = 0.149"),
+             {"[jet] center_m"});
+  expect_bad(edit(base, "jet", "velocity_m_s", "velocity_m_s = -5"), {"[jet] velocity_m_s"});
+  // A bed that does not fit the box, by height or by count; both or neither given.
+  expect_bad(edit(base, "particles", "bed_height_mf_m", "bed_height_mf_m = 0.5"),
+             {"[particles] bed_height_mf_m", "box height"});
+  expect_bad(edit(base, "particles", "bed_height_mf_m", "count = 100000"),
+             {"does not fit the box"});
+  expect_bad(edit(base, "particles", "bed_height_mf_m", "bed_height_mf_m = 0.22\ncount = 1000"),
+             {"exactly one of count and bed_height_mf_m"});
+  expect_bad(edit(base, "particles", "bed_height_mf_m", "# none"), {"exactly one"});
+  expect_bad(edit(base, "particles", "bed_height_mf_m", "count = 0"), {"[particles] count"});
+  // Times and steps: a DEM step above t_c/20 (t_c = 1.2e-4 s) is refused.
+  expect_bad(edit(base, "time", "dem_dt_s", "dem_dt_s = 1e-5"),
+             {"[time] dem_dt_s", "stability limit"});
+  expect_bad(edit(base, "time", "contact_steps", "contact_steps = 10"),
+             {"[time] contact_steps", "[20, 1000]"});
+  expect_bad(edit(base, "time", "t_ref_s", "t_ref_s = 0.5"), {"[time] t_ref_s", "duration_s"});
+  expect_bad(edit(base, "time", "duration_s", "duration_s = 0"), {"[time] duration_s"});
+  expect_bad(edit(base, "grid", "cells_x", "cells_x = 100"), {"[grid]", "smaller than a particle"});
+  expect_bad(edit(base, "grid", "cells_y", "cells_y = 0"), {"[grid] cells_y", "[1, 100000]"});
+  expect_bad(edit(base, "bubble", "eps_threshold", "eps_threshold = 0.3"),
+             {"[bubble] eps_threshold"});
+  expect_bad(edit(base, "bubble", "eps_threshold", "eps_threshold = 1.0"),
+             {"[bubble] eps_threshold"});
+  expect_bad(edit(base, "drag", "eps_mf", "eps_mf = 0.95"), {"[drag] eps_mf"});
+  expect_bad(edit(base, "drag", "laws", "laws = []"), {"[drag] laws", "empty"});
+  expect_bad(edit(base, "drag", "laws", "laws = [\"ergun@1\", \"ergun@1\"]"), {"twice"});
+  expect_bad(edit(base, "drag", "laws", "laws = [3]"), {"[drag] laws[0]", "string"});
+  expect_bad(edit(base, "drag", "range_policy", "range_policy = \"ignore\""),
+             {"[drag] range_policy"});
+  expect_bad(edit(base, "distributor", "background", "background = \"plate\""),
+             {"[distributor] background", "umf, fixed"});
+  expect_bad(edit(edit(base, "distributor", "background", "background = \"fixed\""), "distributor",
+                  "velocity_m_s", "velocity_m_s = 0"),
+             {"[distributor] velocity_m_s"});
+  expect_bad(edit(base, "scene", "solver", "solver = \"lbm\""), {"[scene] solver"});
+  expect_bad(edit(base, "scene", "name", "name = \"a b\""), {"[scene] name"});
+  EXPECT_THROW(load_scene("/nonexistent/scene.toml"), Error);
+}
+
+}  // namespace
+}  // namespace consumers
+}  // namespace draglab
