@@ -74,6 +74,9 @@ TEST(DatasetStore, HashDependsOnPointsOnly) {
   Dataset c = sample();
   c.points[3].F = std::nextafter(c.points[3].F, 1e9);  // one ulp
   EXPECT_NE(dataset_hash(a.points), dataset_hash(c.points));
+  Dataset slower = sample();
+  slower.points[2].wall_s *= 3.0;  // the machine's speed is not part of the identity
+  EXPECT_EQ(dataset_hash(a.points), dataset_hash(slower.points));
   Dataset swapped = sample();
   std::swap(swapped.points[0], swapped.points[1]);
   EXPECT_NE(dataset_hash(a.points), dataset_hash(swapped.points));

@@ -36,7 +36,9 @@ std::string exact(double x) {
 
 // Canonical JSON: fixed key order (nlohmann::json sorts object keys), doubles as %.17g strings so
 // that the text, and the hash, do not depend on the JSON library's number formatting.
-nlohmann::json canonical_points(const std::vector<DatasetPoint>& points) {
+// `with_timing`: include wall_s. The hash leaves it out, so that the same measurements made on
+// another machine, or re-run, are the same dataset; the stored JSON keeps it.
+nlohmann::json canonical_points(const std::vector<DatasetPoint>& points, bool with_timing) {
   nlohmann::json array = nlohmann::json::array();
   for (const DatasetPoint& p : points) {
     nlohmann::json resolutions = nlohmann::json::array(), at = nlohmann::json::array();
@@ -53,8 +55,8 @@ nlohmann::json canonical_points(const std::vector<DatasetPoint>& points) {
                      {"resolutions", resolutions},
                      {"F_at_resolution", at},
                      {"order", exact(p.order)},
-                     {"extrapolation", p.extrapolation},
-                     {"wall_s", exact(p.wall_s)}});
+                     {"extrapolation", p.extrapolation}});
+    if (with_timing) array.back()["wall_s"] = exact(p.wall_s);
   }
   return array;
 }
@@ -132,7 +134,7 @@ void validate_point(const DatasetPoint& p, const std::string& where) {
 }  // namespace
 
 std::string dataset_hash(const std::vector<DatasetPoint>& points) {
-  return sha256_hex(canonical_points(points).dump());
+  return sha256_hex(canonical_points(points, false).dump());
 }
 
 Dataset store_dataset(Database& database, Dataset dataset) {
@@ -143,8 +145,8 @@ Dataset store_dataset(Database& database, Dataset dataset) {
   for (std::size_t i = 0; i < dataset.points.size(); ++i) {
     validate_point(dataset.points[i], "dataset '" + dataset.name + "', point " + std::to_string(i));
   }
-  const std::string points_json = canonical_points(dataset.points).dump();
-  dataset.hash = sha256_hex(points_json);
+  const std::string points_json = canonical_points(dataset.points, true).dump();
+  dataset.hash = dataset_hash(dataset.points);
   dataset.id = dataset.hash.substr(0, 12);
   if (dataset.created_at.empty()) dataset.created_at = db::utc_now_iso8601();
   if (dataset.code_version.empty()) dataset.code_version = kDragDbVersion;

@@ -52,7 +52,8 @@ struct Dataset {
 /// packings.
 std::string sha256_hex(const std::string& data);
 
-/// SHA-256 (hex) of the canonical JSON of the points (values as %.17g); stable across runs.
+/// SHA-256 (hex) of the canonical JSON of the points (values as %.17g) without their wall_s:
+/// the measurements, not the machine's speed, identify a dataset.
 std::string dataset_hash(const std::vector<DatasetPoint>& points);
 
 /// Stores `dataset` (computing hash and id; created_at and code_version if empty) in one
