@@ -2,6 +2,7 @@
 // numbers a scene implies.
 //   draglab scene umf data/scenes/dpm_bubble.toml [--law ergun@1,bvk2007@1] [--json]
 //   draglab scene check data/scenes/dpm_bubble.toml [--json]
+//   draglab scene run data/scenes/dpm_bubble_quick.toml [--law ergun@1] [--duration S] [--json]
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -11,6 +12,8 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "cli/progress.h"
+#include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/error.h"
 
@@ -22,7 +25,8 @@ using consumers::Scene;
 
 struct SceneArgs {
   std::string scene_path;
-  std::string laws;  // --law a,b,c
+  std::string laws;       // --law a,b,c
+  double duration_s = 0;  // scene run --duration (0: the scene's)
 };
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -161,6 +165,81 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
                "step is not limited by it; D* = q/(pi U_mf) (Davidson-Harrison with leakage).\n";
 }
 
+void run_run(const CliContext& ctx, const SceneArgs& args) {
+  const Scene scene = consumers::load_scene(args.scene_path);
+  if (scene.solver != "dpm")
+    throw Error(ErrorCode::kInvalidArgument,
+                "scene.solver: `scene run` supports \"dpm\" only (this release), got \"" +
+                    scene.solver + "\"");
+  if (args.duration_s < 0.0) throw UsageError("--duration must be >= 0 (0: the scene's)");
+  const std::string ref = args.laws.empty() ? scene.laws.front() : args.laws;
+  if (ref.find(',') != std::string::npos)
+    throw UsageError("--law: `scene run` takes one NAME@V (use `draglab sensitivity` for several)");
+  auto db = ctx.open_database();
+  std::string warning;
+  std::shared_ptr<const Law> law =
+      db->load(ref, range_policy_from_string(scene.range_policy), &warning);
+  if (!warning.empty()) ctx.warn(warning);
+  consumers::DpmOptions options;
+  options.duration_s = args.duration_s;
+  consumers::DpmSimulation sim(scene, law, options);
+  ProgressLine progress(!ctx.quiet);
+  const consumers::DpmResult r =
+      sim.Run([&](double f, const std::string& stage) { progress.update(f, stage); });
+  progress.finish();
+  if (r.void_fraction_clamps > 0)
+    ctx.warn(fmt::format("{} cell void fractions were raised to the minimum (dense packing)",
+                         r.void_fraction_clamps));
+  if (ctx.json) {
+    nlohmann::json series = nlohmann::json::array();
+    for (const auto& smp : r.series) {
+      series.push_back({{"t_s", smp.t_s},
+                        {"bubble_diameter_m", smp.bubble_diameter_m},
+                        {"bubble_centroid_m", smp.bubble_centroid_m},
+                        {"bed_height_m", smp.bed_height_m},
+                        {"pressure_drop_pa", smp.pressure_drop_pa}});
+    }
+    ctx.print_json(
+        {{"scene", r.scene},
+         {"scene_hash", r.scene_hash},
+         {"law", r.law},
+         {"umf_m_s", r.umf_m_s},
+         {"background_m_s", r.background_m_s},
+         {"background", r.background_mode},
+         {"eps_mf", r.eps_mf},
+         {"bubble_diameter_m",
+          r.bubble_at_t_ref ? nlohmann::json(r.bubble_diameter_m) : nlohmann::json(nullptr)},
+         {"t_ref_s", r.t_ref_s},
+         {"series", series},
+         {"particles", r.particles},
+         {"settled_bed_height_m", r.settled_bed_height_m},
+         {"gas_dt_s", r.gas_dt_s},
+         {"dem_dt_s", r.dem_dt_s},
+         {"gas_steps", r.gas_steps},
+         {"dem_steps", r.dem_steps},
+         {"wall_s", r.wall_s},
+         {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
+         {"momentum_mismatch", r.momentum_mismatch},
+         {"void_fraction_clamps", r.void_fraction_clamps},
+         {"drag_out_of_range", r.law_out_of_range},
+         {"numerical_uncertainty", nullptr},
+         {"numerical_uncertainty_reason",
+          "one grid and one packing realization run; the uncertainty needs two grids or two "
+          "realizations (draglab sensitivity)"}});
+    return;
+  }
+  std::cout << r.BriefReport() << "\n";
+  std::cout << fmt::format("{:>9} {:>10} {:>11} {:>10} {:>10}\n", "t-jet s", "D m", "centroid m",
+                           "bed m", "dp Pa");
+  for (const auto& smp : r.series) {
+    std::cout << fmt::format("{:>9.3f} {:>10.4f} {:>11.4f} {:>10.4f} {:>10.1f}\n", smp.t_s,
+                             smp.bubble_diameter_m, smp.bubble_centroid_m, smp.bed_height_m,
+                             smp.pressure_drop_pa);
+  }
+  std::cout << "  numerical uncertainty: not estimated (one grid, one packing; see draglab "
+               "sensitivity)\n";
+}
+
 }  // namespace
 
 void add_scene_commands(CLI::App& app, CliContext& ctx) {
@@ -192,6 +271,20 @@ void add_scene_commands(CLI::App& app, CliContext& ctx) {
   check->footer("Example:\n  draglab scene check data/scenes/dpm_bubble_quick.toml --json");
   check->callback(
       [&ctx, check_args] { ctx.action = [&ctx, check_args] { run_check(ctx, *check_args); }; });
+
+  auto run_args = std::make_shared<SceneArgs>();
+  auto* run = scene->add_subcommand(
+      "run",
+      "Run a DPM scene (CFD-DEM, docs/dpm.md) with one law: settle, fluidize, inject the jet's "
+      "bubble; prints U_mf, the background velocity used, the bubble diameter at t_ref and the "
+      "time series (progress with ETA on stderr)");
+  run->add_option("SCENE", run_args->scene_path, "Scene file (TOML)")->required();
+  run->add_option("--law", run_args->laws, "One law NAME@V (default: the scene's first)");
+  run->add_option("--duration", run_args->duration_s,
+                  "Simulated time after the flow starts [s] (default: the scene's)");
+  run->footer(
+      "Example:\n  draglab scene run data/scenes/dpm_bubble_quick.toml --law ergun@1 --json");
+  run->callback([&ctx, run_args] { ctx.action = [&ctx, run_args] { run_run(ctx, *run_args); }; });
 }
 
 }  // namespace cli

@@ -1,0 +1,480 @@
+// DpmSimulation: the coupled CFD-DEM run (draglab/consumers/dpm.h, docs/dpm.md).
+#include "draglab/consumers/dpm.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+[[noreturn]] void Fail(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+std::string Num(double x) {
+  std::ostringstream s;
+  s.precision(4);
+  s << x;
+  return s.str();
+}
+
+/// Bilinear tent kernel on cell centres: the two cells (per axis) around the point and their
+/// weights; weight that would fall outside the grid is folded into the boundary cell, so the
+/// mapped solids volume is exactly the particles' volume and eps stays continuous as particles
+/// cross cell faces.
+struct Tent {
+  int i[2], j[2];
+  double wx[2], wz[2];
+};
+Tent TentAt(double x, double z, double dx, double dz, int nx, int nz) {
+  Tent t;
+  const double sx = x / dx - 0.5, sz = z / dz - 0.5;
+  const double fx = std::floor(sx), fz = std::floor(sz);
+  const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fz);
+  t.wx[1] = sx - fx;
+  t.wx[0] = 1.0 - t.wx[1];
+  t.wz[1] = sz - fz;
+  t.wz[0] = 1.0 - t.wz[1];
+  t.i[0] = std::clamp(i0, 0, nx - 1);
+  t.i[1] = std::clamp(i0 + 1, 0, nx - 1);
+  t.j[0] = std::clamp(j0, 0, nz - 1);
+  t.j[1] = std::clamp(j0 + 1, 0, nz - 1);
+  return t;
+}
+
+}  // namespace
+
+bool DpmOptions::IsValid(std::string* error) const {
+  auto bad = [&](const std::string& m) {
+    if (error) *error = "DpmOptions." + m;
+    return false;
+  };
+  if (!(duration_s >= 0.0) || !std::isfinite(duration_s))
+    return bad("duration_s must be >= 0 (0: the scene's), got " + Num(duration_s));
+  if (!std::isfinite(background_override_m_s))
+    return bad("background_override_m_s must be finite (< 0: from the scene)");
+  if (!(min_void_fraction > 0.0 && min_void_fraction < 0.5))
+    return bad("min_void_fraction must be in (0, 0.5), got " + Num(min_void_fraction));
+  if (!(settle_kinetic_tolerance > 0.0 && settle_kinetic_tolerance <= 1e-2))
+    return bad("settle_kinetic_tolerance must be in (0, 1e-2], got " +
+               Num(settle_kinetic_tolerance));
+  if (!(settle_max_time_s > 0.0) || !std::isfinite(settle_max_time_s))
+    return bad("settle_max_time_s must be > 0, got " + Num(settle_max_time_s));
+  if (!(gas_dt_s >= 0.0) || !std::isfinite(gas_dt_s))
+    return bad("gas_dt_s must be >= 0 (0: from the scene), got " + Num(gas_dt_s));
+  return true;
+}
+
+std::string DpmResult::BriefReport() const {
+  std::ostringstream s;
+  s << "DPM " << scene << " with " << law << ": U_mf = " << Num(umf_m_s)
+    << " m/s, background = " << Num(background_m_s) << " m/s (" << background_mode
+    << "), eps_mf = " << eps_mf << "\n  " << particles << " particles, settled bed "
+    << Num(settled_bed_height_m) << " m; " << gas_steps << " gas steps of " << Num(gas_dt_s)
+    << " s, " << dem_steps << " DEM steps of " << Num(dem_dt_s) << " s; wall " << Num(wall_s)
+    << " s (settling " << Num(settle_wall_s) << " s)\n  bubble D at t_ref = " << Num(t_ref_s)
+    << " s: " << (bubble_at_t_ref ? Num(bubble_diameter_m) + " m" : std::string("none"))
+    << "\n  gas mass imbalance (max rel.) " << Num(max_relative_mass_imbalance)
+    << ", momentum mismatch " << Num(momentum_mismatch) << ", action-reaction max "
+    << Num(max_action_reaction_mismatch_n) << " N, eps clamps " << void_fraction_clamps
+    << ", drag out of range " << law_out_of_range;
+  return s.str();
+}
+
+struct DpmSimulation::Impl {
+  std::unique_ptr<DemSystem> dem;
+  std::unique_ptr<GasPhase> gas;
+  Eigen::ArrayXXd eps, beta, upx, upz;
+  std::vector<double> c;  // per-particle drag coefficient c_p [kg/s]
+  DpmStepDiagnostics diag;
+  double time = 0.0;
+  // Vertical momentum bookkeeping (gas + particles).
+  double impulse_z = 0.0;
+  double wall_impulse_step = 0.0;
+};
+
+DpmSimulation::DpmSimulation(const Scene& scene, std::shared_ptr<const Law> law,
+                             const DpmOptions& options)
+    : scene_(scene), law_(std::move(law)), opt_(options), impl_(std::make_unique<Impl>()) {
+  scene_.Validate();
+  std::string why;
+  if (!opt_.IsValid(&why)) Fail(why);
+  if (!law_) Fail("DpmSimulation: law is null (load it with Database::load)");
+  if (std::abs(scene_.jet_center_m() - 0.5 * scene_.geometry.width_m) >
+      1e-9 * scene_.geometry.width_m)
+    Fail("jet.center_m: the DPM gas solver supports only a central slot (width / 2 = " +
+         Num(0.5 * scene_.geometry.width_m) + " m), got " + Num(scene_.jet_center_m()));
+}
+
+DpmSimulation::~DpmSimulation() = default;
+
+const GasPhase& DpmSimulation::gas() const {
+  if (!impl_->gas) Fail("DpmSimulation::gas: call Settle() first");
+  return *impl_->gas;
+}
+const DemSystem& DpmSimulation::dem() const {
+  if (!impl_->dem) Fail("DpmSimulation::dem: call Settle() first");
+  return *impl_->dem;
+}
+double DpmSimulation::time() const { return impl_->time; }
+
+double DpmSimulation::bed_weight_n() const {
+  const double n = impl_->dem ? static_cast<double>(impl_->dem->particles().size())
+                              : static_cast<double>(scene_.particle_count());
+  return n * scene_.particle_mass_kg() * scene_.gas.gravity_m_s2 *
+         (1.0 - scene_.gas.density_kg_m3 / scene_.particles.density_kg_m3);
+}
+
+void DpmSimulation::Settle(const DpmProgress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Scene& s = scene_;
+  const DemOptions d = MakeDemOptions();
+  SettleOptions so;
+  so.n = static_cast<int>(s.particle_count());
+  so.diameter = s.particles.diameter_m;
+  so.density = s.particles.density_kg_m3;
+  so.seed = s.seed;
+  so.kinetic_energy_tolerance = opt_.settle_kinetic_tolerance;
+  so.max_time = opt_.settle_max_time_s;
+  SettleResult settled = settle_particles(d, so, [&](double f, const std::string& stage) {
+    if (progress) progress(f, "settle: " + stage);
+  });
+  Start(std::move(settled.particles));
+  result_.settle_wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+DemOptions DpmSimulation::MakeDemOptions() const {
+  const Scene& s = scene_;
+  DemOptions d;
+  d.box_max = {s.geometry.width_m, s.geometry.height_m, s.geometry.depth_m};
+  d.gravity = {0.0, -s.gas.gravity_m_s2, 0.0};
+  d.normal_stiffness = s.particles.spring_stiffness_n_m;
+  d.restitution = d.wall_restitution = s.particles.restitution;
+  d.friction = d.wall_friction = s.particles.friction;
+  d.dt = s.time.dem_dt_s;
+  d.min_steps_per_contact = s.time.contact_steps;
+  return d;
+}
+
+void DpmSimulation::Start(Particles settled) {
+  const Scene& s = scene_;
+  const double settle_wall_s = result_.settle_wall_s;
+  settled_height_ = 0.0;
+  for (std::size_t n = 0; n < settled.size(); ++n)
+    settled_height_ = std::max(settled_height_, settled.y[n] + 0.5 * settled.diameter[n]);
+  impl_->dem = std::make_unique<DemSystem>(MakeDemOptions(), std::move(settled));
+
+  // Gas. Incompressible: the jet's Mach number is < 0.1 (scene.h), so density changes are
+  // < 0.5 % and a pressure projection is cheaper and more robust than a weakly compressible gas.
+  const SceneDerived derived = derive_scene(s, *law_);
+  result_ = DpmResult{};
+  result_.settle_wall_s = settle_wall_s;
+  result_.law = law_->record().name + "@" + std::to_string(law_->record().version);
+  result_.scene = s.name;
+  result_.scene_hash = s.hash();
+  result_.umf_m_s = derived.umf.umf_m_s;
+  result_.eps_mf = s.eps_mf;
+  result_.t_ref_s = s.time.t_ref_s;
+  if (opt_.background_override_m_s >= 0.0) {
+    result_.background_m_s = opt_.background_override_m_s;
+    result_.background_mode = "override";
+  } else {
+    result_.background_m_s = derived.background_m_s;
+    result_.background_mode = to_string(s.distributor.mode);
+  }
+  GasOptions g;
+  g.nx = s.grid.cells_x;
+  g.nz = s.grid.cells_y;
+  g.width_m = s.geometry.width_m;
+  g.height_m = s.geometry.height_m;
+  g.depth_m = s.geometry.depth_m;
+  g.rho_g = s.gas.density_kg_m3;
+  g.mu_g = s.gas.viscosity_pa_s;
+  g.gravity_z = -s.gas.gravity_m_s2;
+  g.side_walls = WallSlip::kNoSlip;
+  g.background_velocity_m_s = result_.background_m_s;
+  if (opt_.jet) {
+    g.jet_width_m = s.jet.slot_width_m;
+    g.jet_velocity_m_s = s.jet.velocity_m_s;
+    g.jet_start_s = s.jet.start_s;
+    g.jet_duration_s = s.jet.duration_s;
+  }
+  impl_->gas = std::make_unique<GasPhase>(g);
+  gas_dt_ = opt_.gas_dt_s > 0.0     ? opt_.gas_dt_s
+            : s.time.gas_dt_s > 0.0 ? s.time.gas_dt_s
+                                    : derived.recommended_gas_dt_s;
+  // The gas step is a whole number of DEM steps (DEM step from the contact time, never above).
+  const double dem_max = impl_->dem->time_step();
+  const double k = std::max(1.0, std::ceil(gas_dt_ / dem_max - 1e-9));
+  result_.dem_dt_s = gas_dt_ / k;
+  result_.gas_dt_s = gas_dt_;
+  result_.particles = static_cast<std::int64_t>(impl_->dem->particles().size());
+  result_.settled_bed_height_m = settled_height_;
+  const int nx = g.nx, nz = g.nz;
+  impl_->eps = Eigen::ArrayXXd::Ones(nx, nz);
+  impl_->beta = impl_->upx = impl_->upz = Eigen::ArrayXXd::Zero(nx, nz);
+  impl_->time = 0.0;
+  // Initial void fraction (no time derivative implied).
+  {
+    const auto& p = impl_->dem->particles();
+    const double dx = impl_->gas->dx(), dz = impl_->gas->dz();
+    const double vcell = dx * dz * s.geometry.depth_m;
+    Eigen::ArrayXXd solid = Eigen::ArrayXXd::Zero(nx, nz);
+    for (std::size_t n = 0; n < p.size(); ++n) {
+      const Tent t = TentAt(p.x[n], p.y[n], dx, dz, nx, nz);
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) solid(t.i[a], t.j[b]) += p.volume(n) * t.wx[a] * t.wz[b];
+    }
+    impl_->eps = (1.0 - solid / vcell).max(opt_.min_void_fraction);
+    impl_->gas->SetVoidFraction(impl_->eps);
+  }
+}
+
+GridField2D DpmSimulation::VoidFractionField() const {
+  GridField2D f;
+  f.nx = scene_.grid.cells_x;
+  f.ny = scene_.grid.cells_y;
+  f.width_m = scene_.geometry.width_m;
+  f.height_m = scene_.geometry.height_m;
+  f.values.resize(static_cast<std::size_t>(f.nx) * f.ny);
+  for (int j = 0; j < f.ny; ++j)
+    for (int i = 0; i < f.nx; ++i)
+      f.values[static_cast<std::size_t>(j) * f.nx + i] = impl_->eps(i, j);
+  return f;
+}
+
+const DpmStepDiagnostics& DpmSimulation::Step() {
+  if (!impl_->gas) Fail("DpmSimulation::Step: call Settle() first");
+  Impl& m = *impl_;
+  GasPhase& gas = *m.gas;
+  DemSystem& dem = *m.dem;
+  Particles& p = dem.mutable_particles();
+  const int nx = gas.options().nx, nz = gas.options().nz;
+  const double dx = gas.dx(), dz = gas.dz(), depth = scene_.geometry.depth_m;
+  const double vcell = dx * dz * depth;
+  const double mu = scene_.gas.viscosity_pa_s, rho_g = scene_.gas.density_kg_m3;
+  const std::size_t np = p.size();
+  DpmStepDiagnostics& diag = m.diag;
+  diag = DpmStepDiagnostics{};
+
+  // Cell-centred gas velocity (average of the two faces): the field the kernel interpolates.
+  Eigen::ArrayXXd ugx(nx, nz), ugz(nx, nz);
+  auto centre_velocity = [&]() {
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        ugx(i, j) = 0.5 * (gas.u()(i, j) + gas.u()(i + 1, j));
+        ugz(i, j) = 0.5 * (gas.w()(i, j) + gas.w()(i, j + 1));
+      }
+  };
+  centre_velocity();
+
+  // 1. Particles -> grid: void fraction.
+  std::vector<Tent> tents(np);
+  Eigen::ArrayXXd solid = Eigen::ArrayXXd::Zero(nx, nz);
+  for (std::size_t n = 0; n < np; ++n) {
+    tents[n] = TentAt(p.x[n], p.y[n], dx, dz, nx, nz);
+    const Tent& t = tents[n];
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) solid(t.i[a], t.j[b]) += p.volume(n) * t.wx[a] * t.wz[b];
+  }
+  Eigen::ArrayXXd eps_next = 1.0 - solid / vcell;
+  diag.min_void_fraction = eps_next.minCoeff();
+  if (!std::isfinite(diag.min_void_fraction) || eps_next.maxCoeff() > 1.0 + 1e-12)
+    Fail("DPM: the mapped void fraction left (0, 1] at t = " + Num(m.time) +
+         " s (non-finite or > 1): the particle state diverged; reduce the DEM step "
+         "(time.contact_steps) or the gas step (time.gas_dt_s)");
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i)
+      if (eps_next(i, j) < opt_.min_void_fraction) {
+        eps_next(i, j) = opt_.min_void_fraction;
+        ++result_.void_fraction_clamps;
+      }
+
+  // 2. Per particle: eps and gas velocity at the centre (transpose of the mapping), beta, c_p.
+  m.c.assign(np, 0.0);
+  auto interp = [&](const Eigen::ArrayXXd& f, const Tent& t) {
+    double v = 0.0;
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) v += f(t.i[a], t.j[b]) * t.wx[a] * t.wz[b];
+    return v;
+  };
+  Eigen::ArrayXXd csum = Eigen::ArrayXXd::Zero(nx, nz), cux = csum, cuz = csum;
+  for (std::size_t n = 0; n < np; ++n) {
+    const Tent& t = tents[n];
+    const double eps_p = std::min(1.0, interp(eps_next, t));
+    const double sx = interp(ugx, t) - p.vx[n], sz = interp(ugz, t) - p.vy[n];
+    const double slip = std::hypot(sx, sz);
+    // dga = beta / phi: c_p = beta V_p / (1 - eps) without the 0/0 at eps = 1.
+    m.c[n] = law_->dga(eps_p, mu, rho_g, slip, p.diameter[n]) * p.volume(n);
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) {
+        const double cw = m.c[n] * t.wx[a] * t.wz[b];
+        csum(t.i[a], t.j[b]) += cw;
+        cux(t.i[a], t.j[b]) += cw * p.vx[n];
+        cuz(t.i[a], t.j[b]) += cw * p.vy[n];
+      }
+  }
+  m.beta = csum / vcell;
+  m.upx = (csum > 0.0).select(cux / csum, 0.0);
+  m.upz = (csum > 0.0).select(cuz / csum, 0.0);
+
+  // 3. Gas step with implicit drag.
+  gas.SetSolids(eps_next, m.beta, m.upx, m.upz);
+  try {
+    gas.Step(gas_dt_);
+  } catch (const Error& e) {
+    throw Error(e.code(), "DPM stopped at t = " + Num(m.time) + " s (gas): " + e.what());
+  }
+  m.eps = eps_next;
+  centre_velocity();
+
+  // 4. Grid -> particles: drag with the new gas velocity (implicit on both sides) and the
+  // pressure-gradient force; gas-side drag of the cell fields for the action-reaction check.
+  for (std::size_t n = 0; n < np; ++n) {
+    const Tent& t = tents[n];
+    const double fx = m.c[n] * (interp(ugx, t) - p.vx[n]);
+    const double fz = m.c[n] * (interp(ugz, t) - p.vy[n]);
+    const Eigen::Vector2d gp = gas.PressureGradientAt(p.x[n], p.y[n]);
+    diag.drag_on_particles_x += fx;
+    diag.drag_on_particles_z += fz;
+    p.fx_ext[n] = opt_.freeze_particles ? 0.0 : fx - p.volume(n) * gp.x();
+    p.fy_ext[n] = opt_.freeze_particles ? 0.0 : fz - p.volume(n) * gp.y();
+    p.fz_ext[n] = 0.0;
+  }
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      diag.drag_on_gas_x += m.beta(i, j) * vcell * (m.upx(i, j) - ugx(i, j));
+      diag.drag_on_gas_z += m.beta(i, j) * vcell * (m.upz(i, j) - ugz(i, j));
+    }
+  result_.max_action_reaction_mismatch_n =
+      std::max(result_.max_action_reaction_mismatch_n,
+               std::hypot(diag.drag_on_particles_x + diag.drag_on_gas_x,
+                          diag.drag_on_particles_z + diag.drag_on_gas_z));
+  const GasDiagnostics& gd = gas.diagnostics();
+  if (gd.mass_in_kg_s > 0.0)
+    result_.max_relative_mass_imbalance = std::max(
+        result_.max_relative_mass_imbalance, std::abs(gd.mass_imbalance_kg_s) / gd.mass_in_kg_s);
+  ++result_.gas_steps;
+
+  // 5. DEM substeps; the wall impulse on the particles enters the momentum balance.
+  m.wall_impulse_step = 0.0;
+  if (!opt_.freeze_particles) {
+    const int k = static_cast<int>(std::lround(gas_dt_ / result_.dem_dt_s));
+    try {
+      for (int s = 0; s < k; ++s) {
+        dem.step(result_.dem_dt_s);
+        double fy = 0.0;
+        for (int w = 0; w < 6; ++w) fy -= dem.wall_force(static_cast<Wall>(w))[1];
+        m.wall_impulse_step += fy * result_.dem_dt_s;
+      }
+    } catch (const Error& e) {
+      throw Error(e.code(), "DPM stopped at t = " + Num(m.time) + " s (DEM): " + e.what());
+    }
+    result_.dem_steps += k;
+  }
+  m.time += gas_dt_;
+  return diag;
+}
+
+DpmResult DpmSimulation::Run(const DpmProgress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool settle_here = !impl_->gas;
+  if (settle_here) Settle(progress);
+  Impl& m = *impl_;
+  const Scene& s = scene_;
+  const double duration = opt_.duration_s > 0.0 ? opt_.duration_s : s.time.duration_s;
+  const long steps = std::max(1L, std::lround(duration / gas_dt_));
+  const double interval = s.bubble.sample_interval_s;
+  const int nx = s.grid.cells_x;
+  const double dx = s.geometry.width_m / nx;
+  const double area = s.geometry.width_m * s.geometry.depth_m;
+  const double g = s.gas.gravity_m_s2, rho_g = s.gas.density_kg_m3;
+  const double particle_mass = static_cast<double>(result_.particles) * s.particle_mass_kg();
+  BubbleOptions bo;
+  bo.eps_threshold = s.bubble.eps_threshold;
+  const double half = std::max(0.5 * s.jet.slot_width_m, 0.5 * dx);
+  bo.jet_x_min_m = s.jet_center_m() - half;
+  bo.jet_x_max_m = s.jet_center_m() + half;
+  bo.bed_height_initial_m = settled_height_;
+
+  // Vertical momentum of gas + particles [kg m/s].
+  auto total_momentum = [&]() {
+    const GasPhase& gas = *m.gas;
+    double pg = 0.0;
+    for (int j = 0; j < gas.options().nz; ++j)
+      for (int i = 0; i < nx; ++i)
+        pg += rho_g * m.eps(i, j) * 0.5 * (gas.w()(i, j) + gas.w()(i, j + 1));
+    pg *= gas.dx() * gas.dz() * s.geometry.depth_m;
+    double pp = 0.0;
+    const auto& p = m.dem->particles();
+    for (std::size_t n = 0; n < p.size(); ++n) pp += p.mass(n) * p.vy[n];
+    return pg + pp;
+  };
+  // External vertical force on gas + particles other than the walls' contact forces: pressure
+  // at the distributor minus the outlet, gravity, and the momentum flux in minus out.
+  auto external_force = [&]() {
+    const GasPhase& gas = *m.gas;
+    const int nz = gas.options().nz;
+    const double p0 = gas.WidthAveragedPressure(0.5 * gas.dz()),
+                 p1 = gas.WidthAveragedPressure(1.5 * gas.dz());
+    const double p_bottom = p0 + 0.5 * (p0 - p1);  // linear extrapolation to the plate
+    const double gas_mass = rho_g * m.eps.sum() * gas.dx() * gas.dz() * s.geometry.depth_m;
+    double flux = 0.0;
+    for (int i = 0; i < nx; ++i) {
+      flux += rho_g * gas.w()(i, 0) * gas.w()(i, 0) * m.eps(i, 0);
+      flux -= rho_g * gas.w()(i, nz) * gas.w()(i, nz) * m.eps(i, nz - 1);
+    }
+    flux *= gas.dx() * s.geometry.depth_m;
+    return (p_bottom - gas.options().outlet_pressure_pa) * area - (gas_mass + particle_mass) * g +
+           flux;
+  };
+
+  double next_sample = 0.0;
+  const double t_ref_abs = s.jet.start_s + s.time.t_ref_s;
+  double best_ref_gap = 0.5 * interval + 1e-12;
+  const double p_start = total_momentum();
+  double f_prev = external_force();
+  for (long n = 0; n < steps; ++n) {
+    Step();
+    const double f_now = external_force();
+    m.impulse_z += 0.5 * (f_prev + f_now) * gas_dt_ + m.wall_impulse_step;
+    f_prev = f_now;
+    if (m.time + 1e-12 >= next_sample) {
+      BubbleMetrics b = measure_bubble(VoidFractionField(), bo);
+      DpmSample smp;
+      smp.t_s = m.time - s.jet.start_s;
+      smp.bubble_diameter_m = b.found ? b.diameter_m : 0.0;
+      smp.bubble_centroid_m = b.found ? b.centroid_y_m : 0.0;
+      smp.bed_height_m = b.bed_height_m;
+      smp.pressure_drop_pa = m.gas->PressureDrop(0.5 * m.gas->dz(), s.geometry.height_m);
+      result_.series.push_back(smp);
+      const double gap = std::abs(m.time - t_ref_abs);
+      if (opt_.jet && gap < best_ref_gap) {
+        best_ref_gap = gap;
+        result_.bubble_at_t_ref = b.found;
+        result_.bubble_diameter_m = smp.bubble_diameter_m;
+      }
+      next_sample += interval;
+    }
+    if (progress) progress(static_cast<double>(n + 1) / steps, "coupled run");
+  }
+  const double weight =
+      (particle_mass + rho_g * s.geometry.width_m * s.geometry.height_m * s.geometry.depth_m) * g;
+  result_.momentum_mismatch =
+      std::abs(total_momentum() - p_start - m.impulse_z) / (weight * std::max(m.time, 1e-30));
+  result_.law_out_of_range = law_->out_of_range_count();
+  result_.wall_s = (settle_here ? 0.0 : result_.settle_wall_s) +
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result_;
+}
+
+}  // namespace consumers
+}  // namespace draglab
