@@ -36,6 +36,7 @@
 //     fields put on the gas cancel to round-off (the particle velocity sampling is the transpose
 //     of the mapping kernel): below 1e-12 of the total drag magnitude, each step.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -98,7 +99,8 @@ range_policy = "clamp"
 class DpmCouplingTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    path_ = ::testing::TempDir() + "/dpm_coupling_test.db";
+    // One file per process: ctest runs these tests as separate processes in parallel.
+    path_ = ::testing::TempDir() + "/dpm_coupling_test_" + std::to_string(::getpid()) + ".db";
     std::remove(path_.c_str());
     db_ = std::make_unique<Database>(path_);
     // One settled packing shared by the tests (settling is most of the cost).
