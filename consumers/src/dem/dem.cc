@@ -374,33 +374,30 @@ void DemSystem::compute_forces(double dt) {
     const int c = cell_of_[i];
     const int cx = c % ncell_[0], cy = (c / ncell_[0]) % ncell_[1],
               cz = c / (ncell_[0] * ncell_[1]);
+    // Neighbour cell index along `axis` (wrapped on periodic axes, with the image shift of the
+    // positions); false if it lies outside a walled axis.
+    auto neighbour = [this](int axis, int k, int* wrapped, double* shift) {
+      *shift = 0.0;
+      *wrapped = k;
+      if (k >= 0 && k < ncell_[axis]) return true;
+      if (!options_.periodic[axis]) return false;
+      const double length = options_.box_max[axis] - options_.box_min[axis];
+      *shift = k < 0 ? -length : length;
+      *wrapped = (k + ncell_[axis]) % ncell_[axis];
+      return true;
+    };
     for (int oz = -1; oz <= 1; ++oz) {
-      int kz = cz + oz;
-      double shz = 0.0;
-      if (kz < 0 || kz >= ncell_[2]) {
-        if (!options_.periodic[2]) continue;
-        shz = kz < 0 ? -(options_.box_max[2] - options_.box_min[2])
-                     : (options_.box_max[2] - options_.box_min[2]);
-        kz = (kz + ncell_[2]) % ncell_[2];
-      }
+      int kz;
+      double shz;
+      if (!neighbour(2, cz + oz, &kz, &shz)) continue;
       for (int oy = -1; oy <= 1; ++oy) {
-        int ky = cy + oy;
-        double shy = 0.0;
-        if (ky < 0 || ky >= ncell_[1]) {
-          if (!options_.periodic[1]) continue;
-          shy = ky < 0 ? -(options_.box_max[1] - options_.box_min[1])
-                       : (options_.box_max[1] - options_.box_min[1]);
-          ky = (ky + ncell_[1]) % ncell_[1];
-        }
+        int ky;
+        double shy;
+        if (!neighbour(1, cy + oy, &ky, &shy)) continue;
         for (int ox = -1; ox <= 1; ++ox) {
-          int kx = cx + ox;
-          double shx = 0.0;
-          if (kx < 0 || kx >= ncell_[0]) {
-            if (!options_.periodic[0]) continue;
-            shx = kx < 0 ? -(options_.box_max[0] - options_.box_min[0])
-                         : (options_.box_max[0] - options_.box_min[0]);
-            kx = (kx + ncell_[0]) % ncell_[0];
-          }
+          int kx;
+          double shx;
+          if (!neighbour(0, cx + ox, &kx, &shx)) continue;
           const int cell = (kz * ncell_[1] + ky) * ncell_[0] + kx;
           for (int s = cell_start_[cell]; s < cell_start_[cell + 1]; ++s) {
             const int j = cell_particles_[s];

@@ -6,22 +6,19 @@
 
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/error.h"
+#include "scene/scene_util.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using scene_util::kPi;
+
 // Convective Courant number of the recommended gas step (the explicit advection limit is 1;
 // 0.5 leaves room for the jet's acceleration through the bed).
 constexpr double kGasCourant = 0.5;
 
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
+std::string fmt(double x) { return scene_util::fmt(x, 4); }
 
 }  // namespace
 

@@ -17,24 +17,15 @@
 
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
+#include "scene/scene_util.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
-
-bool fail(std::string* error, const std::string& message) {
-  if (error) *error = message;
-  return false;
-}
+using scene_util::fail;
+using scene_util::fmt;
+using scene_util::kPi;
 
 [[noreturn]] void bad(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, message);

@@ -1,0 +1,29 @@
+// Small helpers shared by the scene sources (private to consumers/src/scene).
+#pragma once
+
+#include <sstream>
+#include <string>
+
+namespace draglab {
+namespace consumers {
+namespace scene_util {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// A value for a message, with `digits` significant digits.
+inline std::string fmt(double x, int digits = 6) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << x;
+  return s.str();
+}
+
+/// IsValid() helper: stores `message` in *error (if given) and returns false.
+inline bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+}  // namespace scene_util
+}  // namespace consumers
+}  // namespace draglab
