@@ -390,6 +390,8 @@ void run_bench(const CliContext& ctx, const BenchCommand& b) {
     ctx.print_json(
         {{"mflups", r.mflups},
          {"mflups_fluid_packing", r.mflups_fluid_packing},
+         {"mflups_fluid_packing_bb", r.mflups_fluid_packing_bb},
+         {"packing_bb_to_fluid_ratio", r.mflups > 0 ? r.mflups_fluid_packing_bb / r.mflups : 0.0},
          {"bandwidth_gbs", r.bandwidth_gbs},
          {"roofline_fraction", r.roofline_fraction},
          {"packing_to_fluid_ratio", r.mflups > 0 ? r.mflups_fluid_packing / r.mflups : 0.0},
@@ -402,6 +404,9 @@ void run_bench(const CliContext& ctx, const BenchCommand& b) {
       "phi = 0.4 packing {:.1f} MFLUPS (fluid nodes), {:.2f} x all-fluid "
       "(goal >= 0.8)\n",
       r.mflups_fluid_packing, r.mflups > 0 ? r.mflups_fluid_packing / r.mflups : 0.0);
+  std::cout << fmt::format(
+      "  same, halfway bounce-back {:.1f} MFLUPS, {:.2f} x all-fluid\n", r.mflups_fluid_packing_bb,
+      r.mflups > 0 ? r.mflups_fluid_packing_bb / r.mflups : 0.0);
   std::cout << fmt::format("bandwidth         {:.1f} GB/s (in-place update kernel)\n",
                            r.bandwidth_gbs);
   std::cout << fmt::format(
