@@ -65,6 +65,11 @@ void add_report_commands(CLI::App& app, CliContext& ctx);
 void add_pipeline_commands(CLI::App& app, CliContext& ctx);
 /// Registers `draglab scene ...` (scene_commands.cc).
 void add_scene_commands(CLI::App& app, CliContext& ctx);
+/// `draglab sensitivity`: a scene per law, bubble diameter with its numerical uncertainty,
+/// the seed's Fig. 4 as a PNG, and its --work-precision study (bubble vs grid and DEM step).
+void add_sensitivity_commands(CLI::App& app, CliContext& ctx);
+/// `draglab regress`: consumer predictions of changed law versions against stored baselines.
+void add_regress_commands(CLI::App& app, CliContext& ctx);
 
 /// Parses "a,b,c" into doubles; throws UsageError naming `field`.
 std::vector<double> parse_double_list(const std::string& text, const std::string& field);

@@ -109,6 +109,8 @@ int main(int argc, char** argv) {
   draglab::cli::add_report_commands(app, ctx);
   draglab::cli::add_pipeline_commands(app, ctx);
   draglab::cli::add_scene_commands(app, ctx);
+  draglab::cli::add_sensitivity_commands(app, ctx);
+  draglab::cli::add_regress_commands(app, ctx);
 
   try {
     app.parse(argc, argv);

@@ -49,6 +49,18 @@ Tent TentAt(double x, double z, double dx, double dz, int nx, int nz) {
   return t;
 }
 
+/// The bubble criterion of a scene (bubble.h) with the settled bed height for the expansion.
+BubbleOptions SceneBubbleOptions(const Scene& s, double settled_height_m) {
+  BubbleOptions bo;
+  bo.eps_threshold = s.bubble.eps_threshold;
+  const double dx = s.geometry.width_m / s.grid.cells_x;
+  const double half = std::max(0.5 * s.jet.slot_width_m, 0.5 * dx);
+  bo.jet_x_min_m = s.jet_center_m() - half;
+  bo.jet_x_max_m = s.jet_center_m() + half;
+  bo.bed_height_initial_m = settled_height_m;
+  return bo;
+}
+
 }  // namespace
 
 bool DpmOptions::IsValid(std::string* error) const {
@@ -170,6 +182,15 @@ void DpmSimulation::Start(Particles settled) {
   settled_height_ = 0.0;
   for (std::size_t n = 0; n < settled.size(); ++n)
     settled_height_ = std::max(settled_height_, settled.y[n] + 0.5 * settled.diameter[n]);
+  // Initial layers: equal-height bands of the settled bed, by stable id (particles reorder).
+  std::int64_t max_id = -1;
+  for (std::size_t n = 0; n < settled.size(); ++n) max_id = std::max(max_id, settled.id[n]);
+  layer_by_id_.assign(static_cast<std::size_t>(max_id + 1), 0);
+  for (std::size_t n = 0; n < settled.size(); ++n) {
+    const double h = settled_height_ > 0.0 ? settled.y[n] / settled_height_ : 0.0;
+    layer_by_id_[static_cast<std::size_t>(settled.id[n])] =
+        std::clamp(static_cast<int>(h * kInitialLayers), 0, kInitialLayers - 1);
+  }
   impl_->dem = std::make_unique<DemSystem>(MakeDemOptions(), std::move(settled));
 
   // Gas. Incompressible: the jet's Mach number is < 0.1 (scene.h), so density changes are
@@ -249,6 +270,25 @@ GridField2D DpmSimulation::VoidFractionField() const {
     for (int i = 0; i < f.nx; ++i)
       f.values[static_cast<std::size_t>(j) * f.nx + i] = impl_->eps(i, j);
   return f;
+}
+
+DpmSnapshot DpmSimulation::Snapshot() const {
+  if (!impl_->gas) Fail("DpmSimulation::Snapshot: call Settle() first");
+  DpmSnapshot snap;
+  snap.t_s = impl_->time - scene_.jet.start_s;
+  const Particles& p = impl_->dem->particles();
+  snap.x = p.x;
+  snap.y = p.y;
+  snap.z = p.z;
+  snap.diameter = p.diameter;
+  snap.layer.resize(p.size());
+  for (std::size_t n = 0; n < p.size(); ++n) {
+    const auto id = static_cast<std::size_t>(p.id[n]);
+    snap.layer[n] = id < layer_by_id_.size() ? layer_by_id_[id] : 0;
+  }
+  snap.void_fraction = VoidFractionField();
+  snap.bubble = measure_bubble(snap.void_fraction, SceneBubbleOptions(scene_, settled_height_));
+  return snap;
 }
 
 const DpmStepDiagnostics& DpmSimulation::Step() {
@@ -394,16 +434,10 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   const long steps = std::max(1L, std::lround(duration / gas_dt_));
   const double interval = s.bubble.sample_interval_s;
   const int nx = s.grid.cells_x;
-  const double dx = s.geometry.width_m / nx;
   const double area = s.geometry.width_m * s.geometry.depth_m;
   const double g = s.gas.gravity_m_s2, rho_g = s.gas.density_kg_m3;
   const double particle_mass = static_cast<double>(result_.particles) * s.particle_mass_kg();
-  BubbleOptions bo;
-  bo.eps_threshold = s.bubble.eps_threshold;
-  const double half = std::max(0.5 * s.jet.slot_width_m, 0.5 * dx);
-  bo.jet_x_min_m = s.jet_center_m() - half;
-  bo.jet_x_max_m = s.jet_center_m() + half;
-  bo.bed_height_initial_m = settled_height_;
+  const BubbleOptions bo = SceneBubbleOptions(s, settled_height_);
 
   // Vertical momentum of gas + particles [kg m/s].
   auto total_momentum = [&]() {
@@ -461,6 +495,8 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
         best_ref_gap = gap;
         result_.bubble_at_t_ref = b.found;
         result_.bubble_diameter_m = smp.bubble_diameter_m;
+        result_.snapshot = Snapshot();
+        result_.has_snapshot = true;
       }
       next_sample += interval;
     }

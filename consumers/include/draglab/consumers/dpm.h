@@ -45,6 +45,9 @@ struct DpmOptions {
   double settle_max_time_s = 3.0;  ///< Settling time limit [s], > 0.
   /// Gas step [s]; 0: the scene's gas_dt_s, else SceneDerived::recommended_gas_dt_s. >= 0.
   double gas_dt_s = 0.0;
+  /// Output directory for fields/particles files (scene [outputs]); empty: the scene's
+  /// outputs.directory, else out/<scene name>. Files are written only if the scene asks.
+  std::string output_directory;
   bool IsValid(std::string* error) const;
 };
 
@@ -55,6 +58,20 @@ struct DpmSample {
   double bubble_centroid_m = 0.0;  ///< Height of the bubble centroid [m].
   double bed_height_m = 0.0;       ///< From the width-averaged eps (bubble.h).
   double pressure_drop_pa = 0.0;   ///< Width-averaged p(first cell centre) - p(outlet).
+};
+
+/// Number of initial layers the particles are coloured by (equal-height bands of the settled
+/// bed, bottom = 0), as the experiment colours them so that mixing shows.
+constexpr int kInitialLayers = 6;
+
+/// The particles and the void fraction at one instant (figures and files).
+struct DpmSnapshot {
+  double t_s = 0.0;              ///< After jet start [s].
+  std::vector<double> x, y, z;   ///< Particle centres [m] (x width, y height, z depth).
+  std::vector<double> diameter;  ///< [m].
+  std::vector<int> layer;        ///< Initial layer, 0 (bottom) .. kInitialLayers - 1.
+  GridField2D void_fraction;     ///< Mapped gas fraction (x, height).
+  BubbleMetrics bubble;          ///< measure_bubble on void_fraction.
 };
 
 /// Per gas step coupling diagnostics (the last step).
@@ -93,6 +110,10 @@ struct DpmResult {
   double momentum_mismatch = 0.0;
   double max_action_reaction_mismatch_n = 0.0;  ///< max |sum F_p + sum F_gas| per step [N].
   std::uint64_t law_out_of_range = 0;           ///< Clamped/extrapolated drag evaluations.
+  /// Snapshot at the sample nearest to t_ref (has_snapshot false if the run ended before).
+  bool has_snapshot = false;
+  DpmSnapshot snapshot;
+  std::vector<std::string> output_files;  ///< HDF5/XDMF files written (only when asked).
   std::string BriefReport() const;
 };
 
@@ -126,6 +147,10 @@ class DpmSimulation {
   double settled_bed_height_m() const { return settled_height_; }
   /// The mapped void fraction as a GridField2D (x, height) for bubble.h.
   GridField2D VoidFractionField() const;
+  /// Initial layer of each particle by its stable id (Particles::id), set by Start().
+  const std::vector<int>& initial_layer_by_id() const { return layer_by_id_; }
+  /// Snapshot of the current state (t_s = time after jet start).
+  DpmSnapshot Snapshot() const;
 
  private:
   DemOptions MakeDemOptions() const;
@@ -136,6 +161,7 @@ class DpmSimulation {
   DpmResult result_;
   double gas_dt_ = 0.0;
   double settled_height_ = 0.0;
+  std::vector<int> layer_by_id_;
   std::unique_ptr<Impl> impl_;
 };
 
