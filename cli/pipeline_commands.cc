@@ -11,6 +11,12 @@
 // Re-running is cheap and safe: the campaign resumes (finished units are kept), the dataset is
 // identified by its content hash, and a fit that gives a law identical to the latest published
 // version of the name (same content hash, same dataset) reuses it instead of adding a version.
+//
+// The pipeline ends with the regression check of the law it published (`draglab regress --law`,
+// consumers/regress.h) on the registered scenes (the quick scene data/scenes/dpm_bubble_quick.toml
+// is registered if none is; --regress-scene FILE checks that scene instead; --no-regress skips
+// the check). A brand-new law name registers its baseline; a prediction that moved beyond the
+// baseline's tolerance is printed and the pipeline exits 1 (the law stays published).
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -25,7 +31,11 @@
 
 #include "cli/cli_context.h"
 #include "cli/progress.h"
+#include "cli/regress_report.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/consumers/regress.h"
+#include "draglab/consumers/scene.h"
+#include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/fitter/fit.h"
@@ -53,6 +63,18 @@ std::string preset_path(const std::string& preset) {
   if (fs::exists(installed)) return installed.lexically_normal().string();
   throw UsageError("preset '" + preset + "': no spec file " + source.string() + " or " +
                    installed.lexically_normal().string());
+}
+
+// The scene the pipeline's regression check registers when no scene is registered yet: found
+// like the presets (source tree, else the installed share directory); empty if neither exists.
+std::string quick_scene_path() {
+  const std::string file = "scenes/dpm_bubble_quick.toml";
+  const fs::path source = fs::path(DRAGLAB_SOURCE_DATA_DIR) / file;
+  if (fs::exists(source)) return source.string();
+  const fs::path installed =
+      fs::path(executable_path()).parent_path() / ".." / DRAGLAB_INSTALL_SHARE_DIR / file;
+  if (fs::exists(installed)) return installed.lexically_normal().string();
+  return "";
 }
 
 std::vector<fitter::FitPoint> fit_points(const Dataset& dataset) {
@@ -133,7 +155,39 @@ struct PipelineArgs {
   std::string out_dir;
   int jobs = 0;
   bool no_report = false;
+  bool no_regress = false;
+  std::string regress_scene;  // --regress-scene FILE (default: the registered scenes)
 };
+
+// 6. The regression check of the published law (consumers/regress.h). `scene` is the
+// --regress-scene file, parsed before the campaign; null: the registered scenes, registering the
+// quick scene if there is none. Returns false (with a warning) if there is nothing to run on.
+bool run_pipeline_check(const CliContext& ctx, const LawRecord& record,
+                        const consumers::Scene* scene, consumers::RegressSummary* summary) {
+  auto db = ctx.open_database(false);
+  consumers::RegressOptions options;
+  options.law = record.reference();
+  if (scene) {
+    register_consumer_scene(*db, scene->name, scene->source_text);
+    options.scene_hashes = {scene->hash()};
+  } else if (list_consumer_scenes(*db).empty()) {
+    const std::string path = quick_scene_path();
+    if (path.empty()) {
+      ctx.warn(
+          "regression check skipped: no scene is registered and the quick scene "
+          "scenes/dpm_bubble_quick.toml was not found (pass --regress-scene FILE)");
+      return false;
+    }
+    const consumers::Scene quick = consumers::load_scene(path);
+    register_consumer_scene(*db, quick.name, quick.source_text);
+    ctx.info("pipeline: registered the scene " + path + " for regression checks");
+  }
+  ctx.info("pipeline: regression check of " + record.reference() + " on the registered scenes");
+  ProgressLine line(!ctx.quiet);
+  *summary = consumers::run_regression(*db, options, regress_progress(line));
+  line.finish();
+  return true;
+}
 
 void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
   using Clock = std::chrono::steady_clock;
@@ -150,6 +204,12 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
     if (!ok) {
       throw UsageError("--law-name '" + law_name + "': use letters, digits, '_', '-' and '.' only");
     }
+  }
+  // The check's scene is read before hours of LBM too (a bad file exits 2 here).
+  std::unique_ptr<consumers::Scene> regress_scene;
+  if (!args.regress_scene.empty()) {
+    if (args.no_regress) throw UsageError("--regress-scene and --no-regress exclude each other");
+    regress_scene = std::make_unique<consumers::Scene>(consumers::load_scene(args.regress_scene));
   }
   const std::string db_path = ctx.resolved_db_path();
   ctx.open_database(false);  // create, migrate and seed the database before the workers open it
@@ -233,6 +293,13 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
           dataset.id + " --law " + record.reference() + " --out " + out_dir + "`)");
     }
   }
+  // 6. Regression check of the published law on the registered consumer scenes.
+  consumers::RegressSummary check;
+  bool checked = false;
+  if (!args.no_regress) {
+    db.reset();  // the check opens its own connection
+    checked = run_pipeline_check(ctx, record, regress_scene.get(), &check);
+  }
   const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
 
   if (ctx.json) {
@@ -268,8 +335,10 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
                     {"constraints_satisfied", fit.constraints_satisfied},
                     {"comparison", comparison},
                     {"report", report_file},
+                    {"regress", checked ? regress_json(check) : nlohmann::json(nullptr)},
                     {"campaign_s", campaign_s},
                     {"wall_s", wall_s}});
+    if (checked) finish_regress(ctx, check);
     return;
   }
 
@@ -362,7 +431,20 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
   out << "Next: draglab law show " << record.reference() << " | draglab law eval "
       << record.reference() << " --phi 0.3 --re 20 | draglab fit --dataset " << dataset.id
       << " --free a,n,b,c0,c1,c2\n";
+  if (checked) {
+    out << "\nRegression check of " << record.reference()
+        << " (consumer predictions against the stored baselines):\n"
+        << check.FullReport();
+    if (check.any_moved()) {
+      out << "PREDICTION MOVED: " << record.reference()
+          << " changes a consumer prediction beyond the baseline's tolerance (the law is "
+             "published; see `draglab regress list`)\n";
+    }
+  } else if (args.no_regress) {
+    out << "\nRegression check skipped (--no-regress).\n";
+  }
   std::cout << out.str();
+  if (checked) finish_regress(ctx, check);
 }
 
 }  // namespace
@@ -382,12 +464,20 @@ void add_pipeline_commands(CLI::App& app, CliContext& ctx) {
   cmd->add_option("--jobs", args->jobs, "Parallel LBM units (0 = number of cores)")
       ->check(CLI::Range(0, 1024));
   cmd->add_flag("--no-report", args->no_report, "Skip the figures");
+  cmd->add_flag("--no-regress", args->no_regress,
+                "Skip the final regression check of the published law");
+  cmd->add_option("--regress-scene", args->regress_scene,
+                  "Scene (TOML) of the final regression check, registered if new (default: the "
+                  "registered scenes; the quick scene if none is)")
+      ->check(CLI::ExistingFile);
   cmd->footer(
       "Examples:\n"
       "  draglab pipeline --preset quick\n"
       "  draglab pipeline --preset standard --jobs 2 --out out/standard\n"
       "  draglab pipeline --spec my.toml --law-name eq6_mine --json\n"
-      "Re-running resumes the campaign and reuses an identical fitted version.");
+      "Re-running resumes the campaign and reuses an identical fitted version. The pipeline "
+      "ends with `draglab regress --law` for the published version: exit 1 if a consumer "
+      "prediction moved beyond its baseline's tolerance.");
   cmd->callback([&ctx, args] { ctx.action = [&ctx, args] { run_pipeline(ctx, *args); }; });
 }
 

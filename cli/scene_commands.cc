@@ -207,6 +207,8 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
          {"background_m_s", r.background_m_s},
          {"background", r.background_mode},
          {"eps_mf", r.eps_mf},
+         {"eps_packing", r.eps_packing},
+         {"umf_packing_m_s", r.umf_packing_m_s},
          {"bubble_diameter_m",
           r.bubble_at_t_ref ? nlohmann::json(r.bubble_diameter_m) : nlohmann::json(nullptr)},
          {"t_ref_s", r.t_ref_s},

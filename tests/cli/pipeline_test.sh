@@ -6,6 +6,14 @@
 # (Stokes F grows with phi, as every drag law says); re-running resumes (no new unit, same
 # dataset id) and reuses the identical law version instead of adding one; a bad spec exits 2
 # and writes nothing.
+# The pipeline ends with the regression check of the law it published (--regress-scene): the
+# tiny DPM scene of tests/cli/data/regress_tiny.toml with a gas 100 times as viscous as air and
+# eps_mf = 0.7, so that the bed at minimum fluidization (phi = 0.3, Re_mf ~ 1) lies inside the
+# validity box of a law fitted to this campaign (phi 0.15-0.35, Re 0-10); one DPM run of ~2 s.
+# The first run registers eq6_tiny@1 as the scene's baseline (exit 0), the re-run compares the
+# same version with it from the stored result (ok, no run), --no-regress skips the check, and a
+# baseline that eq6_tiny@1 does not match (below) makes the pipeline exit 1; a missing or invalid
+# --regress-scene exits 2 before the campaign, writing nothing.
 set -u
 draglab="$1"
 work="$(mktemp -d)"
@@ -29,8 +37,23 @@ resolutions = [8]
 extrapolation = "finest"
 TOML
 
-check "pipeline" 0 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --out "$work/report" --json
+sed -e 's/^viscosity_pa_s = 1.8e-5/viscosity_pa_s = 1.8e-3/' -e 's/^eps_mf = 0.42/eps_mf = 0.7/' \
+  -e 's/^name = "dpm_tiny_test"/name = "dpm_tiny_viscous"/' \
+  "$(dirname "$0")/data/regress_tiny.toml" >"$work/viscous.toml"
+
+check "pipeline" 0 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --out "$work/report" \
+  --regress-scene "$work/viscous.toml" --json
 cp "$work/out" "$work/first.json"
+pycheck "pipeline ends with the check: baseline registered" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/first.json"))
+g = r["regress"]
+assert g["baselines_registered"] == 1 and g["moved"] == 0 and g["failed"] == 0, g
+e = g["entries"][0]
+assert e["law"] == "eq6_tiny@1" and e["scene"] == "dpm_tiny_viscous", e
+assert e["outcome"] == "baseline_registered" and e["ran"], e
+assert 0 < e["metrics"]["umf_m_s"] < 1, e["metrics"]
+'
 pycheck "pipeline JSON" '
 import json, os, sys
 w = sys.argv[1]
@@ -67,13 +90,21 @@ assert len(stokes) == 3, stokes
 assert stokes[0][1] < stokes[1][1] < stokes[2][1], stokes
 '
 
-check "pipeline again" 0 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --out "$work/report" --json
+check "pipeline again" 0 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --out "$work/report" \
+  --regress-scene "$work/viscous.toml" --json
 pycheck "re-run resumes and reuses" '
 import json, sys
 w = sys.argv[1]
 a = json.load(open(w + "/first.json")); b = json.load(open(w + "/out"))
 assert b["version"] == 1 and b["dataset"] == a["dataset"], (a["version"], b["version"])
 assert b["params"] == a["params"]
+e = b["regress"]["entries"][0]
+assert e["outcome"] == "ok" and not e["ran"] and e["baseline"] == "eq6_tiny@1", e
+'
+check "pipeline --no-regress" 0 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --no-report --no-regress --json
+pycheck "no check" '
+import json, sys
+assert json.load(open(sys.argv[1] + "/out"))["regress"] is None
 '
 check "still one version" 0 "$draglab" --db "$db" law list --json
 pycheck "one eq6_tiny version" '
@@ -83,6 +114,20 @@ laws = laws["laws"] if isinstance(laws, dict) else laws
 assert sum(1 for l in laws if l["name"] == "eq6_tiny") == 1
 '
 
+# A moved prediction makes the pipeline exit 1: a refit of only k0 (eq6_tiny@2, other
+# coefficients as printed) becomes the scene's baseline with a U_mf tolerance of 0, so the
+# re-run's eq6_tiny@1, whose U_mf differs, has moved.
+dataset_id="$("$py" -c 'import json,sys; print(json.load(open(sys.argv[1]))["dataset"])' "$work/first.json")"
+check "refit eq6_tiny@2" 0 "$draglab" --db "$db" -q fit --dataset "$dataset_id" --free k0 --cv 0 --no-global \
+  --publish eq6_tiny
+check "publish eq6_tiny@2" 0 "$draglab" --db "$db" -q law publish eq6_tiny@2
+check "baseline eq6_tiny@2, U_mf tolerance 0" 0 "$draglab" --db "$db" regress register "$work/viscous.toml" \
+  --law eq6_tiny@2 --replace --tol-umf-rel 0
+check "pipeline reports the moved prediction" 1 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" \
+  --no-report --regress-scene "$work/viscous.toml"
+ok "the summary says PREDICTION MOVED" grep -q "PREDICTION MOVED: eq6_tiny@1" "$work/out"
+ok "the error names the move" grep -q "eq6_tiny@1 on dpm_tiny_viscous vs eq6_tiny@2 (umf_m_s" "$work/err"
+
 before="$(md5sum "$db" | cut -d" " -f1)"
 sed 's/phi = \[0.15, 0.25, 0.35\]/phi = [0.15, 0.9]/' "$work/tiny.toml" > "$work/bad.toml"
 check "bad spec (phi out of range)" 2 "$draglab" --db "$db" pipeline --spec "$work/bad.toml"
@@ -91,6 +136,11 @@ if grep -q "phi" "$work/err"; then passed=$((passed + 1)); else
 printf '[campaign]\nname = "x"\nbogus = 1\n' > "$work/bad2.toml"
 check "bad spec (unknown key)" 2 "$draglab" --db "$db" pipeline --spec "$work/bad2.toml"
 check "bad law name" 2 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --law-name "a b"
+check "missing regression scene" 2 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --regress-scene "$work/none.toml"
+sed 's/^cells_x = 4/cells_x = 0/' "$work/viscous.toml" >"$work/bad_scene.toml"
+check "invalid regression scene" 2 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --regress-scene "$work/bad_scene.toml"
+ok "message names cells_x" grep -q "cells_x" "$work/err"
+check "--no-regress with --regress-scene" 2 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --no-regress --regress-scene "$work/viscous.toml"
 after="$(md5sum "$db" | cut -d" " -f1)"
 if [ "$before" = "$after" ]; then passed=$((passed + 1)); else
   echo "FAIL bad input changed the database"; failures=$((failures + 1)); fi

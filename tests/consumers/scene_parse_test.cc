@@ -149,7 +149,7 @@ TEST(SceneParse, EveryBadInputIsNamed) {
   expect_bad(edit(base, "drag", "range_policy", "range_policy = \"ignore\""),
              {"[drag] range_policy"});
   expect_bad(edit(base, "distributor", "background", "background = \"plate\""),
-             {"[distributor] background", "umf, fixed"});
+             {"[distributor] background", "umf, umf_packing, fixed"});
   expect_bad(edit(edit(base, "distributor", "background", "background = \"fixed\""), "distributor",
                   "velocity_m_s", "velocity_m_s = 0"),
              {"[distributor] velocity_m_s"});

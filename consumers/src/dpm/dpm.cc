@@ -1,6 +1,8 @@
 // DpmSimulation: the coupled CFD-DEM run (draglab/consumers/dpm.h, docs/dpm.md).
 #include "draglab/consumers/dpm.h"
 
+#include "draglab/consumers/dpm_output.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -88,7 +90,8 @@ std::string DpmResult::BriefReport() const {
   std::ostringstream s;
   s << "DPM " << scene << " with " << law << ": U_mf = " << Num(umf_m_s)
     << " m/s, background = " << Num(background_m_s) << " m/s (" << background_mode
-    << "), eps_mf = " << eps_mf << "\n  " << particles << " particles, settled bed "
+    << "), eps_mf = " << eps_mf << "; settled packing eps = " << Num(eps_packing)
+    << ", its U_mf = " << Num(umf_packing_m_s) << " m/s\n  " << particles << " particles, settled bed "
     << Num(settled_bed_height_m) << " m; " << gas_steps << " gas steps of " << Num(gas_dt_s)
     << " s, " << dem_steps << " DEM steps of " << Num(dem_dt_s) << " s; wall " << Num(wall_s)
     << " s (settling " << Num(settle_wall_s) << " s)\n  bubble D at t_ref = " << Num(t_ref_s)
@@ -204,11 +207,43 @@ void DpmSimulation::Start(Particles settled) {
   result_.umf_m_s = derived.umf.umf_m_s;
   result_.eps_mf = s.eps_mf;
   result_.t_ref_s = s.time.t_ref_s;
+  {
+    // Settled packing: surface = mean over 2 d wide columns of the highest particle top (the
+    // single highest particle overstates a rough surface by up to a diameter).
+    const Particles& p = impl_->dem->particles();
+    const double d = s.particles.diameter_m, w = s.geometry.width_m;
+    const int columns = std::max(1, static_cast<int>(w / (2.0 * d)));
+    std::vector<double> top(static_cast<std::size_t>(columns), 0.0);
+    double solids = 0.0;
+    for (std::size_t n = 0; n < p.size(); ++n) {
+      const int c = std::clamp(static_cast<int>(p.x[n] / w * columns), 0, columns - 1);
+      top[static_cast<std::size_t>(c)] =
+          std::max(top[static_cast<std::size_t>(c)], p.y[n] + 0.5 * p.diameter[n]);
+      solids += p.volume(n);
+    }
+    double surface = 0.0;
+    for (double t : top) surface += t / columns;
+    result_.eps_packing = 1.0 - solids / (w * s.geometry.depth_m * std::max(surface, d));
+    MinFluidizationOptions mo;
+    mo.eps_mf = std::clamp(result_.eps_packing, 0.21, 0.89);
+    try {
+      result_.umf_packing_m_s = minimum_fluidization(*law_, s.particles, s.gas, mo).umf_m_s;
+    } catch (const Error& e) {
+      if (s.distributor.mode == BackgroundMode::kUmfPacking && opt_.background_override_m_s < 0.0)
+        throw Error(e.code(), "distributor.background = \"umf_packing\": the law's U_mf at the "
+                              "settled packing's eps = " + Num(result_.eps_packing) +
+                              " cannot be computed (" + e.what() +
+                              "); use background = \"umf\" or \"fixed\"");
+      result_.umf_packing_m_s = 0.0;
+    }
+  }
   if (opt_.background_override_m_s >= 0.0) {
     result_.background_m_s = opt_.background_override_m_s;
     result_.background_mode = "override";
   } else {
-    result_.background_m_s = derived.background_m_s;
+    result_.background_m_s = s.distributor.mode == BackgroundMode::kUmfPacking
+                                 ? s.distributor.umf_factor * result_.umf_packing_m_s
+                                 : derived.background_m_s;
     result_.background_mode = to_string(s.distributor.mode);
   }
   GasOptions g;
@@ -228,6 +263,7 @@ void DpmSimulation::Start(Particles settled) {
     g.jet_start_s = s.jet.start_s;
     g.jet_duration_s = s.jet.duration_s;
   }
+  g.inflow_ramp_s = s.jet.ramp_s;
   impl_->gas = std::make_unique<GasPhase>(g);
   gas_dt_ = opt_.gas_dt_s > 0.0     ? opt_.gas_dt_s
             : s.time.gas_dt_s > 0.0 ? s.time.gas_dt_s
@@ -471,6 +507,17 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
            flux;
   };
 
+  // Files only when the scene asks: every outputs.interval_s, or (interval 0) once at t_ref.
+  std::unique_ptr<DpmOutputWriter> writer;
+  if (s.outputs.fields || s.outputs.particles) {
+    const std::string dir = !opt_.output_directory.empty() ? opt_.output_directory
+                            : !s.outputs.directory.empty() ? s.outputs.directory
+                                                           : "out/" + s.name;
+    writer = std::make_unique<DpmOutputWriter>(s, result_.law, dir, s.outputs.fields,
+                                               s.outputs.particles);
+  }
+  double next_output = s.outputs.interval_s > 0.0 ? 0.0 : -1.0;
+  bool t_ref_written = false;
   double next_sample = 0.0;
   const double t_ref_abs = s.jet.start_s + s.time.t_ref_s;
   double best_ref_gap = 0.5 * interval + 1e-12;
@@ -500,7 +547,20 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
       }
       next_sample += interval;
     }
+    if (writer) {
+      if (next_output >= 0.0 && m.time + 1e-12 >= next_output) {
+        writer->Write(m.time, *m.gas, m.dem->particles(), layer_by_id_);
+        next_output += s.outputs.interval_s;
+      } else if (next_output < 0.0 && !t_ref_written && m.time + 0.5 * gas_dt_ >= t_ref_abs) {
+        writer->Write(m.time, *m.gas, m.dem->particles(), layer_by_id_);
+        t_ref_written = true;
+      }
+    }
     if (progress) progress(static_cast<double>(n + 1) / steps, "coupled run");
+  }
+  if (writer) {
+    writer->Finish();
+    result_.output_files = writer->files();
   }
   const double weight =
       (particle_mass + rho_g * s.geometry.width_m * s.geometry.height_m * s.geometry.depth_m) * g;

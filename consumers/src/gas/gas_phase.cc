@@ -72,6 +72,9 @@ bool GasOptions::IsValid(std::string* why) const {
   if (!std::isfinite(jet_start_s) || jet_start_s < 0.0) {
     return fail("gas.jet_start_s = " + Fmt("%g", jet_start_s) + " s must be >= 0");
   }
+  if (!std::isfinite(inflow_ramp_s) || inflow_ramp_s < 0.0) {
+    return fail("gas.inflow_ramp_s = " + Fmt("%g", inflow_ramp_s) + " s must be >= 0");
+  }
   if (!std::isfinite(jet_duration_s) || jet_duration_s < 0.0) {
     return fail("gas.jet_duration_s = " + Fmt("%g", jet_duration_s) + " s must be >= 0");
   }
@@ -178,16 +181,25 @@ void GasPhase::SetUniformVelocity(double u_x, double u_z) {
 
 double GasPhase::InflowSuperficialVelocity(int i, double t) const {
   if (opt_.vertical != VerticalBoundary::kInflowOutlet) return 0.0;
-  double velocity = opt_.background_velocity_m_s;
-  const bool jet_open =
-      opt_.jet_width_m > 0.0 && t >= opt_.jet_start_s && t < opt_.jet_start_s + opt_.jet_duration_s;
-  if (jet_open) {
+  const double ramp = opt_.inflow_ramp_s;
+  // Linear ramp 0 -> 1 over [a, a + ramp] (a step at a when ramp = 0).
+  auto opened = [ramp](double t_now, double a) {
+    if (ramp <= 0.0) return t_now >= a ? 1.0 : 0.0;
+    return std::clamp((t_now - a) / ramp, 0.0, 1.0);
+  };
+  double velocity = opt_.background_velocity_m_s * opened(t, 0.0);
+  const double jet_fraction =
+      opt_.jet_width_m > 0.0
+          ? opened(t, opt_.jet_start_s) - opened(t, opt_.jet_start_s + opt_.jet_duration_s)
+          : 0.0;
+  if (jet_fraction > 0.0) {
     // The slot is centred; a partly covered face gets the area-weighted mean so the injected
     // volume flow is exactly jet_width * jet_velocity per unit depth on any grid.
     const double x0 = 0.5 * (opt_.width_m - opt_.jet_width_m);
     const double x1 = x0 + opt_.jet_width_m;
     const double overlap = std::max(0.0, std::min(x1, (i + 1) * dx_) - std::max(x0, i * dx_));
-    velocity += (opt_.jet_velocity_m_s - opt_.background_velocity_m_s) * overlap / dx_;
+    velocity += jet_fraction * (opt_.jet_velocity_m_s - opt_.background_velocity_m_s) * overlap /
+                dx_;
   }
   return velocity;
 }

@@ -31,7 +31,9 @@ SceneDerived derive_scene(const Scene& scene, const Law& law) {
   options.eps_mf = scene.eps_mf;
   r.umf = minimum_fluidization(law, scene.particles, scene.gas, options);
   r.archimedes = r.umf.archimedes;
-  r.background_m_s = scene.distributor.mode == BackgroundMode::kUmf
+  // kUmfPacking: the packing's own U_mf is known only after settling (DpmSimulation); the
+  // eps_mf value is the estimate used for the time steps here.
+  r.background_m_s = scene.distributor.mode != BackgroundMode::kFixed
                          ? scene.distributor.umf_factor * r.umf.umf_m_s
                          : scene.distributor.velocity_m_s;
   const double d = scene.particles.diameter_m, rho_p = scene.particles.density_kg_m3;

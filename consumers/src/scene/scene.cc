@@ -136,8 +136,10 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                      s.distributor.mode = BackgroundMode::kUmf;
                    } else if (v == "fixed") {
                      s.distributor.mode = BackgroundMode::kFixed;
+                   } else if (v == "umf_packing") {
+                     s.distributor.mode = BackgroundMode::kUmfPacking;
                    } else {
-                     bad(at + ": " + f + " = '" + v + "' is not one of umf, fixed");
+                     bad(at + ": " + f + " = '" + v + "' is not one of umf, umf_packing, fixed");
                    }
                  }},
                 num("umf_factor", [](S& s) -> double& { return s.distributor.umf_factor; }),
@@ -147,7 +149,8 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                 num("velocity_m_s", [](S& s) -> double& { return s.jet.velocity_m_s; }),
                 num("center_m", [](S& s) -> double& { return s.jet.center_m; }),
                 num("start_s", [](S& s) -> double& { return s.jet.start_s; }),
-                num("duration_s", [](S& s) -> double& { return s.jet.duration_s; })}},
+                num("duration_s", [](S& s) -> double& { return s.jet.duration_s; }),
+                num("ramp_s", [](S& s) -> double& { return s.jet.ramp_s; })}},
               {"time",
                {num("duration_s", [](S& s) -> double& { return s.time.duration_s; }),
                 num("t_ref_s", [](S& s) -> double& { return s.time.t_ref_s; }),
@@ -218,7 +221,15 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
 }  // namespace
 
 const char* to_string(BackgroundMode mode) {
-  return mode == BackgroundMode::kUmf ? "umf" : "fixed";
+  switch (mode) {
+    case BackgroundMode::kUmf:
+      return "umf";
+    case BackgroundMode::kUmfPacking:
+      return "umf_packing";
+    case BackgroundMode::kFixed:
+      break;
+  }
+  return "fixed";
 }
 
 Scene parse_scene(const std::string& toml_text, const std::string& origin) {
@@ -348,7 +359,7 @@ bool Scene::IsValid(std::string* error) const {
                            " m high, less than one particle diameter (give more particles)");
   }
   // Distributor.
-  if (distributor.mode == BackgroundMode::kUmf) {
+  if (distributor.mode != BackgroundMode::kFixed) {
     if (!in_range(distributor.umf_factor, 0.0, 10.0, false, false, "[distributor] umf_factor", "",
                   error)) {
       return false;
@@ -363,7 +374,8 @@ bool Scene::IsValid(std::string* error) const {
       !in_range(jet.velocity_m_s, 0.0, 300.0, false, false, "[jet] velocity_m_s",
                 "m/s (incompressible gas: Mach < 0.9)", error) ||
       !in_range(jet.start_s, 0.0, 1e4, false, false, "[jet] start_s", "s", error) ||
-      !in_range(jet.duration_s, 0.0, 1e4, false, false, "[jet] duration_s", "s", error)) {
+      !in_range(jet.duration_s, 0.0, 1e4, false, false, "[jet] duration_s", "s", error) ||
+      !in_range(jet.ramp_s, 0.0, 1.0, false, false, "[jet] ramp_s", "s", error)) {
     return false;
   }
   if (jet.center_m != -1.0) {  // -1: the default, the bed's centre line

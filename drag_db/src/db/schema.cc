@@ -404,6 +404,115 @@ END;
 )sql";
 }
 
+// Version 5: consumer results, the scenes they ran and regression baselines
+// (consumer_results.h, `draglab regress`).
+//   consumer_scenes: the registered scenes, keyed by the SHA-256 of their TOML text, with the text
+//     itself so that a regression re-runs exactly what was registered; never changed or deleted.
+//   consumer_results: one row per consumer run (scene, law name@version and its content hash,
+//     code version, metrics JSON, full result JSON); immutable. The law version must exist with
+//     that content hash when the row is inserted (a draft changed later keeps its old results
+//     under the old hash, so they are never mistaken for the new content).
+//   consumer_baselines: the result a (scene, law name) is compared against, with the tolerances.
+//     One active row per (scene, law name) (partial unique index); a new baseline replaces the
+//     active one only by marking it superseded (superseded_at set once, nothing else may change)
+//     and naming it in `supersedes`: the rows are the history. No DELETE, no REPLACE.
+std::string migration_5() {
+  return R"sql(
+CREATE TABLE consumer_scenes (
+  hash TEXT PRIMARY KEY CHECK (length(hash) = 64),
+  name TEXT NOT NULL CHECK (length(name) >= 1),
+  toml TEXT NOT NULL,
+  registered_at TEXT NOT NULL,
+  code_version TEXT NOT NULL
+);
+CREATE TABLE consumer_results (
+  id INTEGER PRIMARY KEY,
+  scene_name TEXT NOT NULL,
+  scene_hash TEXT NOT NULL REFERENCES consumer_scenes(hash),
+  law_name TEXT NOT NULL,
+  law_version INTEGER NOT NULL CHECK (law_version >= 1),
+  law_content_hash TEXT NOT NULL CHECK (length(law_content_hash) = 64),
+  code_version TEXT NOT NULL,
+  created_at TEXT NOT NULL,
+  metrics_json TEXT NOT NULL CHECK (json_valid(metrics_json)),
+  result_json TEXT NOT NULL CHECK (json_valid(result_json))
+);
+CREATE INDEX consumer_results_by_run ON consumer_results (scene_hash, law_name, law_version, id);
+CREATE TABLE consumer_baselines (
+  id INTEGER PRIMARY KEY,
+  scene_hash TEXT NOT NULL REFERENCES consumer_scenes(hash),
+  law_name TEXT NOT NULL,
+  result_id INTEGER NOT NULL REFERENCES consumer_results(id),
+  tolerances_json TEXT NOT NULL CHECK (json_valid(tolerances_json)),
+  registered_at TEXT NOT NULL,
+  superseded_at TEXT,
+  supersedes INTEGER REFERENCES consumer_baselines(id)
+);
+CREATE UNIQUE INDEX consumer_baselines_one_active ON consumer_baselines (scene_hash, law_name)
+  WHERE superseded_at IS NULL;
+
+CREATE TRIGGER consumer_scenes_immutable_update BEFORE UPDATE ON consumer_scenes
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: registered consumer scenes are immutable (another text is another scene); create a new version instead');
+END;
+CREATE TRIGGER consumer_scenes_immutable_delete BEFORE DELETE ON consumer_scenes
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: registered consumer scenes are immutable and cannot be deleted; create a new version instead');
+END;
+CREATE TRIGGER consumer_scenes_no_replace_insert BEFORE INSERT ON consumer_scenes
+WHEN EXISTS (SELECT 1 FROM consumer_scenes WHERE hash = NEW.hash)
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: registered consumer scenes are immutable (a scene with this hash exists); create a new version instead');
+END;
+
+CREATE TRIGGER consumer_results_immutable_update BEFORE UPDATE ON consumer_results
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: consumer results are immutable (a new run is a new result); create a new version instead');
+END;
+CREATE TRIGGER consumer_results_immutable_delete BEFORE DELETE ON consumer_results
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: consumer results are immutable and cannot be deleted; create a new version instead');
+END;
+CREATE TRIGGER consumer_results_no_replace_insert BEFORE INSERT ON consumer_results
+WHEN EXISTS (SELECT 1 FROM consumer_results WHERE id = NEW.id)
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: consumer results are immutable (a result with this id exists); create a new version instead');
+END;
+CREATE TRIGGER consumer_results_law_exists BEFORE INSERT ON consumer_results
+WHEN NOT EXISTS (SELECT 1 FROM laws WHERE name = NEW.law_name AND version = NEW.law_version
+                 AND content_hash = NEW.law_content_hash)
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: a consumer result must name a stored law version with its current content hash');
+END;
+
+CREATE TRIGGER consumer_baselines_insert_checks BEFORE INSERT ON consumer_baselines
+WHEN NEW.superseded_at IS NOT NULL OR NOT EXISTS (SELECT 1 FROM consumer_results
+  WHERE id = NEW.result_id AND scene_hash = NEW.scene_hash AND law_name = NEW.law_name)
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: a baseline is inserted active and names a result of its own scene and law name');
+END;
+CREATE TRIGGER consumer_baselines_no_replace_insert BEFORE INSERT ON consumer_baselines
+WHEN EXISTS (SELECT 1 FROM consumer_baselines WHERE id = NEW.id OR (scene_hash = NEW.scene_hash
+  AND law_name = NEW.law_name AND superseded_at IS NULL))
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: this scene and law name have an active baseline; replace it explicitly (draglab regress register --replace), which keeps it as superseded; create a new version instead');
+END;
+CREATE TRIGGER consumer_baselines_supersede_only BEFORE UPDATE ON consumer_baselines
+WHEN OLD.superseded_at IS NOT NULL OR NEW.superseded_at IS NULL
+  OR NEW.id IS NOT OLD.id OR NEW.scene_hash IS NOT OLD.scene_hash
+  OR NEW.law_name IS NOT OLD.law_name OR NEW.result_id IS NOT OLD.result_id
+  OR NEW.tolerances_json IS NOT OLD.tolerances_json OR NEW.registered_at IS NOT OLD.registered_at
+  OR NEW.supersedes IS NOT OLD.supersedes
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: baselines are immutable except for being superseded once by a new baseline; create a new version instead');
+END;
+CREATE TRIGGER consumer_baselines_immutable_delete BEFORE DELETE ON consumer_baselines
+BEGIN
+  SELECT RAISE(ABORT, 'draglab: baselines are never deleted (a replaced baseline is kept as superseded); create a new version instead');
+END;
+)sql";
+}
+
 }  // namespace
 
 const std::vector<Migration>& migrations() {
@@ -415,6 +524,8 @@ const std::vector<Migration>& migrations() {
        migration_3()},
       {4, "drag campaigns, campaign units (measurements) and immutable datasets",
        migration_4()},
+      {5, "consumer scenes, immutable consumer results and regression baselines",
+       migration_5()},
   };
   return all;
 }
@@ -484,6 +595,17 @@ std::vector<std::string> expected_triggers(int schema_version) {
           "campaign_units_no_delete", "campaign_units_no_replace_insert",
           "datasets_immutable_update", "datasets_immutable_delete",
           "datasets_no_replace_insert"}) {
+      names.push_back(name);
+    }
+  }
+  if (schema_version >= 5) {
+    for (const char* name :
+         {"consumer_scenes_immutable_update", "consumer_scenes_immutable_delete",
+          "consumer_scenes_no_replace_insert", "consumer_results_immutable_update",
+          "consumer_results_immutable_delete", "consumer_results_no_replace_insert",
+          "consumer_results_law_exists", "consumer_baselines_insert_checks",
+          "consumer_baselines_no_replace_insert", "consumer_baselines_supersede_only",
+          "consumer_baselines_immutable_delete"}) {
       names.push_back(name);
     }
   }

@@ -90,8 +90,12 @@ struct DpmResult {
   std::string scene_hash;
   double umf_m_s = 0.0;         ///< The loaded law's U_mf (scene particles, gas, eps_mf).
   double background_m_s = 0.0;  ///< Superficial background velocity used.
-  std::string background_mode;  ///< "umf", "fixed" or "override".
+  std::string background_mode;  ///< "umf", "umf_packing", "fixed" or "override".
   double eps_mf = 0.0;
+  /// Mean gas fraction of the settled packing (column-averaged surface height) and the law's
+  /// U_mf at it (background "umf_packing" uses the latter).
+  double eps_packing = 0.0;
+  double umf_packing_m_s = 0.0;
   double t_ref_s = 0.0;            ///< After jet start.
   double bubble_diameter_m = 0.0;  ///< At t_ref (nearest sample); 0 if none found.
   bool bubble_at_t_ref = false;    ///< A sample at t_ref existed and held a bubble.

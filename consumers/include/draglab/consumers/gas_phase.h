@@ -54,6 +54,11 @@ struct GasOptions {
   double jet_velocity_m_s = 0.0;         ///< Superficial velocity through the slot (replaces bg).
   double jet_start_s = 0.0;              ///< Time at which the jet opens, >= 0.
   double jet_duration_s = 0.0;           ///< How long it stays open, >= 0.
+  /// Valve opening time [s], >= 0: the background rises linearly from 0 over [0, ramp], the
+  /// jet's excess over [start, start + ramp] and falls over [end, end + ramp], so the injected
+  /// volume is exactly jet_width * jet_velocity * duration. An instantaneous switch in an
+  /// incompressible gas is a pressure impulse on the whole bed (kPa spikes, docs/dpm.md).
+  double inflow_ramp_s = 0.0;
   // Numerics.
   DragCoupling drag = DragCoupling::kImplicit;
   PoissonSolver poisson = PoissonSolver::kDirectLDLT;

@@ -62,6 +62,10 @@ struct SceneGas {
 enum class BackgroundMode {
   kUmf,    ///< umf_factor times the loaded law's own U_mf (each law at its own incipient state).
   kFixed,  ///< velocity_m_s for every law (as the experiment did with one measured U_mf).
+  /// umf_factor times the law's U_mf at the SETTLED packing's own mean gas fraction (from the
+  /// settled bed height) instead of eps_mf: a DEM packing in a thin box settles looser than
+  /// eps_mf, and at the eps_mf U_mf it is not yet fluidized (docs/dpm.md).
+  kUmfPacking,
 };
 const char* to_string(BackgroundMode mode);
 
@@ -80,6 +84,9 @@ struct SceneJet {
   double center_m = -1.0;  ///< Slot centre from the left wall; < 0 in the file: width / 2.
   double start_s = 0.0;    ///< Jet start, after the settled bed has been fluidized from t = 0.
   double duration_s = 0.0;
+  /// Valve opening time [s] of the jet and the distributor (linear ramps, gas_phase.h
+  /// inflow_ramp_s), [0, duration_s]; 0 switches instantly.
+  double ramp_s = 0.0;
 };
 
 /// Times [s]. t = 0 is when the background flow starts through the settled bed.
