@@ -1,12 +1,550 @@
-// `draglab sensitivity` (being written).
+// `draglab sensitivity`: a DPM scene per drag law, the bubble diameter at t_ref with its
+// numerical uncertainty, the seed's Fig. 4 as a PNG; and --work-precision (bubble diameter
+// against grid size and DEM step, with run times). docs/scenes.md, "Sensitivity and
+// work-precision".
+//   draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1
+//   draglab sensitivity SCENE --uncertainty grids --out out/quick --json
+//   draglab sensitivity SCENE --work-precision --law ergun@1 --grids 8x24,12x36 --contact-steps
+//   20,40
+//
+// The C++ side runs everything and writes DIR/sensitivity.json (or DIR/work_precision.json) with
+// every number and the snapshots; scripts/draglab_fig4.py (Debian's /usr/bin/python3 +
+// matplotlib) only draws from it, so a figure can be redrawn without rerunning.
+#include <limits.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+
 #include "cli/cli_context.h"
+#include "cli/progress.h"
+#include "draglab/consumers/scene.h"
+#include "draglab/consumers/sensitivity.h"
+#include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace cli {
+namespace {
+
+using consumers::Scene;
+
+const char* const kBundleFormat = "draglab_sensitivity";
+const char* const kWorkPrecisionFormat = "draglab_work_precision";
+const char* const kFigureScript = "draglab_fig4.py";
+
+struct SensitivityArgs {
+  std::string scene_path;
+  std::string laws;  // --laws a@1,b@1
+  std::string uncertainty = "realizations";
+  int realizations = 2;
+  double duration_s = 0.0;
+  std::string out_dir;
+  bool no_figure = false;
+  bool work_precision = false;
+  std::string law;            // --work-precision --law
+  std::string grids;          // --grids 8x24,12x36
+  std::string contact_steps;  // --contact-steps 20,40
+};
+
+std::vector<std::string> split_list(const std::string& text, const std::string& field) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item.empty()) throw UsageError(field + ": empty entry in '" + text + "' (expected a,b,c)");
+    out.push_back(item);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return out + "'";
+}
+
+bool file_exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool directory_exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+/// mkdir -p; throws UsageError naming --out if a component cannot be created.
+void make_directories(const std::string& path) {
+  std::size_t pos = 0;
+  while (pos != std::string::npos) {
+    pos = path.find('/', pos + 1);
+    const std::string partial = path.substr(0, pos);
+    if (partial.empty() || directory_exists(partial)) continue;
+    if (::mkdir(partial.c_str(), 0777) != 0 && !directory_exists(partial))
+      throw UsageError(fmt::format("--out: cannot create directory '{}'", partial));
+  }
+}
+
+std::string executable_dir() {
+  char buf[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) return "";
+  const std::string path(buf, static_cast<std::size_t>(n));
+  return path.substr(0, path.rfind('/'));
+}
+
+/// The figure script: installed next to the executable (bin/../share/draglab), else the source
+/// tree's (as `draglab report` finds draglab_report.py).
+std::string find_figure_script() {
+  const std::string installed =
+      executable_dir() + "/../" + DRAGLAB_INSTALL_SHARE_DIR + "/" + kFigureScript;
+  if (file_exists(installed)) return installed;
+  const std::string source = std::string(DRAGLAB_SOURCE_SCRIPTS_DIR) + "/" + kFigureScript;
+  if (file_exists(source)) return source;
+  throw std::runtime_error(fmt::format("the figure script {} was found neither at {} nor at {}",
+                                       kFigureScript, installed, source));
+}
+
+/// $DRAGLAB_PYTHON (tests, unusual installs), else Debian's interpreter with python3-matplotlib.
+std::string python_interpreter() {
+  const char* p = std::getenv("DRAGLAB_PYTHON");
+  return p && *p ? p : "/usr/bin/python3";
+}
+
+/// Writes JSON to `path` through a temporary file and a rename, so a reader never sees half.
+void write_json_file(const std::string& path, const nlohmann::json& j) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+    out << j.dump(1) << '\n';
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw std::runtime_error("cannot rename " + tmp + " to " + path);
+}
+
+/// Runs the figure script on `bundle`; it writes `figure` into out_dir.
+void render(const CliContext& ctx, const std::string& bundle, const std::string& out_dir,
+            const std::string& figure) {
+  const std::string python = python_interpreter();
+  const std::string probe = shell_quote(python) + " -c 'import matplotlib' >/dev/null 2>&1";
+  if (std::system(probe.c_str()) != 0) {
+    throw std::runtime_error(fmt::format(
+        "{} cannot import matplotlib: install the Debian package python3-matplotlib and rerun, "
+        "or draw the figure later with '/usr/bin/python3 {} {} {}'. The data {} were written.",
+        python, find_figure_script(), bundle, out_dir, bundle));
+  }
+  std::remove(figure.c_str());  // so a stale figure is never taken for a new one
+  const std::string command = shell_quote(python) + " " + shell_quote(find_figure_script()) + " " +
+                              shell_quote(bundle) + " " + shell_quote(out_dir) +
+                              (ctx.quiet ? " --quiet" : "") + " 1>&2";
+  const int status = std::system(command.c_str());
+  if (status != 0 || !file_exists(figure)) {
+    throw std::runtime_error(
+        fmt::format("the figure script failed (exit status {}): '{}'; the data {} were kept",
+                    status, command, bundle));
+  }
+}
+
+nlohmann::json number_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
+nlohmann::json bubble_json(const consumers::BubbleMetrics& b) {
+  return {{"found", b.found},
+          {"diameter_m", b.diameter_m},
+          {"area_m2", b.area_m2},
+          {"cells", b.cells},
+          {"centroid_x_m", b.centroid_x_m},
+          {"centroid_y_m", b.centroid_y_m},
+          {"top_m", b.top_m},
+          {"bottom_m", b.bottom_m},
+          {"touches_surface", b.touches_surface},
+          {"regions_above_threshold", b.regions_above_threshold},
+          {"bed_height_m", b.bed_height_m}};
+}
+
+nlohmann::json snapshot_json(const consumers::DpmSnapshot& s) {
+  const auto& f = s.void_fraction;
+  return {{"t_s", s.t_s},
+          {"layers", consumers::kInitialLayers},
+          {"x", s.x},
+          {"y", s.y},
+          {"diameter", s.diameter},
+          {"layer", s.layer},
+          {"void_fraction",
+           {{"nx", f.nx},
+            {"ny", f.ny},
+            {"width_m", f.width_m},
+            {"height_m", f.height_m},
+            {"values", f.values}}},
+          {"bubble", bubble_json(s.bubble)}};
+}
+
+nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySummary& s,
+                            bool with_snapshots) {
+  nlohmann::json grids = nlohmann::json::array();
+  for (const auto& g : s.grids) grids.push_back({g.cells_x, g.cells_y});
+  nlohmann::json packings = nlohmann::json::array();
+  for (const auto& p : s.packings) {
+    packings.push_back({{"seed", p.seed},
+                        {"particles", p.particles},
+                        {"settled_bed_height_m", p.settled_bed_height_m},
+                        {"settle_wall_s", p.settle_wall_s}});
+  }
+  nlohmann::json laws = nlohmann::json::array();
+  for (const auto& lr : s.laws) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const auto& r : lr.runs) {
+      runs.push_back({{"seed", r.seed},
+                      {"cells_x", r.cells_x},
+                      {"cells_y", r.cells_y},
+                      {"cell_size_m", r.cell_size_m},
+                      {"bubble_diameter_m", r.bubble_diameter_m},
+                      {"bubble_found", r.bubble_found},
+                      {"reached_t_ref", r.reached_t_ref},
+                      {"background_m_s", r.background_m_s},
+                      {"wall_s", r.wall_s},
+                      {"gas_steps", r.gas_steps},
+                      {"dem_steps", r.dem_steps},
+                      {"gas_dt_s", r.gas_dt_s},
+                      {"dem_dt_s", r.dem_dt_s},
+                      {"momentum_mismatch", r.momentum_mismatch},
+                      {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
+                      {"void_fraction_clamps", r.void_fraction_clamps},
+                      {"drag_out_of_range", r.drag_out_of_range}});
+    }
+    nlohmann::json law = {{"law", lr.law},
+                          {"umf_m_s", lr.umf_m_s},
+                          {"background_m_s", lr.background_m_s},
+                          {"background", lr.background_mode},
+                          {"d_mean_m", lr.diameter.mean_m},
+                          {"d_estimate_m", lr.diameter.estimate_m},
+                          {"uncertainty_m", lr.diameter.total_m},
+                          {"spread_m", lr.diameter.spread_m},
+                          {"boundary_m", lr.diameter.boundary_m},
+                          {"bubbles_found", lr.bubbles_found},
+                          {"bubble_found", lr.bubbles_found == static_cast<int>(lr.runs.size())},
+                          {"runs", runs},
+                          {"wall_s", lr.wall_s},
+                          {"has_snapshot", lr.has_snapshot}};
+    if (with_snapshots) {
+      law["snapshot"] = lr.has_snapshot ? snapshot_json(lr.snapshot) : nlohmann::json(nullptr);
+    }
+    laws.push_back(law);
+  }
+  return {{"format", kBundleFormat},
+          {"version", 1},
+          {"scene", s.scene},
+          {"scene_hash", s.scene_hash},
+          {"t_ref_s", s.t_ref_s},
+          {"eps_threshold", s.eps_threshold},
+          {"geometry",
+           {{"width_m", scene.geometry.width_m},
+            {"height_m", scene.geometry.height_m},
+            {"depth_m", scene.geometry.depth_m}}},
+          {"uncertainty",
+           {{"method", consumers::to_string(s.method)},
+            {"description", s.method_description},
+            {"grids", grids}}},
+          {"packings", packings},
+          {"laws", laws},
+          {"wall_s", s.wall_s}};
+}
+
+nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& r : w.rows) {
+    rows.push_back({{"cells_x", r.cells_x},
+                    {"cells_y", r.cells_y},
+                    {"contact_steps", r.contact_steps},
+                    {"cell_size_m", r.cell_size_m},
+                    {"bubble_diameter_m", r.bubble_diameter_m},
+                    {"bubble_found", r.bubble_found},
+                    {"reached_t_ref", r.reached_t_ref},
+                    {"error_m", number_or_null(r.error_m)},
+                    {"is_reference", r.is_reference},
+                    {"wall_s", r.wall_s},
+                    {"gas_steps", r.gas_steps},
+                    {"dem_steps", r.dem_steps},
+                    {"gas_dt_s", r.gas_dt_s},
+                    {"dem_dt_s", r.dem_dt_s}});
+  }
+  return {{"format", kWorkPrecisionFormat},
+          {"version", 1},
+          {"scene", w.scene},
+          {"scene_hash", w.scene_hash},
+          {"law", w.law},
+          {"seed", w.seed},
+          {"umf_m_s", w.umf_m_s},
+          {"background_m_s", w.background_m_s},
+          {"t_ref_s", w.t_ref_s},
+          {"reference_method", w.reference_method},
+          {"reference_diameter_m", w.reference_diameter_m},
+          {"observed_order", w.reference_method == "richardson" ? nlohmann::json(w.observed_order)
+                                                                : nlohmann::json(nullptr)},
+          {"reference_note", w.reference_note},
+          {"settle_wall_s", w.settle_wall_s},
+          {"rows", rows},
+          {"wall_s", w.wall_s}};
+}
+
+std::string cm(double metres) { return fmt::format("{:.2f}", 100.0 * metres); }
+
+void print_sensitivity_table(const consumers::SensitivitySummary& s) {
+  std::vector<std::string> per_run;
+  std::size_t per_run_width = 12;
+  for (const auto& lr : s.laws) {
+    std::string runs;
+    for (const auto& r : lr.runs)
+      runs += (runs.empty() ? "" : " ") + (r.bubble_found ? cm(r.bubble_diameter_m) : "-");
+    per_run_width = std::max(per_run_width, runs.size());
+    per_run.push_back(runs);
+  }
+  std::cout << fmt::format("Bubble diameter D at t_ref = {} s after injection, scene {}\n",
+                           format_number(s.t_ref_s, 4), s.scene);
+  std::cout << fmt::format("{:<22} {:>8} {:>16} {:>14}  {:<{}} {:>8}\n", "law", "U_mf m/s",
+                           "background m/s", "D cm", "D per run cm", per_run_width, "wall s");
+  for (std::size_t i = 0; i < s.laws.size(); ++i) {
+    const auto& lr = s.laws[i];
+    std::cout << fmt::format("{:<22} {:>8.3f} {:>16} {:>14}  {:<{}} {:>8.1f}\n", lr.law, lr.umf_m_s,
+                             fmt::format("{:.3f} ({})", lr.background_m_s, lr.background_mode),
+                             cm(lr.diameter.estimate_m) + " +- " + cm(lr.diameter.total_m),
+                             per_run[i], per_run_width, lr.wall_s);
+  }
+  std::cout << "  D +- u: " << s.method_description << "; '-': no bubble at t_ref (D = 0)\n";
+  for (const auto& p : s.packings) {
+    std::cout << fmt::format(
+        "  packing seed {}: {} particles, settled bed {} cm, settling {:.1f} s\n", p.seed,
+        p.particles, cm(p.settled_bed_height_m), p.settle_wall_s);
+  }
+}
+
+void print_work_precision_table(const consumers::WorkPrecisionResult& w) {
+  std::cout << w.BriefReport();
+  std::cout << fmt::format("{:>9} {:>13} {:>7} {:>7} {:>11} {:>9} {:>10} {:>8}\n", "grid",
+                           "contact_steps", "h cm", "D cm", "error cm", "gas steps", "DEM steps",
+                           "wall s");
+  for (const auto& r : w.rows) {
+    std::cout << fmt::format("{:>9} {:>13} {:>7} {:>7} {:>11} {:>9} {:>10} {:>8.1f}\n",
+                             fmt::format("{}x{}", r.cells_x, r.cells_y), r.contact_steps,
+                             cm(r.cell_size_m),
+                             r.bubble_found ? cm(r.bubble_diameter_m) : std::string("-"),
+                             std::isfinite(r.error_m) ? cm(r.error_m) : std::string("(ref)"),
+                             r.gas_steps, r.dem_steps, r.wall_s);
+  }
+  std::cout << "  error: |D - D_ref| against the reference above; h: the bubble-boundary bound "
+               "(one cell) of each grid\n";
+}
+
+void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args) {
+  // Flags of the other mode are a usage error, not silently ignored.
+  if (args.work_precision) {
+    if (!args.laws.empty())
+      throw UsageError("--laws is for the law table; with --work-precision give one --law NAME@V");
+    if (args.uncertainty != "realizations" || args.realizations != 2)
+      throw UsageError("--uncertainty/--realizations do not apply to --work-precision");
+    if (args.law.empty()) throw UsageError("--work-precision needs --law NAME@V (one law)");
+    if (args.law.find(',') != std::string::npos)
+      throw UsageError("--law: --work-precision takes one NAME@V, got '" + args.law + "'");
+  } else if (!args.law.empty() || !args.grids.empty() || !args.contact_steps.empty()) {
+    throw UsageError(
+        "--law, --grids and --contact-steps belong to --work-precision (the law "
+        "table takes --laws a@1,b@1)");
+  }
+  if (args.duration_s < 0.0 || !std::isfinite(args.duration_s))
+    throw UsageError("--duration must be >= 0 s (0: the scene's)");
+
+  const Scene scene = consumers::load_scene(args.scene_path);
+  consumers::DpmOptions dpm;
+  dpm.duration_s = args.duration_s;
+
+  consumers::SensitivityOptions sens;
+  consumers::WorkPrecisionOptions wp;
+  std::string why;
+  if (args.work_precision) {
+    wp.law = args.law;
+    if (!args.grids.empty()) wp.grids = consumers::parse_grid_list(args.grids, "--grids");
+    if (!args.contact_steps.empty()) {
+      for (double v : parse_double_list(args.contact_steps, "--contact-steps")) {
+        if (v != std::floor(v) || v < 20 || v > 1000)
+          throw UsageError(fmt::format(
+              "--contact-steps: {} is not a whole number in [20, 1000] (DEM steps per contact "
+              "time)",
+              format_number(v)));
+        wp.contact_steps.push_back(static_cast<int>(v));
+      }
+    }
+    wp.dpm = dpm;
+    if (!wp.IsValid(&why)) throw UsageError(why);
+  } else {
+    if (!args.laws.empty()) sens.laws = split_list(args.laws, "--laws");
+    sens.uncertainty = consumers::uncertainty_method_from_string(args.uncertainty);
+    if (args.realizations < 2 || args.realizations > 32)
+      throw UsageError(fmt::format("--realizations must be in [2, 32], got {}", args.realizations));
+    if (sens.uncertainty == consumers::UncertaintyMethod::kGrids && args.realizations != 2)
+      throw UsageError("--realizations applies to --uncertainty realizations only");
+    sens.realizations = args.realizations;
+    sens.dpm = dpm;
+    if (!sens.IsValid(&why)) throw UsageError(why);
+  }
+
+  const std::string out_dir =
+      args.out_dir.empty() ? "out/" + scene.name + "_sensitivity" : args.out_dir;
+
+  auto db = ctx.open_database(/*read_only=*/false);
+  const RangePolicy policy = range_policy_from_string(scene.range_policy);
+  std::set<std::string> warned;
+  const consumers::LawLoader loader = [&](const std::string& reference) {
+    std::string warning;
+    std::shared_ptr<const Law> law = db->load(reference, policy, &warning);
+    if (!warning.empty() && warned.insert(reference).second) ctx.warn(warning);
+    return law;
+  };
+  // One progress line for the whole study (its ETA is the study's); each settling or run is
+  // announced on its own line as it starts.
+  // The output folder is made at the first progress report: after the runner has checked every
+  // law and grid (bad input leaves nothing behind), before the first settling (a bad --out fails
+  // at once, not after the runs).
+  ProgressLine progress(!ctx.quiet);
+  std::string current;
+  bool out_dir_made = false;
+  const auto on_progress = [&](double f, const std::string& stage) {
+    if (!out_dir_made) {
+      make_directories(out_dir);
+      out_dir_made = true;
+    }
+    if (stage != current) {
+      current = stage;
+      progress.finish();
+      ctx.info(stage);
+    }
+    progress.update(f, args.work_precision ? "work-precision" : "sensitivity");
+  };
+
+  if (args.work_precision) {
+    const consumers::WorkPrecisionResult w =
+        consumers::run_work_precision(scene, loader, wp, on_progress);
+    progress.finish();
+    for (const auto& r : w.rows) {
+      if (!r.bubble_found)
+        ctx.warn(fmt::format("grid {}x{}, contact_steps {}: no bubble at t_ref (D = 0){}",
+                             r.cells_x, r.cells_y, r.contact_steps,
+                             r.reached_t_ref ? ""
+                                             : ": the run ended before t_ref (duration rounded "
+                                               "to whole gas steps; raise [time] duration_s)"));
+    }
+    make_directories(out_dir);
+    const std::string bundle = out_dir + "/work_precision.json";
+    const std::string figure = out_dir + "/work_precision.png";
+    nlohmann::json j = work_precision_json(w);
+    write_json_file(bundle, j);
+    if (!args.no_figure) render(ctx, bundle, out_dir, figure);
+    if (ctx.json) {
+      j["out_dir"] = out_dir;
+      j["data"] = bundle;
+      j["figure"] = args.no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
+      ctx.print_json(j);
+      return;
+    }
+    print_work_precision_table(w);
+    std::cout << "  data: " << bundle << (args.no_figure ? "" : "\n  figure: " + figure) << "\n";
+    return;
+  }
+
+  const consumers::SensitivitySummary s =
+      consumers::run_sensitivity(scene, loader, sens, on_progress);
+  progress.finish();
+  for (const auto& lr : s.laws) {
+    int not_reached = 0;
+    for (const auto& r : lr.runs) not_reached += r.reached_t_ref ? 0 : 1;
+    if (not_reached > 0)
+      ctx.warn(
+          fmt::format("{}: {} of {} runs ended before t_ref (the duration is rounded to whole "
+                      "gas steps): raise [time] duration_s a little past jet.start_s + "
+                      "t_ref_s",
+                      lr.law, not_reached, lr.runs.size()));
+    if (lr.bubbles_found < static_cast<int>(lr.runs.size()))
+      ctx.warn(
+          fmt::format("{}: no bubble at t_ref in {} of {} runs; D = 0 is taken for them, so "
+                      "its mean and uncertainty mix bubble and no bubble",
+                      lr.law, lr.runs.size() - lr.bubbles_found, lr.runs.size()));
+  }
+  make_directories(out_dir);
+  const std::string bundle = out_dir + "/sensitivity.json";
+  const std::string figure = out_dir + "/fig4.png";
+  write_json_file(bundle, summary_json(scene, s, /*with_snapshots=*/true));
+  if (!args.no_figure) render(ctx, bundle, out_dir, figure);
+  if (ctx.json) {
+    nlohmann::json j = summary_json(scene, s, /*with_snapshots=*/false);
+    j["out_dir"] = out_dir;
+    j["data"] = bundle;
+    j["figure"] = args.no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
+    ctx.print_json(j);
+    return;
+  }
+  print_sensitivity_table(s);
+  std::cout << "  data: " << bundle << (args.no_figure ? "" : "\n  figure: " + figure) << "\n";
+}
+
+}  // namespace
 
 void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
-  (void)app;
-  (void)ctx;
+  auto args = std::make_shared<SensitivityArgs>();
+  auto* cmd = app.add_subcommand(
+      "sensitivity",
+      "Run a DPM scene per drag law: bubble diameter at t_ref with its numerical uncertainty "
+      "(two packing realizations or two grids), the seed's Fig. 4 (bubble snapshot per law, "
+      "particles coloured by initial layer) as DIR/fig4.png; or, with --work-precision, the "
+      "bubble diameter against grid size and DEM step with run times");
+  cmd->add_option("SCENE", args->scene_path, "Scene file (TOML, docs/scenes.md)")->required();
+  cmd->add_option("--laws", args->laws, "Laws NAME@V,... (default: the scene's [drag] laws)");
+  cmd->add_option("--uncertainty", args->uncertainty,
+                  "realizations (default: seeds scene.seed and scene.seed+1, same grid) or grids "
+                  "(the scene's grid and a 1.5x finer one, same packing)");
+  cmd->add_option("--realizations", args->realizations,
+                  "Packing realizations for --uncertainty realizations, [2, 32] (default 2)");
+  cmd->add_option("--duration", args->duration_s,
+                  "Simulated time after the flow starts [s] (default: the scene's)");
+  cmd->add_option("--out", args->out_dir,
+                  "Output folder for the JSON data and the PNG (default out/<scene>_sensitivity)");
+  cmd->add_flag("--no-figure", args->no_figure,
+                "Write the JSON data only (draw later with /usr/bin/python3 "
+                "scripts/draglab_fig4.py DATA.json DIR)");
+  cmd->add_flag("--work-precision", args->work_precision,
+                "Work-precision study of one law (--law) over --grids x --contact-steps");
+  cmd->add_option("--law", args->law, "--work-precision: the law NAME@V");
+  cmd->add_option("--grids", args->grids,
+                  "--work-precision: grids CXxCY,... (default: the scene's), e.g. 8x24,12x36");
+  cmd->add_option("--contact-steps", args->contact_steps,
+                  "--work-precision: DEM steps per contact time, [20, 1000], e.g. 20,40 (default: "
+                  "the scene's)");
+  cmd->footer(
+      "Examples:\n"
+      "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1\n"
+      "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --uncertainty grids --json\n"
+      "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --work-precision --law ergun@1 "
+      "--grids 8x24,12x36 --contact-steps 20,40\n"
+      "Writes DIR/sensitivity.json + DIR/fig4.png, or DIR/work_precision.json + "
+      "DIR/work_precision.png.");
+  cmd->callback(
+      [&ctx, args] { ctx.action = [&ctx, args] { run_sensitivity_command(ctx, *args); }; });
 }
 
 }  // namespace cli

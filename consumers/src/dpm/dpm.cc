@@ -467,7 +467,8 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   Impl& m = *impl_;
   const Scene& s = scene_;
   const double duration = opt_.duration_s > 0.0 ? opt_.duration_s : s.time.duration_s;
-  const long steps = std::max(1L, std::lround(duration / gas_dt_));
+  // Enough steps to reach the duration (rounding down could stop one step short of t_ref).
+  const long steps = std::max(1L, static_cast<long>(std::ceil(duration / gas_dt_ - 1e-9)));
   const double interval = s.bubble.sample_interval_s;
   const int nx = s.grid.cells_x;
   const double area = s.geometry.width_m * s.geometry.depth_m;

@@ -1,0 +1,243 @@
+// draglab/consumers/sensitivity.h: how much a DPM bubble depends on the drag law, each law's
+// bubble diameter with its numerical uncertainty (the seed's Fig. 4 study), and the
+// work-precision study of one law (bubble diameter against grid size and DEM step, with run
+// times).
+//
+// run_sensitivity runs one scene (scene.h, docs/scenes.md) per law with the coupled DPM (dpm.h)
+// and reports the bubble diameter D at t_ref with an uncertainty from one of two sources:
+//  - realizations (default): the packing is settled once per seed (scene.seed, scene.seed + 1,
+//    ...) and every law starts from that same packing; the statistical part is the standard
+//    error of the mean over the n realizations, s / sqrt(n) with s the sample standard deviation
+//    (for n = 2: |D1 - D2| / 2);
+//  - grids: one packing, the scene's grid and a grid refined by grid_refinement (1.5); the value
+//    is the finer grid's D and the statistical part the Richardson error estimate of the finer
+//    value for first-order convergence (the traced boundary of a bubble is O(h)):
+//    |D_fine - D_coarse| / (r - 1), r = h_coarse / h_fine.
+// Either part is combined in quadrature with the discretisation bound of the bubble boundary,
+// h = max(dx, dy) of the (finest) grid used (bubble.h: |D - D_true| <~ one cell), which also
+// guards against two runs that agree by chance. The figures of draglab_fig4.py read the
+// snapshots (particles coloured by their initial layer, void fraction, bubble metrics) of the
+// first run of each law.
+//
+// run_work_precision runs one law on a list of grids x DEM contact steps from the same packing
+// (settled once with the scene's own DEM settings) and reports per configuration D at t_ref,
+// wall time, gas and DEM steps and the error against a reference: the Richardson extrapolation
+// of the three finest grids when they are refined by one common ratio and converge monotonically,
+// else the finest configuration itself ("finest as reference", whose own error is then unknown).
+//
+// Units SI. Limits: what dpm.h says (one gas cell across the depth, monodisperse, central jet);
+// two realizations give a rough standard error (a t-interval with one degree of freedom would be
+// 12.7 times wider at 95 %); the grid estimate assumes first-order convergence.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "draglab/consumers/dpm.h"
+#include "draglab/consumers/scene.h"
+#include "draglab/drag_db/law.h"
+
+namespace draglab {
+namespace consumers {
+
+/// Loads a law by "name@version" (the CLI passes Database::load with the scene's range policy,
+/// so consumers need not know the database). Called once per run, so each run gets a fresh
+/// out-of-range counter. Throws as Database::load does (unknown law: Error(kNotFound)).
+using LawLoader = std::function<std::shared_ptr<const Law>(const std::string& reference)>;
+
+/// Where the numerical uncertainty of a law's bubble diameter comes from.
+enum class UncertaintyMethod {
+  kRealizations,  ///< Several packing realizations (seeds), same grid.
+  kGrids,         ///< One packing, the scene's grid and a finer one.
+};
+const char* to_string(UncertaintyMethod method);
+/// "realizations" or "grids"; anything else is Error(kInvalidArgument) naming the choices.
+UncertaintyMethod uncertainty_method_from_string(const std::string& text);
+
+/// Gas cells across the width and the height.
+struct GridSize {
+  int cells_x = 0;
+  int cells_y = 0;
+};
+/// Parses "8x24,12x36" (at least one grid, each count >= 1); throws Error(kInvalidArgument)
+/// naming `field` and the expected form.
+std::vector<GridSize> parse_grid_list(const std::string& text, const std::string& field);
+
+/// Controls of run_sensitivity.
+struct SensitivityOptions {
+  std::vector<std::string> laws;  ///< "name@version", no duplicates; empty: the scene's [drag].
+  UncertaintyMethod uncertainty = UncertaintyMethod::kRealizations;
+  /// kRealizations: packings with seeds scene.seed, scene.seed + 1, ...; [2, 32].
+  int realizations = 2;
+  /// kGrids: the finer grid has round(factor x cells) cells each way; (1, 4].
+  double grid_refinement = 1.5;
+  /// Run controls for every run (duration, settling); jet must stay on (the bubble needs it).
+  DpmOptions dpm;
+  bool IsValid(std::string* error) const;
+};
+
+/// One coupled run of one law.
+struct SensitivityRun {
+  std::uint64_t seed = 0;  ///< Packing realization.
+  int cells_x = 0, cells_y = 0;
+  double cell_size_m = 0.0;        ///< max(dx, dy): the boundary bound of this grid.
+  double bubble_diameter_m = 0.0;  ///< D at t_ref; 0 when no bubble was found there.
+  bool bubble_found = false;
+  /// A sample lay within half a sample interval of t_ref; false: the run (its duration rounded
+  /// to whole gas steps) ended before t_ref, so "no bubble" means "not measured".
+  bool reached_t_ref = false;
+  double background_m_s = 0.0;  ///< Background used (umf_packing: depends on the packing).
+  double wall_s = 0.0;          ///< Coupled run only (the packing's settling is reported apart).
+  long gas_steps = 0;
+  std::int64_t dem_steps = 0;
+  double gas_dt_s = 0.0, dem_dt_s = 0.0;
+  double momentum_mismatch = 0.0;            ///< dpm.h DpmResult::momentum_mismatch.
+  double max_relative_mass_imbalance = 0.0;  ///< dpm.h.
+  std::int64_t void_fraction_clamps = 0;
+  std::uint64_t drag_out_of_range = 0;  ///< Clamped/extrapolated drag evaluations.
+};
+
+/// D with its numerical uncertainty [m] (see the file comment for the two methods).
+struct DiameterUncertainty {
+  double mean_m = 0.0;      ///< Arithmetic mean of the runs.
+  double estimate_m = 0.0;  ///< Reported value: the mean (realizations) or the finer grid's D.
+  double spread_m = 0.0;    ///< Standard error of the mean, or the Richardson grid estimate.
+  double boundary_m = 0.0;  ///< Cell-size bound h of the (finest) grid.
+  double total_m = 0.0;     ///< sqrt(spread^2 + boundary^2).
+};
+/// Realizations: mean, s / sqrt(n) (s the sample standard deviation; n >= 2), the bound h.
+/// Throws Error(kInvalidArgument) for fewer than two values, non-finite values or h <= 0.
+DiameterUncertainty realization_uncertainty(const std::vector<double>& diameters_m,
+                                            double cell_size_m);
+/// Grids: the finer value and |D_fine - D_coarse| / (h_coarse / h_fine - 1) with the bound
+/// h_fine. Throws Error(kInvalidArgument) unless 0 < h_fine < h_coarse and the values are finite.
+DiameterUncertainty grid_uncertainty(double d_coarse_m, double h_coarse_m, double d_fine_m,
+                                     double h_fine_m);
+
+/// One law's runs and its D with uncertainty.
+struct SensitivityLawResult {
+  std::string law;                   ///< name@version.
+  double umf_m_s = 0.0;              ///< The law's U_mf at the scene's eps_mf.
+  double background_m_s = 0.0;       ///< Background superficial velocity used.
+  std::string background_mode;       ///< "umf", "fixed" or "override".
+  std::vector<SensitivityRun> runs;  ///< Realizations in seed order, or coarse then fine grid.
+  DiameterUncertainty diameter;
+  int bubbles_found = 0;  ///< Runs that found a bubble at t_ref.
+  double wall_s = 0.0;    ///< Sum of the runs' wall times.
+  /// The first run's state at t_ref (particles, initial layers, void fraction, bubble), for the
+  /// figure; has_snapshot is false if the run ended before t_ref.
+  bool has_snapshot = false;
+  DpmSnapshot snapshot;
+};
+
+/// One settled packing (shared by every law of its realization).
+struct SensitivityPacking {
+  std::uint64_t seed = 0;
+  std::int64_t particles = 0;
+  double settled_bed_height_m = 0.0;
+  double settle_wall_s = 0.0;
+};
+
+/// Result of run_sensitivity.
+struct SensitivitySummary {
+  std::string scene;
+  std::string scene_hash;
+  UncertaintyMethod method = UncertaintyMethod::kRealizations;
+  std::string method_description;  ///< How the uncertainty was formed, in words.
+  double t_ref_s = 0.0;            ///< After jet start.
+  double eps_threshold = 0.0;      ///< Bubble criterion.
+  std::vector<GridSize> grids;     ///< Grids run (one, or coarse and fine).
+  std::vector<SensitivityPacking> packings;
+  std::vector<SensitivityLawResult> laws;  ///< In the order asked.
+  double wall_s = 0.0;                     ///< Everything, settling included.
+  /// One line per law: D = mean +- uncertainty.
+  std::string BriefReport() const;
+  /// BriefReport plus the method, every run's D, steps and wall time, the packings.
+  std::string FullReport() const;
+};
+
+/// Progress: fraction of the whole study in [0, 1] and the current unit (a settling or a run),
+/// "LABEL (k of N)", constant while that unit runs.
+using SensitivityProgress = std::function<void(double fraction, const std::string& stage)>;
+
+/// Runs every law of the scene (or options.laws) as described in the file comment. All laws are
+/// loaded and every grid and law checked (U_mf, time steps) before the first run, so bad input
+/// fails fast. Throws Error(kInvalidArgument) for invalid options or a finer grid the scene
+/// cannot take, the loader's errors (unknown law), and the DPM run's diagnoses.
+SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law,
+                                   const SensitivityOptions& options,
+                                   const SensitivityProgress& progress = nullptr);
+
+/// Controls of run_work_precision.
+struct WorkPrecisionOptions {
+  std::string law;                 ///< One "name@version"; required.
+  std::vector<GridSize> grids;     ///< Empty: the scene's grid. No duplicates.
+  std::vector<int> contact_steps;  ///< DEM steps per contact time, [20, 1000]; empty: scene's.
+  DpmOptions dpm;                  ///< Run controls (jet on).
+  bool IsValid(std::string* error) const;
+};
+
+/// One configuration of the work-precision study.
+struct WorkPrecisionRow {
+  int cells_x = 0, cells_y = 0;
+  int contact_steps = 0;
+  double cell_size_m = 0.0;  ///< max(dx, dy): the bubble boundary bound of this grid.
+  double bubble_diameter_m = 0.0;
+  bool bubble_found = false;
+  bool reached_t_ref = false;  ///< As SensitivityRun::reached_t_ref.
+  /// |D - D_reference|; NaN for the reference configuration itself under "finest as
+  /// reference" (its error is not known).
+  double error_m = 0.0;
+  bool is_reference = false;
+  double wall_s = 0.0;  ///< Coupled run (settling excluded: one packing for all rows).
+  long gas_steps = 0;
+  std::int64_t dem_steps = 0;
+  double gas_dt_s = 0.0, dem_dt_s = 0.0;
+};
+
+/// Richardson extrapolation of D from the three finest grids (cell sizes h1 > h2 > h3).
+struct RichardsonEstimate {
+  bool valid = false;
+  double order = 0.0;           ///< Observed order p = ln((D2 - D1)/(D3 - D2)) / ln r.
+  double extrapolated_m = 0.0;  ///< D3 + (D3 - D2) / (r^p - 1).
+  std::string reason;           ///< Why it is not valid (ratios differ, not monotone, ...).
+};
+/// Needs the three cell sizes refined by one ratio r (within 2 %) and monotone convergence
+/// (D2 - D1 and D3 - D2 of the same sign, shrinking), with 0.5 <= p <= 6; otherwise valid is
+/// false with the reason.
+RichardsonEstimate richardson_extrapolate(const std::vector<double>& cell_sizes_m,
+                                          const std::vector<double>& diameters_m);
+
+/// Result of run_work_precision.
+struct WorkPrecisionResult {
+  std::string scene;
+  std::string scene_hash;
+  std::string law;
+  std::uint64_t seed = 0;
+  double umf_m_s = 0.0, background_m_s = 0.0;
+  double t_ref_s = 0.0;
+  /// "richardson" (observed order and extrapolated D below) or "finest as reference".
+  std::string reference_method;
+  double reference_diameter_m = 0.0;
+  double observed_order = 0.0;  ///< Richardson only; 0 otherwise.
+  std::string reference_note;   ///< Why Richardson was not possible, when it was not.
+  double settle_wall_s = 0.0;
+  std::vector<WorkPrecisionRow> rows;  ///< Grids in the order given, contact steps inside.
+  double wall_s = 0.0;
+  std::string BriefReport() const;  ///< The reference and the range of errors and times.
+  std::string FullReport() const;   ///< BriefReport plus the table.
+};
+
+/// Runs the study (every grid with every contact_steps value; the scene's dem_dt_s is set to 0
+/// so that contact_steps sets the DEM step). Throws Error(kInvalidArgument) for invalid options
+/// or a configuration the scene cannot take (grid finer than a particle, gas step), the loader's
+/// errors, and the DPM run's diagnoses.
+WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load_law,
+                                       const WorkPrecisionOptions& options,
+                                       const SensitivityProgress& progress = nullptr);
+
+}  // namespace consumers
+}  // namespace draglab

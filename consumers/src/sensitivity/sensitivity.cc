@@ -1,0 +1,652 @@
+// Bubble diameter per drag law with its numerical uncertainty, and the work-precision study
+// (draglab/consumers/sensitivity.h, docs/scenes.md "Sensitivity and work-precision").
+#include "draglab/consumers/sensitivity.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+[[noreturn]] void Fail(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+std::string Num(double x, int digits = 4) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << x;
+  return s.str();
+}
+
+std::string Cm(double metres) { return Num(100.0 * metres, 3); }
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+std::string GridText(int cells_x, int cells_y) {
+  return std::to_string(cells_x) + "x" + std::to_string(cells_y);
+}
+
+/// The bubble boundary bound of a grid (bubble.h): the traced boundary is misplaced by up to half
+/// a cell along the perimeter; with non-square cells the larger side bounds it.
+double CellSize(const Scene& s) {
+  return std::max(s.geometry.width_m / s.grid.cells_x, s.geometry.height_m / s.grid.cells_y);
+}
+
+/// The scene on another grid (and DEM step), checked; `what` names the configuration in the
+/// message of a scene that cannot take it.
+Scene SceneOnGrid(const Scene& scene, GridSize grid, int contact_steps, const std::string& what) {
+  Scene s = scene;
+  s.grid.cells_x = grid.cells_x;
+  s.grid.cells_y = grid.cells_y;
+  if (contact_steps > 0) {
+    s.time.contact_steps = contact_steps;
+    s.time.dem_dt_s = 0.0;  // the DEM step follows contact_steps (t_c / contact_steps)
+  }
+  std::string why;
+  if (!s.IsValid(&why)) Fail(what + ": " + why);
+  return s;
+}
+
+/// Run controls for one run: the scene's file outputs, if it asks for any, go to a folder per
+/// run instead of every run overwriting the same files.
+DpmOptions RunOptions(const DpmOptions& base, const Scene& s, const std::string& law,
+                      const std::string& tag) {
+  DpmOptions o = base;
+  if (!(s.outputs.fields || s.outputs.particles)) return o;
+  std::string dir = !base.output_directory.empty() ? base.output_directory
+                    : !s.outputs.directory.empty() ? s.outputs.directory
+                                                   : "out/" + s.name;
+  std::string name = law;
+  std::replace(name.begin(), name.end(), '@', '_');
+  o.output_directory = dir + "/" + name + "_" + tag;
+  return o;
+}
+
+std::shared_ptr<const Law> Load(const LawLoader& load_law, const std::string& reference) {
+  std::shared_ptr<const Law> law = load_law(reference);
+  if (!law) Fail("law loader returned no law for '" + reference + "'");
+  return law;
+}
+
+SensitivityRun MakeRun(const DpmResult& r, const Scene& s) {
+  SensitivityRun run;
+  run.seed = s.seed;
+  run.cells_x = s.grid.cells_x;
+  run.cells_y = s.grid.cells_y;
+  run.cell_size_m = CellSize(s);
+  run.bubble_found = r.bubble_at_t_ref;
+  run.reached_t_ref = r.has_snapshot;  // set at the sample nearest t_ref, if any was close
+  run.bubble_diameter_m = r.bubble_at_t_ref ? r.bubble_diameter_m : 0.0;
+  run.background_m_s = r.background_m_s;
+  run.wall_s = r.wall_s;
+  run.gas_steps = r.gas_steps;
+  run.dem_steps = r.dem_steps;
+  run.gas_dt_s = r.gas_dt_s;
+  run.dem_dt_s = r.dem_dt_s;
+  run.momentum_mismatch = r.momentum_mismatch;
+  run.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
+  run.void_fraction_clamps = r.void_fraction_clamps;
+  run.drag_out_of_range = r.law_out_of_range;
+  return run;
+}
+
+/// Settles one packing of `scene` (its seed) with the DPM's own settling; the law is needed by
+/// the simulation object only (settling has no gas).
+Particles SettlePacking(const Scene& scene, std::shared_ptr<const Law> law,
+                        const DpmOptions& options, const DpmProgress& progress,
+                        SensitivityPacking* info) {
+  const auto t0 = Clock::now();
+  DpmSimulation settler(scene, std::move(law), options);
+  settler.Settle(progress);
+  Particles packing = settler.dem().particles();
+  info->seed = scene.seed;
+  info->particles = static_cast<std::int64_t>(packing.size());
+  info->settled_bed_height_m = settler.settled_bed_height_m();
+  info->settle_wall_s = Seconds(t0);
+  return packing;
+}
+
+/// Progress over `total` equal units (a settling or a run each). The stage text is the unit's
+/// label, "LABEL (k of N)", constant over the unit, so that a caller can time and announce it.
+class StudyProgress {
+ public:
+  StudyProgress(const SensitivityProgress& progress, int total)
+      : progress_(progress), total_(std::max(1, total)) {}
+  DpmProgress Unit(const std::string& label) {
+    const int unit = done_++;
+    if (!progress_) return nullptr;
+    const std::string stage =
+        label + " (" + std::to_string(unit + 1) + " of " + std::to_string(total_) + ")";
+    return [this, unit, stage](double f, const std::string&) {
+      progress_((unit + std::clamp(f, 0.0, 1.0)) / total_, stage);
+    };
+  }
+
+ private:
+  SensitivityProgress progress_;
+  int total_;
+  int done_ = 0;
+};
+
+void CheckLawList(const std::vector<std::string>& laws, const std::string& field, std::string* why,
+                  bool* ok) {
+  std::set<std::string> seen;
+  for (const auto& l : laws) {
+    if (l.empty() || l.find_first_of(" \t,") != std::string::npos || l.find('@') == 0) {
+      *why = field + ": '" + l + "' is not a law reference NAME@VERSION (e.g. ergun@1)";
+      *ok = false;
+      return;
+    }
+    if (!seen.insert(l).second) {
+      *why = field + ": '" + l + "' is listed twice";
+      *ok = false;
+      return;
+    }
+  }
+}
+
+}  // namespace
+
+const char* to_string(UncertaintyMethod method) {
+  return method == UncertaintyMethod::kGrids ? "grids" : "realizations";
+}
+
+UncertaintyMethod uncertainty_method_from_string(const std::string& text) {
+  if (text == "realizations") return UncertaintyMethod::kRealizations;
+  if (text == "grids") return UncertaintyMethod::kGrids;
+  Fail("uncertainty: '" + text + "' is not a method (use realizations or grids)");
+}
+
+std::vector<GridSize> parse_grid_list(const std::string& text, const std::string& field) {
+  const std::string form = " (expected CELLS_XxCELLS_Y[,...], e.g. 8x24,12x36)";
+  std::vector<GridSize> grids;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const std::size_t x = item.find('x');
+    GridSize g;
+    bool ok = x != std::string::npos && x > 0 && x + 1 < item.size();
+    for (std::size_t k = 0; ok && k < item.size(); ++k)
+      ok = k == x || (item[k] >= '0' && item[k] <= '9');
+    if (ok && x <= 6 && item.size() - x - 1 <= 6) {
+      g.cells_x = std::stoi(item.substr(0, x));
+      g.cells_y = std::stoi(item.substr(x + 1));
+    }
+    if (!ok || g.cells_x < 1 || g.cells_y < 1)
+      Fail(field + ": '" + item + "' is not a grid of at least 1x1 cells" + form);
+    grids.push_back(g);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return grids;
+}
+
+bool SensitivityOptions::IsValid(std::string* error) const {
+  std::string why;
+  bool ok = true;
+  CheckLawList(laws, "SensitivityOptions.laws", &why, &ok);
+  if (ok && !(realizations >= 2 && realizations <= 32)) {
+    why = "SensitivityOptions.realizations must be in [2, 32], got " + std::to_string(realizations);
+    ok = false;
+  }
+  if (ok && !(grid_refinement > 1.0 && grid_refinement <= 4.0)) {
+    why = "SensitivityOptions.grid_refinement must be in (1, 4], got " + Num(grid_refinement);
+    ok = false;
+  }
+  if (ok && !dpm.jet) {
+    why = "SensitivityOptions.dpm.jet must be true (the bubble is the jet's)";
+    ok = false;
+  }
+  if (ok && dpm.freeze_particles) {
+    why = "SensitivityOptions.dpm.freeze_particles must be false (a frozen bed has no bubble)";
+    ok = false;
+  }
+  if (ok && !dpm.IsValid(&why)) ok = false;
+  if (!ok && error) *error = why;
+  return ok;
+}
+
+bool WorkPrecisionOptions::IsValid(std::string* error) const {
+  std::string why;
+  bool ok = true;
+  CheckLawList({law}, "WorkPrecisionOptions.law", &why, &ok);
+  for (std::size_t a = 0; ok && a < grids.size(); ++a) {
+    if (grids[a].cells_x < 1 || grids[a].cells_y < 1) {
+      why = "WorkPrecisionOptions.grids: " + GridText(grids[a].cells_x, grids[a].cells_y) +
+            " needs at least 1 cell each way";
+      ok = false;
+    }
+    for (std::size_t b = 0; ok && b < a; ++b) {
+      if (grids[a].cells_x == grids[b].cells_x && grids[a].cells_y == grids[b].cells_y) {
+        why = "WorkPrecisionOptions.grids: " + GridText(grids[a].cells_x, grids[a].cells_y) +
+              " is listed twice";
+        ok = false;
+      }
+    }
+  }
+  for (std::size_t a = 0; ok && a < contact_steps.size(); ++a) {
+    if (contact_steps[a] < 20 || contact_steps[a] > 1000) {
+      why = "WorkPrecisionOptions.contact_steps: " + std::to_string(contact_steps[a]) +
+            " is outside [20, 1000] (DEM steps per contact time; 20 is the stability limit)";
+      ok = false;
+    }
+    for (std::size_t b = 0; ok && b < a; ++b) {
+      if (contact_steps[a] == contact_steps[b]) {
+        why = "WorkPrecisionOptions.contact_steps: " + std::to_string(contact_steps[a]) +
+              " is listed twice";
+        ok = false;
+      }
+    }
+  }
+  if (ok && (!dpm.jet || dpm.freeze_particles)) {
+    why = "WorkPrecisionOptions.dpm: the jet must be on and the particles free (no bubble else)";
+    ok = false;
+  }
+  if (ok && !dpm.IsValid(&why)) ok = false;
+  if (!ok && error) *error = why;
+  return ok;
+}
+
+DiameterUncertainty realization_uncertainty(const std::vector<double>& diameters_m,
+                                            double cell_size_m) {
+  const std::size_t n = diameters_m.size();
+  if (n < 2)
+    Fail("realization_uncertainty: needs at least two realizations, got " + std::to_string(n));
+  if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m))
+    Fail("realization_uncertainty: cell_size_m must be > 0, got " + Num(cell_size_m));
+  double sum = 0.0;
+  for (double d : diameters_m) {
+    if (!std::isfinite(d)) Fail("realization_uncertainty: a diameter is not finite");
+    sum += d;
+  }
+  DiameterUncertainty u;
+  u.mean_m = sum / static_cast<double>(n);
+  double squares = 0.0;
+  for (double d : diameters_m) squares += (d - u.mean_m) * (d - u.mean_m);
+  const double sample_variance = squares / static_cast<double>(n - 1);
+  u.estimate_m = u.mean_m;
+  u.spread_m = std::sqrt(sample_variance / static_cast<double>(n));  // n = 2: |D1 - D2| / 2
+  u.boundary_m = cell_size_m;
+  u.total_m = std::hypot(u.spread_m, u.boundary_m);
+  return u;
+}
+
+DiameterUncertainty grid_uncertainty(double d_coarse_m, double h_coarse_m, double d_fine_m,
+                                     double h_fine_m) {
+  if (!std::isfinite(d_coarse_m) || !std::isfinite(d_fine_m))
+    Fail("grid_uncertainty: a diameter is not finite");
+  if (!(h_fine_m > 0.0 && h_fine_m < h_coarse_m) || !std::isfinite(h_coarse_m))
+    Fail("grid_uncertainty: needs 0 < h_fine < h_coarse, got h_fine = " + Num(h_fine_m) +
+         " m, h_coarse = " + Num(h_coarse_m) + " m");
+  DiameterUncertainty u;
+  u.mean_m = 0.5 * (d_coarse_m + d_fine_m);
+  u.estimate_m = d_fine_m;
+  // Richardson for order 1: D_fine - D_exact ~ (D_fine - D_coarse) / (r - 1).
+  u.spread_m = std::abs(d_fine_m - d_coarse_m) / (h_coarse_m / h_fine_m - 1.0);
+  u.boundary_m = h_fine_m;
+  u.total_m = std::hypot(u.spread_m, u.boundary_m);
+  return u;
+}
+
+RichardsonEstimate richardson_extrapolate(const std::vector<double>& cell_sizes_m,
+                                          const std::vector<double>& diameters_m) {
+  RichardsonEstimate est;
+  if (cell_sizes_m.size() != 3 || diameters_m.size() != 3) {
+    est.reason = "needs exactly three grids";
+    return est;
+  }
+  const double h1 = cell_sizes_m[0], h2 = cell_sizes_m[1], h3 = cell_sizes_m[2];
+  if (!(h1 > h2 && h2 > h3 && h3 > 0.0)) {
+    est.reason = "cell sizes must decrease (coarse to fine)";
+    return est;
+  }
+  const double r = h1 / h2;
+  if (std::abs(h2 / h3 / r - 1.0) > 0.02) {
+    est.reason = "the three finest grids are not refined by one ratio (" + Num(h1 / h2) + " then " +
+                 Num(h2 / h3) + ")";
+    return est;
+  }
+  const double e21 = diameters_m[1] - diameters_m[0], e32 = diameters_m[2] - diameters_m[1];
+  if (!(e21 * e32 > 0.0) || !(std::abs(e32) < std::abs(e21))) {
+    est.reason = "D does not converge monotonically on the three finest grids (" +
+                 Num(diameters_m[0]) + ", " + Num(diameters_m[1]) + ", " + Num(diameters_m[2]) +
+                 " m)";
+    return est;
+  }
+  const double p = std::log(e21 / e32) / std::log(r);
+  if (!(p >= 0.5 && p <= 6.0)) {
+    est.reason = "observed order " + Num(p) + " is outside [0.5, 6]";
+    return est;
+  }
+  est.valid = true;
+  est.order = p;
+  est.extrapolated_m = diameters_m[2] + e32 / (std::pow(r, p) - 1.0);
+  return est;
+}
+
+SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law,
+                                   const SensitivityOptions& options,
+                                   const SensitivityProgress& progress) {
+  const auto t0 = Clock::now();
+  scene.Validate();
+  if (scene.solver != "dpm")
+    Fail("scene.solver: sensitivity runs \"dpm\" scenes only, got \"" + scene.solver + "\"");
+  std::string why;
+  if (!options.IsValid(&why)) Fail(why);
+  if (!load_law) Fail("run_sensitivity: no law loader given");
+  const std::vector<std::string> laws = options.laws.empty() ? scene.laws : options.laws;
+
+  // Grids and seeds of the study.
+  std::vector<Scene> grid_scenes = {scene};
+  if (options.uncertainty == UncertaintyMethod::kGrids) {
+    GridSize fine{static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_x)),
+                  static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_y))};
+    grid_scenes.push_back(SceneOnGrid(scene, fine, 0,
+                                      "the finer grid (" + Num(options.grid_refinement) +
+                                          " x the scene's, " +
+                                          GridText(fine.cells_x, fine.cells_y) + " cells)"));
+    if (!(CellSize(grid_scenes[1]) < CellSize(scene)))
+      Fail("the finer grid " + GridText(fine.cells_x, fine.cells_y) +
+           " has no smaller cells than the scene's; raise grid_refinement");
+  }
+  std::vector<std::uint64_t> seeds;
+  const int n_seeds =
+      options.uncertainty == UncertaintyMethod::kRealizations ? options.realizations : 1;
+  for (int k = 0; k < n_seeds; ++k) seeds.push_back(scene.seed + static_cast<std::uint64_t>(k));
+
+  // Fail fast: every law loads and has a U_mf and stable steps on every grid.
+  for (const auto& ref : laws) {
+    const auto law = Load(load_law, ref);
+    for (const Scene& gs : grid_scenes) (void)derive_scene(gs, *law);
+  }
+
+  SensitivitySummary summary;
+  summary.scene = scene.name;
+  summary.scene_hash = scene.hash();
+  summary.method = options.uncertainty;
+  summary.t_ref_s = scene.time.t_ref_s;
+  summary.eps_threshold = scene.bubble.eps_threshold;
+  for (const Scene& gs : grid_scenes) summary.grids.push_back({gs.grid.cells_x, gs.grid.cells_y});
+  if (options.uncertainty == UncertaintyMethod::kRealizations) {
+    summary.method_description =
+        std::to_string(n_seeds) + " packing realizations (seeds " + std::to_string(seeds.front()) +
+        ".." + std::to_string(seeds.back()) +
+        ") on one grid; D = mean of the runs; uncertainty = sqrt(SE^2 + h^2) with SE = s/sqrt(n) "
+        "the standard error of the mean (n = 2: |D1 - D2|/2) and h = max(dx, dy) = " +
+        Cm(CellSize(scene)) + " cm the bubble-boundary bound of the grid";
+  } else {
+    const double r = CellSize(grid_scenes[0]) / CellSize(grid_scenes[1]);
+    summary.method_description =
+        "one packing (seed " + std::to_string(scene.seed) + ") on the grids " +
+        GridText(scene.grid.cells_x, scene.grid.cells_y) + " and " +
+        GridText(grid_scenes[1].grid.cells_x, grid_scenes[1].grid.cells_y) + " (r = " + Num(r) +
+        "); D = the finer grid's; uncertainty = sqrt(E^2 + h^2) with E = |D_fine - D_coarse|/(r - "
+        "1) the Richardson error of the finer value for first-order convergence and h = max(dx, "
+        "dy) = " +
+        Cm(CellSize(grid_scenes[1])) + " cm the bubble-boundary bound of the finer grid";
+  }
+
+  summary.laws.resize(laws.size());
+  for (std::size_t i = 0; i < laws.size(); ++i) summary.laws[i].law = laws[i];
+  StudyProgress study(progress,
+                      static_cast<int>(seeds.size() * (1 + grid_scenes.size() * laws.size())));
+  for (std::size_t k = 0; k < seeds.size(); ++k) {
+    Scene seeded = scene;
+    seeded.seed = seeds[k];
+    SensitivityPacking packing_info;
+    // Settled once per realization; every law and grid starts from this same packing.
+    const Particles packing =
+        SettlePacking(seeded, Load(load_law, laws.front()), options.dpm,
+                      study.Unit("settle packing seed " + std::to_string(seeds[k])), &packing_info);
+    summary.packings.push_back(packing_info);
+    for (std::size_t g = 0; g < grid_scenes.size(); ++g) {
+      Scene run_scene = grid_scenes[g];
+      run_scene.seed = seeds[k];
+      const std::string tag = "seed" + std::to_string(seeds[k]) + "_" +
+                              GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
+      for (std::size_t i = 0; i < laws.size(); ++i) {
+        DpmSimulation sim(run_scene, Load(load_law, laws[i]),
+                          RunOptions(options.dpm, run_scene, laws[i], tag));
+        sim.Start(packing);
+        const DpmResult r = sim.Run(study.Unit(laws[i] + " " + tag));
+        SensitivityLawResult& lr = summary.laws[i];
+        lr.runs.push_back(MakeRun(r, run_scene));
+        lr.wall_s += r.wall_s;
+        if (lr.runs.size() == 1) {
+          lr.umf_m_s = r.umf_m_s;
+          lr.background_m_s = r.background_m_s;
+          lr.background_mode = r.background_mode;
+          lr.has_snapshot = r.has_snapshot;
+          if (r.has_snapshot) lr.snapshot = r.snapshot;
+        }
+      }
+    }
+  }
+
+  for (SensitivityLawResult& lr : summary.laws) {
+    std::vector<double> d;
+    for (const SensitivityRun& run : lr.runs) {
+      d.push_back(run.bubble_diameter_m);
+      lr.bubbles_found += run.bubble_found ? 1 : 0;
+    }
+    if (options.uncertainty == UncertaintyMethod::kRealizations) {
+      lr.diameter = realization_uncertainty(d, lr.runs.front().cell_size_m);
+    } else {
+      lr.diameter = grid_uncertainty(d[0], lr.runs[0].cell_size_m, d[1], lr.runs[1].cell_size_m);
+    }
+  }
+  summary.wall_s = Seconds(t0);
+  return summary;
+}
+
+std::string SensitivitySummary::BriefReport() const {
+  std::ostringstream s;
+  s << "Bubble diameter at t_ref = " << Num(t_ref_s) << " s after injection, scene " << scene
+    << " (" << to_string(method) << "):\n";
+  for (const SensitivityLawResult& lr : laws) {
+    s << "  " << lr.law << ": D = " << Cm(lr.diameter.estimate_m) << " +- "
+      << Cm(lr.diameter.total_m) << " cm";
+    if (lr.bubbles_found < static_cast<int>(lr.runs.size()))
+      s << " (no bubble at t_ref in " << lr.runs.size() - lr.bubbles_found << " of "
+        << lr.runs.size() << " runs: D = 0 there)";
+    s << "; U_mf " << Num(lr.umf_m_s) << " m/s, background " << Num(lr.background_m_s) << " m/s\n";
+  }
+  return s.str();
+}
+
+std::string SensitivitySummary::FullReport() const {
+  std::ostringstream s;
+  s << BriefReport() << "  uncertainty: " << method_description << "\n";
+  for (const SensitivityPacking& p : packings) {
+    s << "  packing seed " << p.seed << ": " << p.particles << " particles, settled bed "
+      << Cm(p.settled_bed_height_m) << " cm, settling " << Num(p.settle_wall_s, 3) << " s wall\n";
+  }
+  for (const SensitivityLawResult& lr : laws) {
+    s << "  " << lr.law << " (mean " << Cm(lr.diameter.mean_m) << " cm, spread "
+      << Cm(lr.diameter.spread_m) << " cm, cell bound " << Cm(lr.diameter.boundary_m) << " cm):\n";
+    for (const SensitivityRun& r : lr.runs) {
+      s << "    seed " << r.seed << ", grid " << GridText(r.cells_x, r.cells_y) << ": D "
+        << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none")) << ", "
+        << r.gas_steps << " gas / " << r.dem_steps << " DEM steps, " << Num(r.wall_s, 3)
+        << " s wall, momentum mismatch " << Num(r.momentum_mismatch, 2) << "\n";
+    }
+  }
+  s << "  total wall " << Num(wall_s, 3) << " s\n";
+  return s.str();
+}
+
+WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load_law,
+                                       const WorkPrecisionOptions& options,
+                                       const SensitivityProgress& progress) {
+  const auto t0 = Clock::now();
+  scene.Validate();
+  if (scene.solver != "dpm")
+    Fail("scene.solver: work-precision runs \"dpm\" scenes only, got \"" + scene.solver + "\"");
+  std::string why;
+  if (!options.IsValid(&why)) Fail(why);
+  if (!load_law) Fail("run_work_precision: no law loader given");
+  const std::vector<GridSize> grids =
+      options.grids.empty() ? std::vector<GridSize>{{scene.grid.cells_x, scene.grid.cells_y}}
+                            : options.grids;
+  const std::vector<int> steps = options.contact_steps.empty()
+                                     ? std::vector<int>{scene.time.contact_steps}
+                                     : options.contact_steps;
+
+  // Every configuration is checked (and the law's U_mf and gas steps) before the first run.
+  std::vector<Scene> configs;
+  for (const GridSize& g : grids) {
+    for (int cs : steps) {
+      configs.push_back(SceneOnGrid(
+          scene, g, cs,
+          "grid " + GridText(g.cells_x, g.cells_y) + " with contact_steps " + std::to_string(cs)));
+    }
+  }
+  {
+    const auto law = Load(load_law, options.law);
+    for (const Scene& c : configs) (void)derive_scene(c, *law);
+  }
+
+  WorkPrecisionResult result;
+  result.scene = scene.name;
+  result.scene_hash = scene.hash();
+  result.law = options.law;
+  result.seed = scene.seed;
+  result.t_ref_s = scene.time.t_ref_s;
+  StudyProgress study(progress, 1 + static_cast<int>(configs.size()));
+  SensitivityPacking packing_info;
+  // One packing, settled with the scene's own DEM settings, for every configuration.
+  const Particles packing =
+      SettlePacking(scene, Load(load_law, options.law), options.dpm,
+                    study.Unit("settle packing seed " + std::to_string(scene.seed)), &packing_info);
+  result.settle_wall_s = packing_info.settle_wall_s;
+  for (const Scene& c : configs) {
+    const std::string tag =
+        GridText(c.grid.cells_x, c.grid.cells_y) + "_cs" + std::to_string(c.time.contact_steps);
+    DpmSimulation sim(c, Load(load_law, options.law), RunOptions(options.dpm, c, options.law, tag));
+    sim.Start(packing);
+    const DpmResult r = sim.Run(study.Unit(options.law + " " + tag));
+    WorkPrecisionRow row;
+    row.cells_x = c.grid.cells_x;
+    row.cells_y = c.grid.cells_y;
+    row.contact_steps = c.time.contact_steps;
+    row.cell_size_m = CellSize(c);
+    row.bubble_found = r.bubble_at_t_ref;
+    row.reached_t_ref = r.has_snapshot;
+    row.bubble_diameter_m = r.bubble_at_t_ref ? r.bubble_diameter_m : 0.0;
+    row.wall_s = r.wall_s;
+    row.gas_steps = r.gas_steps;
+    row.dem_steps = r.dem_steps;
+    row.gas_dt_s = r.gas_dt_s;
+    row.dem_dt_s = r.dem_dt_s;
+    result.rows.push_back(row);
+    result.umf_m_s = r.umf_m_s;
+    result.background_m_s = r.background_m_s;
+  }
+
+  // Reference: Richardson over the three finest grids at the finest DEM step, else the finest
+  // configuration (most cells, then most contact steps).
+  const int finest_steps = *std::max_element(steps.begin(), steps.end());
+  std::vector<const WorkPrecisionRow*> at_finest_steps;
+  for (const auto& row : result.rows)
+    if (row.contact_steps == finest_steps) at_finest_steps.push_back(&row);
+  std::sort(at_finest_steps.begin(), at_finest_steps.end(),
+            [](const WorkPrecisionRow* a, const WorkPrecisionRow* b) {
+              return a->cell_size_m > b->cell_size_m;  // coarse to fine
+            });
+  RichardsonEstimate rich;
+  if (at_finest_steps.size() >= 3) {
+    const std::size_t n = at_finest_steps.size();
+    std::vector<double> h, d;
+    bool uniform = true;
+    for (std::size_t k = n - 3; k < n; ++k) {
+      h.push_back(at_finest_steps[k]->cell_size_m);
+      d.push_back(at_finest_steps[k]->bubble_diameter_m);
+      // Refinement must be the same in both directions for one cell size to describe a grid.
+      const double rx = static_cast<double>(at_finest_steps[k]->cells_x) /
+                        at_finest_steps[n - 3]->cells_x,
+                   ry = static_cast<double>(at_finest_steps[k]->cells_y) /
+                        at_finest_steps[n - 3]->cells_y;
+      uniform = uniform && std::abs(rx / ry - 1.0) <= 0.02;
+      uniform = uniform && at_finest_steps[k]->bubble_found;
+    }
+    rich = uniform ? richardson_extrapolate(h, d)
+                   : RichardsonEstimate{false, 0.0, 0.0,
+                                        "the three finest grids are not refined alike in x and "
+                                        "y, or one of them has no bubble at t_ref"};
+  } else {
+    rich.reason = "fewer than three grids";
+  }
+  if (rich.valid) {
+    result.reference_method = "richardson";
+    result.observed_order = rich.order;
+    result.reference_diameter_m = rich.extrapolated_m;
+    for (auto& row : result.rows)
+      row.error_m = std::abs(row.bubble_diameter_m - result.reference_diameter_m);
+  } else {
+    result.reference_method = "finest as reference";
+    result.reference_note = "Richardson not possible: " + rich.reason;
+    std::size_t finest = 0;
+    for (std::size_t k = 1; k < result.rows.size(); ++k) {
+      const auto& a = result.rows[k];
+      const auto& b = result.rows[finest];
+      const long cells_a = static_cast<long>(a.cells_x) * a.cells_y,
+                 cells_b = static_cast<long>(b.cells_x) * b.cells_y;
+      if (cells_a > cells_b || (cells_a == cells_b && a.contact_steps > b.contact_steps))
+        finest = k;
+    }
+    result.rows[finest].is_reference = true;
+    result.reference_diameter_m = result.rows[finest].bubble_diameter_m;
+    for (auto& row : result.rows) {
+      row.error_m = row.is_reference
+                        ? std::numeric_limits<double>::quiet_NaN()
+                        : std::abs(row.bubble_diameter_m - result.reference_diameter_m);
+    }
+  }
+  result.wall_s = Seconds(t0);
+  return result;
+}
+
+std::string WorkPrecisionResult::BriefReport() const {
+  std::ostringstream s;
+  s << "Work-precision of " << law << " on scene " << scene << " (seed " << seed
+    << "): D at t_ref = " << Num(t_ref_s) << " s; reference " << reference_method
+    << " D = " << Cm(reference_diameter_m) << " cm";
+  if (reference_method == "richardson") s << " (observed order " << Num(observed_order, 3) << ")";
+  s << "; " << rows.size() << " configurations, settling " << Num(settle_wall_s, 3) << " s, total "
+    << Num(wall_s, 3) << " s wall\n";
+  if (!reference_note.empty()) s << "  " << reference_note << "\n";
+  return s.str();
+}
+
+std::string WorkPrecisionResult::FullReport() const {
+  std::ostringstream s;
+  s << BriefReport();
+  for (const WorkPrecisionRow& r : rows) {
+    s << "  grid " << GridText(r.cells_x, r.cells_y) << ", contact_steps " << r.contact_steps
+      << ": D " << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none"))
+      << ", error " << (std::isnan(r.error_m) ? std::string("(reference)") : Cm(r.error_m) + " cm")
+      << ", cell bound " << Cm(r.cell_size_m) << " cm, " << r.gas_steps << " gas / " << r.dem_steps
+      << " DEM steps, " << Num(r.wall_s, 3) << " s wall\n";
+  }
+  return s.str();
+}
+
+}  // namespace consumers
+}  // namespace draglab

@@ -1,0 +1,229 @@
+#!/usr/bin/python3
+"""Draw the figures of `draglab sensitivity` from its JSON data.
+
+Usage: /usr/bin/python3 draglab_fig4.py DATA.json OUT_DIR [--quiet]
+
+DATA.json is either
+  - sensitivity.json (format "draglab_sensitivity" version 1): writes OUT_DIR/fig4.png, the seed
+    paper's Fig. 4: one panel per drag law side by side, the bed (x width, y height, equal
+    aspect) at t_ref after injection, particles drawn to their diameter and coloured by their
+    initial layer in alternating contrasting colours (as the experiment's coloured layers, so
+    mixing shows), the eps = threshold contour of the bubble over them, and the title
+    "law@v  D = x.x +- y.y cm";
+  - work_precision.json (format "draglab_work_precision" version 1): writes
+    OUT_DIR/work_precision.png, the bubble diameter and its error against wall time.
+Both are described in docs/scenes.md ("Sensitivity and work-precision"). This script only
+draws; it needs Debian's python3-matplotlib (run it with /usr/bin/python3) and nothing else.
+"""
+import json
+import math
+import os
+import sys
+import textwrap
+
+try:
+    import matplotlib
+
+    matplotlib.use("Agg")  # no display on build machines
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+    from matplotlib.collections import EllipseCollection
+    import numpy as np
+except ImportError as exc:  # the C++ side checks first; this is for direct use
+    sys.stderr.write(
+        "error: matplotlib is not importable by %s (%s); install the Debian package "
+        "python3-matplotlib and run this script with /usr/bin/python3\n" % (sys.executable, exc)
+    )
+    sys.exit(1)
+
+# Alternating layer colours: dark blue and amber contrast in colour and in grey scale.
+LAYER_COLOURS = ("#1d3557", "#f4a300")
+CONTOUR_COLOUR = "#d62828"
+
+
+def log(quiet, message):
+    if not quiet:
+        sys.stderr.write(message + "\n")
+
+
+def finite(x):
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def bubble_only_field(field, bubble, threshold):
+    """The void fraction with every above-threshold region except the bubble pulled just below the
+    threshold, so that the threshold contour outlines the bubble only (not the freeboard or other
+    voids). The bubble is the 4-connected region above the threshold, below the bed surface, whose
+    centroid is nearest the reported one (draglab's bubble.h finds it from the jet; its cells are
+    not in the data, its centroid and area are)."""
+    nx, ny = field["nx"], field["ny"]
+    eps = np.array(field["values"], dtype=float).reshape(ny, nx)  # row j from the bottom
+    dx, dy = field["width_m"] / nx, field["height_m"] / ny
+    below = np.nextafter(threshold, 0.0)
+    if not bubble or not bubble.get("found"):
+        return np.minimum(eps, below)
+    surface = bubble.get("bed_height_m", field["height_m"])
+    label = -np.ones((ny, nx), dtype=int)
+    regions = []
+    for j0 in range(ny):
+        for i0 in range(nx):
+            if label[j0, i0] >= 0 or eps[j0, i0] <= threshold or (j0 + 0.5) * dy >= surface:
+                continue
+            k = len(regions)
+            stack, cells = [(j0, i0)], []
+            label[j0, i0] = k
+            while stack:
+                j, i = stack.pop()
+                cells.append((j, i))
+                for jj, ii in ((j + 1, i), (j - 1, i), (j, i + 1), (j, i - 1)):
+                    if 0 <= jj < ny and 0 <= ii < nx and label[jj, ii] < 0 \
+                            and eps[jj, ii] > threshold and (jj + 0.5) * dy < surface:
+                        label[jj, ii] = k
+                        stack.append((jj, ii))
+            cx = sum((i + 0.5) * dx for _, i in cells) / len(cells)
+            cy = sum((j + 0.5) * dy for j, _ in cells) / len(cells)
+            regions.append((cx, cy, len(cells)))
+    if not regions:
+        return np.minimum(eps, below)
+    bx, by = bubble["centroid_x_m"], bubble["centroid_y_m"]
+    best = min(range(len(regions)), key=lambda k: (
+        (regions[k][0] - bx) ** 2 + (regions[k][1] - by) ** 2, -regions[k][2]))
+    out = np.minimum(eps, below)
+    out[label == best] = eps[label == best]
+    return out
+
+
+def draw_fig4(data, out_dir, quiet):
+    laws = data["laws"]
+    if not laws:
+        raise SystemExit("error: the data hold no laws")
+    width = data["geometry"]["width_m"]
+    height = data["geometry"]["height_m"]
+    threshold = data["eps_threshold"]
+    # Show the bed, not the freeboard: up to the highest particle top (+ 15 % of the width).
+    top = 0.0
+    for law in laws:
+        snap = law.get("snapshot")
+        if snap and snap["y"]:
+            top = max(top, max(y + 0.5 * d for y, d in zip(snap["y"], snap["diameter"])))
+    shown = min(height, top + 0.15 * width) if top > 0 else height
+    panel_w = 2.6
+    panel_h = min(8.0, max(2.0, panel_w * shown / width))
+    fig_w = max(6.0, panel_w * len(laws) + 0.6)
+    fig, axes = plt.subplots(1, len(laws), figsize=(fig_w, panel_h + 1.5), squeeze=False)
+    for ax, law in zip(axes[0], laws):
+        snap = law.get("snapshot")
+        d_est, d_unc = law["d_estimate_m"], law["uncertainty_m"]
+        if law.get("bubble_found"):
+            size = "D = %.1f \u00b1 %.1f cm" % (100 * d_est, 100 * d_unc)
+        else:
+            size = "D = %.1f \u00b1 %.1f cm (no bubble in %d of %d runs)" % (
+                100 * d_est, 100 * d_unc, len(law["runs"]) - law["bubbles_found"],
+                len(law["runs"]))
+        ax.set_title("%s  %s" % (law["law"], size), fontsize=9)
+        ax.set_xlim(0, 100 * width)
+        ax.set_ylim(0, 100 * shown)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x [cm]")
+        if not snap:
+            ax.text(0.5, 0.5, "no snapshot\n(run ended before t_ref)", transform=ax.transAxes,
+                    ha="center", va="center")
+            continue
+        xy = np.column_stack([np.array(snap["x"]) * 100, np.array(snap["y"]) * 100])
+        diam = np.array(snap["diameter"]) * 100
+        colours = [LAYER_COLOURS[layer % 2] for layer in snap["layer"]]
+        ax.add_collection(EllipseCollection(diam, diam, np.zeros_like(diam), units="xy",
+                                            offsets=xy, offset_transform=ax.transData,
+                                            facecolors=colours, edgecolors="none"))
+        field = snap["void_fraction"]
+        nx, ny = field["nx"], field["ny"]
+        if nx >= 2 and ny >= 2:
+            eps = bubble_only_field(field, snap.get("bubble"), threshold)
+            # Cell centres plus the walls and the plate (edge values copied there), so that the
+            # contour of a bubble on the plate or at a wall reaches it.
+            eps = np.pad(eps, 1, mode="edge")
+            xc = np.concatenate(([0.0], (np.arange(nx) + 0.5) * field["width_m"] / nx,
+                                 [field["width_m"]])) * 100
+            yc = np.concatenate(([0.0], (np.arange(ny) + 0.5) * field["height_m"] / ny,
+                                 [field["height_m"]])) * 100
+            if eps.max() > threshold:
+                ax.contour(xc, yc, eps, levels=[threshold], colors=CONTOUR_COLOUR, linewidths=1.8)
+    axes[0][0].set_ylabel("y [cm]")
+    caption = ("%s: bubble %.3g s after injection; particles coloured by initial layer; red: "
+               "\u03b5 = %.2f contour of the bubble; \u00b1 from %s (sensitivity.json)" % (
+                   data["scene"], data["t_ref_s"], threshold, data["uncertainty"]["method"]))
+    fig.suptitle(textwrap.fill(caption, width=int(16 * fig_w)), fontsize=9)
+    fig.tight_layout()
+    path = os.path.join(out_dir, "fig4.png")
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    log(quiet, "wrote " + path)
+
+
+def draw_work_precision(data, out_dir, quiet):
+    rows = data["rows"]
+    if not rows:
+        raise SystemExit("error: the data hold no configurations")
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
+    for r in rows:
+        label = "%dx%d/%d" % (r["cells_x"], r["cells_y"], r["contact_steps"])
+        wall = max(r["wall_s"], 1e-3)
+        d_cm = 100 * r["bubble_diameter_m"]
+        left.errorbar([wall], [d_cm], yerr=[100 * r["cell_size_m"]], fmt="o", capsize=3,
+                      color="k" if r.get("is_reference") else "C0")
+        left.annotate(label, (wall, d_cm), textcoords="offset points", xytext=(4, 4), fontsize=7)
+        if finite(r.get("error_m")) and r["error_m"] > 0:
+            right.loglog([wall], [100 * r["error_m"]], "o", color="C0")
+            right.annotate(label, (wall, 100 * r["error_m"]), textcoords="offset points",
+                           xytext=(4, 4), fontsize=7)
+        right.loglog([wall], [100 * r["cell_size_m"]], "s", mfc="none", color="C1")
+    zero = sum(1 for r in rows if finite(r.get("error_m")) and r["error_m"] == 0)
+    left.axhline(100 * data["reference_diameter_m"], color="0.5", ls="--", lw=1)
+    left.set_xscale("log")
+    left.set_xlabel("wall time [s]")
+    left.set_ylabel("D at t_ref [cm]  (bar: one cell)")
+    left.set_title("bubble diameter; dashed: reference (%s)" % data["reference_method"],
+                   fontsize=9)
+    right.set_xlabel("wall time [s]")
+    right.set_ylabel("error [cm]")
+    right.set_title("circles: |D - D_ref|; squares: cell bound h" +
+                    ("; %d zero error(s) not shown" % zero if zero else ""), fontsize=9)
+    for ax in (left, right):  # plain wall-time labels (runs often span less than a decade)
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+        ax.tick_params(axis="x", which="minor", labelsize=7)
+    right.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    right.yaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    right.tick_params(axis="y", which="minor", labelsize=7)
+    fig.suptitle("work-precision of %s on %s (grid/contact steps per point)" % (
+        data["law"], data["scene"]), fontsize=10)
+    fig.tight_layout()
+    path = os.path.join(out_dir, "work_precision.png")
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    log(quiet, "wrote " + path)
+
+
+def main(argv):
+    args = [a for a in argv[1:] if a != "--quiet"]
+    quiet = "--quiet" in argv[1:]
+    if len(args) != 2:
+        sys.stderr.write(__doc__)
+        return 2
+    with open(args[0]) as f:
+        data = json.load(f)
+    kind = data.get("format")
+    if data.get("version") != 1 or kind not in ("draglab_sensitivity", "draglab_work_precision"):
+        sys.stderr.write("error: %s is not draglab sensitivity data (format %r, version %r)\n" % (
+            args[0], kind, data.get("version")))
+        return 2
+    os.makedirs(args[1], exist_ok=True)
+    if kind == "draglab_sensitivity":
+        draw_fig4(data, args[1], quiet)
+    else:
+        draw_work_precision(data, args[1], quiet)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
