@@ -14,7 +14,9 @@
 #include "cli/cli_context.h"
 #include "cli/progress.h"
 #include "draglab/consumers/dpm.h"
+#include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
+#include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -27,6 +29,7 @@ struct SceneArgs {
   std::string scene_path;
   std::string laws;       // --law a,b,c
   double duration_s = 0;  // scene run --duration (0: the scene's)
+  bool no_store = false;  // scene run --no-store
 };
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -187,6 +190,21 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
   const consumers::DpmResult r =
       sim.Run([&](double f, const std::string& stage) { progress.update(f, stage); });
   progress.finish();
+  // Consumer results are provenance like laws and datasets: scene text, law content, code
+  // version and metrics, stored (immutable) unless asked not to.
+  std::int64_t result_id = 0;
+  if (!args.no_store) {
+    const ConsumerScene stored_scene = register_consumer_scene(*db, scene.name, scene.source_text);
+    ConsumerResult stored;
+    stored.scene_name = scene.name;
+    stored.scene_hash = stored_scene.hash;
+    stored.law_name = law->record().name;
+    stored.law_version = law->record().version;
+    stored.law_content_hash = law->record().content_hash;
+    stored.metrics = consumers::consumer_metrics_of(r);
+    stored.result_json = consumers::dpm_result_json(r);
+    result_id = store_consumer_result(*db, stored).id;
+  }
   if (r.void_fraction_clamps > 0)
     ctx.warn(fmt::format("{} cell void fractions were raised to the minimum (dense packing)",
                          r.void_fraction_clamps));
@@ -202,6 +220,8 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
     ctx.print_json(
         {{"scene", r.scene},
          {"scene_hash", r.scene_hash},
+         {"result_id", result_id > 0 ? nlohmann::json(result_id) : nlohmann::json(nullptr)},
+         {"output_files", r.output_files},
          {"law", r.law},
          {"umf_m_s", r.umf_m_s},
          {"background_m_s", r.background_m_s},
@@ -240,6 +260,8 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
   }
   std::cout << "  numerical uncertainty: not estimated (one grid, one packing; see draglab "
                "sensitivity)\n";
+  for (const auto& file : r.output_files) std::cout << "  wrote " << file << "\n";
+  if (result_id > 0) std::cout << "  stored as consumer result " << result_id << "\n";
 }
 
 }  // namespace
@@ -284,6 +306,9 @@ void add_scene_commands(CLI::App& app, CliContext& ctx) {
   run->add_option("--law", run_args->laws, "One law NAME@V (default: the scene's first)");
   run->add_option("--duration", run_args->duration_s,
                   "Simulated time after the flow starts [s] (default: the scene's)");
+  run->add_flag("--no-store", run_args->no_store,
+                "Do not store the result in the database (stored by default: scene text, law "
+                "content hash, code version, metrics)");
   run->footer(
       "Example:\n  draglab scene run data/scenes/dpm_bubble_quick.toml --law ergun@1 --json");
   run->callback([&ctx, run_args] { ctx.action = [&ctx, run_args] { run_run(ctx, *run_args); }; });

@@ -182,6 +182,30 @@ assert run["bubble_diameter_m"] == expected, (run["bubble_diameter_m"], expected
 assert run["gas_steps"] == r["gas_steps"] and run["dem_steps"] == r["dem_steps"], (run, r)
 '
 
+# `scene run` stores its result (scene text, law content hash, metrics) unless --no-store.
+export SENSITIVITY_TEST_DB="$db"
+pycheck "scene run stored one consumer result with its metrics" '
+import json, os, sqlite3, sys
+w, db = sys.argv[1], os.environ["SENSITIVITY_TEST_DB"]
+r = json.load(open(w + "/run_seed6.json"))
+assert isinstance(r["result_id"], int) and r["result_id"] > 0, r["result_id"]
+con = sqlite3.connect(db)
+rows = con.execute("SELECT law_name, law_version, metrics_json FROM consumer_results WHERE id = ?",
+                   (r["result_id"],)).fetchall()
+assert len(rows) == 1 and rows[0][:2] == ("gidaspow", 1), rows
+m = json.loads(rows[0][2])
+expected = r["bubble_diameter_m"]
+assert m["bubble_diameter_m"] == expected and abs(m["umf_m_s"] - r["umf_m_s"]) < 1e-15, (m, r)
+'
+db_sum_before_nostore="$(md5sum <"$db")"
+check "scene run --no-store" 0 "$draglab" -q --db "$db" scene run "$work/tiny_seed6.toml" \
+  --law gidaspow@1 --json --no-store
+ok "--no-store left the database unchanged" test "$(md5sum <"$db")" = "$db_sum_before_nostore"
+pycheck "--no-store reports no result id" '
+import json, sys
+assert json.load(open(sys.argv[1] + "/out"))["result_id"] is None
+'
+
 png_check='
 import struct, sys
 path = sys.argv[1] + "/" + sys.argv[2]
