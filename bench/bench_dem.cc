@@ -5,57 +5,114 @@
 // Default set-up (fast to build): the particles are placed on a simple cubic lattice with spacing
 // 0.999 d filling the box bottom up (N = 35 000 -> a 24 cm column, ~6 touching neighbours each,
 // like a packed bed), then `--warmup` steps under gravity before timing. `--settle` instead pours
-// and settles the bed with settle_particles() first (slow: minutes). The JSON says which ran.
+// and settles the bed with settle_particles() first (slow: minutes). `--bed FILE` reads a given
+// state instead (the side-by-side run with LIGGGHTS, bench/liggghts/run_side_by_side.sh, hands
+// over the bed that LIGGGHTS settled). The JSON says which ran.
 //
-// Usage: bench_dem [--n 35000] [--steps 200] [--runs 5] [--warmup 200] [--settle]
+// --bed FILE: x y z vx vy vz wx wy wz diameter density per line, SI, draglab's axes (y up); format
+// in bench/bench_util.h. The particle count is the file's.
+//
+// Contact options, to match another code's set-up (defaults: DemOptions'): --kn [N/m], --dt [s]
+// (0 = t_c/20), --wall-restitution, --tangential-damping-ratio (eta_t / eta_n).
+// --threads 1,2: the OpenMP thread counts timed, in that order (one process per count gives
+// interleaved comparisons).
+//
+// Usage: bench_dem [--n 35000 | --bed FILE | --settle] [--steps 200] [--runs 5] [--warmup 200]
+//                  [--threads 1,2] [--kn K] [--dt S] [--wall-restitution E]
+//                  [--tangential-damping-ratio R]
 #include <omp.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "draglab/consumers/dem.h"
 
+using draglab::bench::ParseNumber;
+using draglab::bench::ParseThreadList;
 using draglab::consumers::DemOptions;
 using draglab::consumers::DemSystem;
 using draglab::consumers::Particles;
 
+namespace {
+
+const char* kUsage =
+    "usage: bench_dem [--n N | --bed FILE | --settle] [--steps S] [--runs R] [--warmup W]\n"
+    "                 [--threads 1,2] [--kn K] [--dt S] [--wall-restitution E]\n"
+    "                 [--tangential-damping-ratio R]\n";
+
+}  // namespace
+
 int main(int argc, char** argv) {
   int n = 35000, steps = 200, runs = 5, warmup = 200;
-  bool settle = false;
-  for (int a = 1; a < argc; ++a) {
-    const std::string arg = argv[a];
-    auto next = [&]() { return a + 1 < argc ? std::atoi(argv[++a]) : 0; };
-    if (arg == "--n")
-      n = next();
-    else if (arg == "--steps")
-      steps = next();
-    else if (arg == "--runs")
-      runs = next();
-    else if (arg == "--warmup")
-      warmup = next();
-    else if (arg == "--settle")
-      settle = true;
-    else {
-      std::fprintf(stderr,
-                   "usage: bench_dem [--n N] [--steps S] [--runs R] [--warmup W] [--settle]\n");
-      return 2;
+  bool settle = false, n_given = false;
+  std::string bed;
+  std::vector<int> thread_counts{1, 2};
+  DemOptions o;  // defaults: the seed's box and contact parameters
+  try {
+    for (int a = 1; a < argc; ++a) {
+      const std::string arg = argv[a];
+      auto value = [&]() -> const char* {
+        if (a + 1 >= argc) throw std::invalid_argument(arg + ": missing value");
+        return argv[++a];
+      };
+      auto integer = [&]() {
+        const double v = ParseNumber(arg, value());
+        if (v != static_cast<int>(v)) throw std::invalid_argument(arg + ": not an integer");
+        return static_cast<int>(v);
+      };
+      if (arg == "--n") {
+        n = integer();
+        n_given = true;
+      } else if (arg == "--steps") {
+        steps = integer();
+      } else if (arg == "--runs") {
+        runs = integer();
+      } else if (arg == "--warmup") {
+        warmup = integer();
+      } else if (arg == "--settle") {
+        settle = true;
+      } else if (arg == "--bed") {
+        bed = value();
+      } else if (arg == "--threads") {
+        thread_counts = ParseThreadList(value());
+      } else if (arg == "--kn") {
+        o.normal_stiffness = ParseNumber(arg, value());
+      } else if (arg == "--dt") {
+        o.dt = ParseNumber(arg, value());
+      } else if (arg == "--wall-restitution") {
+        o.wall_restitution = ParseNumber(arg, value());
+      } else if (arg == "--tangential-damping-ratio") {
+        o.tangential_damping_ratio = ParseNumber(arg, value());
+      } else {
+        throw std::invalid_argument("unknown option " + arg);
+      }
     }
-  }
-  if (n < 1 || steps < 1 || runs < 1 || warmup < 0) {
-    std::fprintf(stderr, "bench_dem: --n, --steps, --runs must be >= 1, --warmup >= 0\n");
+    if (n < 1 || steps < 1 || runs < 1 || warmup < 0)
+      throw std::invalid_argument("--n, --steps, --runs must be >= 1, --warmup >= 0");
+    if (static_cast<int>(settle) + static_cast<int>(!bed.empty()) + static_cast<int>(n_given) > 1)
+      throw std::invalid_argument("--n, --bed and --settle exclude each other");
+    std::string error;
+    if (!o.IsValid(&error)) throw std::invalid_argument(error);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_dem: %s\n%s", e.what(), kUsage);
     return 2;
   }
+
   const double d = 2.5e-3, rho = 2526.0;
-  DemOptions o;  // defaults: the seed's box and contact parameters
   Particles p;
   std::string setup;
   try {
-    if (settle) {
+    if (!bed.empty()) {
+      p = draglab::bench::ReadBedFile(bed);
+      n = static_cast<int>(p.size());
+      setup = "state read from " + bed + ", then warm-up steps";
+    } else if (settle) {
       draglab::consumers::SettleOptions s;
       s.n = n;
       s.diameter = d;
@@ -82,31 +139,43 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_dem: %s\n", e.what());
     return 2;
   }
-  DemSystem dem(o, p);
-  dem.sort_particles();
-  dem.advance(warmup * dem.time_step());
-  std::printf(
-      "{\"benchmark\": \"dem\", \"n\": %d, \"setup\": \"%s\", \"dt_s\": %.4g, "
-      "\"contact_time_s\": %.4g, \"contacts_per_particle\": %.3f, \"steps_per_run\": %d, "
-      "\"runs\": %d, \"results\": [",
-      n, setup.c_str(), dem.time_step(), dem.contact_time(), 2.0 * dem.contact_count() / n, steps,
-      runs);
   const int max_threads = std::min(2, omp_get_max_threads());
-  for (int threads = 1; threads <= 2; ++threads) {
-    omp_set_num_threads(threads);
-    std::vector<double> rates;
-    for (int r = 0; r < runs; ++r) {
-      const auto t0 = std::chrono::steady_clock::now();
-      for (int s = 0; s < steps; ++s) dem.step();
-      const double wall =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      rates.push_back(static_cast<double>(n) * steps / wall);
-    }
-    std::sort(rates.begin(), rates.end());
+  double kinetic_after_warmup = 0.0;
+  try {
+    DemSystem dem(o, p);
+    dem.sort_particles();
+    dem.advance(warmup * dem.time_step());
+    kinetic_after_warmup = dem.kinetic_energy();
     std::printf(
-        "%s{\"threads\": %d, \"median_particle_steps_per_s\": %.4g, \"min\": %.4g, "
-        "\"max\": %.4g}",
-        threads > 1 ? ", " : "", threads, rates[rates.size() / 2], rates.front(), rates.back());
+        "{\"benchmark\": \"dem\", \"n\": %d, \"setup\": \"%s\", \"dt_s\": %.6g, "
+        "\"contact_time_s\": %.6g, \"normal_stiffness_n_m\": %.6g, \"wall_restitution\": %.6g, "
+        "\"tangential_damping_ratio\": %.6g, \"kinetic_energy_after_warmup_j\": %.4g, "
+        "\"contacts_per_particle\": %.3f, \"warmup_steps\": %d, \"steps_per_run\": %d, "
+        "\"runs\": %d, \"results\": [",
+        n, setup.c_str(), dem.time_step(), dem.contact_time(), o.normal_stiffness,
+        o.wall_restitution, o.tangential_damping_ratio, kinetic_after_warmup,
+        2.0 * dem.contact_count() / n, warmup, steps, runs);
+    bool first = true;
+    for (const int threads : thread_counts) {
+      omp_set_num_threads(threads);
+      std::vector<double> rates;
+      for (int r = 0; r < runs; ++r) {
+        const auto t0 = std::chrono::steady_clock::now();
+        for (int s = 0; s < steps; ++s) dem.step();
+        const double wall =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        rates.push_back(static_cast<double>(n) * steps / wall);
+      }
+      std::sort(rates.begin(), rates.end());
+      std::printf(
+          "%s{\"threads\": %d, \"median_particle_steps_per_s\": %.4g, \"min\": %.4g, "
+          "\"max\": %.4g}",
+          first ? "" : ", ", threads, rates[rates.size() / 2], rates.front(), rates.back());
+      first = false;
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_dem: %s\n", e.what());
+    return 2;
   }
   std::printf("], \"max_threads_available\": %d}\n", max_threads);
   return 0;
