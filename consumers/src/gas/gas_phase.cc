@@ -111,6 +111,8 @@ struct GasPhase::PoissonCache {
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
   bool pinned = false;  // all-Neumann/periodic: p(0,0) fixed to remove the constant null space
+  // LDLT ordering and symbolic analysis done: the pattern never changes, only the values.
+  bool ordered = false;
 };
 
 GasPhase::GasPhase(const GasOptions& options) : opt_(options) {
@@ -121,6 +123,7 @@ GasPhase::GasPhase(const GasOptions& options) : opt_(options) {
   u_ = Eigen::ArrayXXd::Zero(opt_.nx + 1, opt_.nz);
   w_ = Eigen::ArrayXXd::Zero(opt_.nx, opt_.nz + 1);
   p_ = Eigen::ArrayXXd::Constant(opt_.nx, opt_.nz, opt_.outlet_pressure_pa);
+  UpdatePressureGradient();
   eps_ = Eigen::ArrayXXd::Ones(opt_.nx, opt_.nz);
   eps_next_ = eps_;
   beta_ = Eigen::ArrayXXd::Zero(opt_.nx, opt_.nz);
@@ -429,7 +432,13 @@ void GasPhase::Step(double dt) {
       }
     }
     if (opt_.poisson == PoissonSolver::kDirectLDLT) {
-      cache.ldlt.compute(matrix);
+      // The sparsity pattern depends only on the grid and the boundaries, not on C: order
+      // (AMD) and analyse it once, then only the numeric factorisation when C changes.
+      if (!cache.ordered) {
+        cache.ldlt.analyzePattern(matrix);
+        cache.ordered = true;
+      }
+      cache.ldlt.factorize(matrix);
       if (cache.ldlt.info() != Eigen::Success) {
         throw Error(ErrorCode::kInternal, "gas pressure equation: LDLT factorisation failed");
       }
@@ -493,6 +502,7 @@ void GasPhase::Step(double dt) {
   diag_.poisson_residual = b_norm > 0.0 ? residual / b_norm : residual;
   diag_.poisson_iterations = iterations;
   p_ = Eigen::Map<const Eigen::ArrayXXd>(pressure.data(), nx, nz);
+  UpdatePressureGradient();
 
   // ---- projection ----
   for (int j = 0; j < nz; ++j) {
@@ -588,27 +598,31 @@ Eigen::Vector2d GasPhase::VelocityAt(double x, double z) const {
           Bilinear(w_, 0.5 * dx_, 0.0, dx_, dz_, x, z)};
 }
 
-Eigen::Vector2d GasPhase::PressureGradientAt(double x, double z) const {
+void GasPhase::UpdatePressureGradient() {
   const int nx = opt_.nx, nz = opt_.nz;
   const bool periodic = opt_.vertical == VerticalBoundary::kPeriodic;
-  Eigen::ArrayXXd gx(nx, nz), gz(nx, nz);
+  grad_px_.resize(nx, nz);
+  grad_pz_.resize(nx, nz);
   for (int j = 0; j < nz; ++j) {
     for (int i = 0; i < nx; ++i) {
       const int il = std::max(i - 1, 0), ir = std::min(i + 1, nx - 1);
-      gx(i, j) = (p_(ir, j) - p_(il, j)) / ((ir - il) * dx_);
+      grad_px_(i, j) = (p_(ir, j) - p_(il, j)) / ((ir - il) * dx_);
       if (periodic) {
-        gz(i, j) = (p_(i, (j + 1) % nz) - p_(i, (j + nz - 1) % nz)) / (2 * dz_);
+        grad_pz_(i, j) = (p_(i, (j + 1) % nz) - p_(i, (j + nz - 1) % nz)) / (2 * dz_);
       } else if (j == nz - 1) {
         // Outlet value half a cell above the last centre.
-        gz(i, j) = (opt_.outlet_pressure_pa - p_(i, j - 1)) / (1.5 * dz_);
+        grad_pz_(i, j) = (opt_.outlet_pressure_pa - p_(i, j - 1)) / (1.5 * dz_);
       } else {
         const int jl = std::max(j - 1, 0);
-        gz(i, j) = (p_(i, j + 1) - p_(i, jl)) / ((j + 1 - jl) * dz_);
+        grad_pz_(i, j) = (p_(i, j + 1) - p_(i, jl)) / ((j + 1 - jl) * dz_);
       }
     }
   }
-  return {Bilinear(gx, 0.5 * dx_, 0.5 * dz_, dx_, dz_, x, z),
-          Bilinear(gz, 0.5 * dx_, 0.5 * dz_, dx_, dz_, x, z)};
+}
+
+Eigen::Vector2d GasPhase::PressureGradientAt(double x, double z) const {
+  return {Bilinear(grad_px_, 0.5 * dx_, 0.5 * dz_, dx_, dz_, x, z),
+          Bilinear(grad_pz_, 0.5 * dx_, 0.5 * dz_, dx_, dz_, x, z)};
 }
 
 double GasPhase::WidthAveragedPressure(double z) const {

@@ -142,6 +142,8 @@ class GasPhase {
   /// Gas velocity (interstitial) at a point by bilinear interpolation of the staggered fields.
   Eigen::Vector2d VelocityAt(double x, double z) const;
   /// Pressure gradient at a point (bilinear interpolation of the face gradients) [Pa/m].
+  /// Interpolates a cell-centred gradient field computed once per Step, so a call costs a few
+  /// flops (the DPM calls it once per particle and gas step).
   Eigen::Vector2d PressureGradientAt(double x, double z) const;
   /// Width-averaged pressure at height z (linear between cell centres; the outlet value above
   /// the top cell centre).
@@ -154,12 +156,15 @@ class GasPhase {
  private:
   void Check(const Eigen::ArrayXXd& a, int rows, int cols, const char* name, double lo, double hi,
              bool lo_open) const;
+  /// Recomputes grad_px_, grad_pz_ from p_; called wherever p_ changes.
+  void UpdatePressureGradient();
 
   GasOptions opt_;
   double dx_, dz_;
   double time_ = 0.0;
   long steps_ = 0;
   Eigen::ArrayXXd u_, w_, p_;
+  Eigen::ArrayXXd grad_px_, grad_pz_;  // cell-centred dp/dx, dp/dz [Pa/m] of p_
   Eigen::ArrayXXd eps_, eps_next_, beta_, upx_, upz_;
   GasDiagnostics diag_;
   struct PoissonCache;
