@@ -62,7 +62,7 @@ TEST(SceneParse, SeedSceneDeclaresTheSeedBed) {
   EXPECT_DOUBLE_EQ(s.bed_height_mf_m(), 0.22);
   // N = (1 - eps_mf) W D H / (pi d^3/6) = 0.58 * 0.15 * 0.015 * 0.22 / 8.181e-9 = 35 093.
   EXPECT_NEAR(static_cast<double>(s.particle_count()), 35093.0, 1.0);
-  EXPECT_EQ(s.distributor.mode, BackgroundMode::kUmf);
+  EXPECT_EQ(s.distributor.mode, BackgroundMode::kUmfPacking);
   EXPECT_DOUBLE_EQ(s.time.t_ref_s, 0.3);
   EXPECT_DOUBLE_EQ(s.jet_center_m(), 0.075);
   EXPECT_DOUBLE_EQ(s.bubble.eps_threshold, 0.8);
