@@ -1,5 +1,7 @@
-// Soft-sphere DEM: contact forces, velocity-Verlet integration, linked cells, settling helper.
+// Soft-sphere DEM: contact forces, velocity-Verlet integration, Verlet neighbour list, settling.
 #include "draglab/consumers/dem.h"
+
+#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -17,8 +19,11 @@ namespace consumers {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// Slots of tangential history per particle: 12 touching equal spheres + 3 walls + margin.
+// Slots of tangential history per particle: 12 touching equal spheres + 3 walls + margin (a
+// particle keeps only the pairs it owns, so dense monodisperse packs use about half).
 constexpr int kMaxContacts = 20;
+// Packed per-particle state for the pair loop: x y z vx vy vz wx wy wz r m (+1 padding).
+constexpr int kStateStride = 12;
 
 std::string Num(double v) {
   char buf[40];
@@ -46,6 +51,15 @@ double ContactTime(double k, double m_eff, double e) {
   const double eta = DampingFactor(e) * std::sqrt(k * m_eff);
   const double gamma = eta / (2.0 * m_eff);
   return kPi / std::sqrt(k / m_eff - gamma * gamma);
+}
+
+// Nearest periodic image of a separation d along an axis of length L, half = L/2 (infinite on a
+// walled axis). One shift suffices: list pairs are closer than L/2 + skin, and a particle's
+// displacement since the list build is below L/2 unless the caller moved it.
+inline double NearestImage(double d, double length, double half) {
+  if (d > half) return d - length;
+  if (d < -half) return d + length;
+  return d;
 }
 
 }  // namespace
@@ -158,6 +172,9 @@ bool DemOptions::IsValid(std::string* error) const {
   if (!(max_overlap_fraction > 0.0 && max_overlap_fraction <= 0.5)) {
     return fail("max_overlap_fraction = " + Num(max_overlap_fraction) + ": must be in (0, 0.5]");
   }
+  if (!(neighbor_skin_fraction >= 0.0 && neighbor_skin_fraction <= 1.0)) {
+    return fail("neighbor_skin_fraction = " + Num(neighbor_skin_fraction) + ": must be in [0, 1]");
+  }
   return true;
 }
 
@@ -194,11 +211,13 @@ DemSystem::DemSystem(const DemOptions& options, Particles particles)
   } else {
     dt_ = max_time_step();
   }
-  // Linked cells: edge >= largest diameter, so contacts are within the 27 neighbouring cells.
+  // Linked cells: edge >= d_max + skin, so every list pair is within the 27 neighbouring cells.
+  // A periodic axis needs >= 3 cells (each neighbour cell distinct, a single image in contact);
+  // where it is too short for the requested skin, the skin shrinks to fit.
+  skin_ = options_.neighbor_skin_fraction * d_max_;
   for (int a = 0; a < 3; ++a) {
     const double length = options_.box_max[a] - options_.box_min[a];
-    ncell_[a] = std::max(1, static_cast<int>(std::floor(length / d_max_)));
-    if (options_.periodic[a] && ncell_[a] < 3) {
+    if (options_.periodic[a] && std::floor(length / d_max_) < 3) {
       Fail("DemOptions.box_max[" + std::to_string(a) + "]: a periodic axis must be at least 3 " +
            "largest diameters long (" + Num(3 * d_max_) + " m), got " + Num(length) + " m");
     }
@@ -206,6 +225,12 @@ DemSystem::DemSystem(const DemOptions& options, Particles particles)
       Fail("DemOptions.box_max[" + std::to_string(a) + "]: the box (" + Num(length) +
            " m) is narrower than the largest particle (" + Num(d_max_) + " m)");
     }
+    if (options_.periodic[a]) skin_ = std::max(0.0, std::min(skin_, length / 3.0 - d_max_));
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double length = options_.box_max[a] - options_.box_min[a];
+    ncell_[a] = std::max(1, static_cast<int>(std::floor(length / (d_max_ + skin_))));
+    if (options_.periodic[a]) ncell_[a] = std::max(ncell_[a], 3);
     cell_size_[a] = length / ncell_[a];
   }
   reset_contacts();
@@ -221,15 +246,97 @@ void DemSystem::reset_contacts() {
     inv_mass_[i] = 1.0 / mass_[i];
     inv_inertia_[i] = 1.0 / p_.moment_of_inertia(i);
   }
-  for (auto* v : {&fx_, &fy_, &fz_, &tx_, &ty_, &tz_, &elastic_}) v->assign(n, 0.0);
+  force_.assign(6 * n, 0.0);
+  elastic_.assign(n, 0.0);
+  state_.assign(kStateStride * n, 0.0);
   for (int b = 0; b < 2; ++b) {
     hist_count_[b].assign(n, 0);
     hist_partner_[b].assign(n * kMaxContacts, 0);
     hist_xi_[b].assign(n * kMaxContacts * 3, 0.0);
   }
-  build_cells();
+  pack_state();
+  build_neighbor_list();
   compute_forces(0.0);
   check_state(0.0);
+}
+
+void DemSystem::pack_state() {
+  const int n = static_cast<int>(p_.size());
+  state_.resize(static_cast<std::size_t>(kStateStride) * n);
+  for (int i = 0; i < n; ++i) {
+    double* s = &state_[static_cast<std::size_t>(kStateStride) * i];
+    s[0] = p_.x[i];
+    s[1] = p_.y[i];
+    s[2] = p_.z[i];
+    s[3] = p_.vx[i];
+    s[4] = p_.vy[i];
+    s[5] = p_.vz[i];
+    s[6] = p_.wx[i];
+    s[7] = p_.wy[i];
+    s[8] = p_.wz[i];
+    s[9] = 0.5 * p_.diameter[i];
+    s[10] = mass_[i];
+    s[11] = 0.0;
+  }
+}
+
+// Half list from the linked cells: for each i the j > i (ascending) with centre distance below
+// R_i + R_j + skin, any periodic image. Serial and cheap next to the steps between rebuilds.
+void DemSystem::build_neighbor_list() {
+  build_cells();
+  const int n = static_cast<int>(p_.size());
+  const double* X = p_.x.data();
+  const double* Y = p_.y.data();
+  const double* Z = p_.z.data();
+  const double* D = p_.diameter.data();
+  nbr_start_.assign(n + 1, 0);
+  nbr_.clear();
+  auto neighbour = [this](int axis, int k, int* wrapped, double* shift) {
+    *shift = 0.0;
+    *wrapped = k;
+    if (k >= 0 && k < ncell_[axis]) return true;
+    if (!options_.periodic[axis]) return false;
+    const double length = options_.box_max[axis] - options_.box_min[axis];
+    *shift = k < 0 ? -length : length;
+    *wrapped = (k + ncell_[axis]) % ncell_[axis];
+    return true;
+  };
+  for (int i = 0; i < n; ++i) {
+    nbr_start_[i] = static_cast<int>(nbr_.size());
+    const double xi = X[i], yi = Y[i], zi = Z[i], ri = 0.5 * D[i];
+    const int c = cell_of_[i];
+    const int cx = c % ncell_[0], cy = (c / ncell_[0]) % ncell_[1],
+              cz = c / (ncell_[0] * ncell_[1]);
+    for (int oz = -1; oz <= 1; ++oz) {
+      int kz;
+      double shz;
+      if (!neighbour(2, cz + oz, &kz, &shz)) continue;
+      for (int oy = -1; oy <= 1; ++oy) {
+        int ky;
+        double shy;
+        if (!neighbour(1, cy + oy, &ky, &shy)) continue;
+        for (int ox = -1; ox <= 1; ++ox) {
+          int kx;
+          double shx;
+          if (!neighbour(0, cx + ox, &kx, &shx)) continue;
+          const int cell = (kz * ncell_[1] + ky) * ncell_[0] + kx;
+          for (int s = cell_start_[cell]; s < cell_start_[cell + 1]; ++s) {
+            const int j = cell_particles_[s];
+            if (j <= i) continue;
+            const double dx = X[j] + shx - xi, dy = Y[j] + shy - yi, dz = Z[j] + shz - zi;
+            const double cut = ri + 0.5 * D[j] + skin_;
+            if (dx * dx + dy * dy + dz * dz < cut * cut) nbr_.push_back(j);
+          }
+        }
+      }
+    }
+    std::sort(nbr_.begin() + nbr_start_[i], nbr_.end());
+  }
+  nbr_start_[n] = static_cast<int>(nbr_.size());
+  x_built_.assign(p_.x.begin(), p_.x.end());
+  y_built_.assign(p_.y.begin(), p_.y.end());
+  z_built_.assign(p_.z.begin(), p_.z.end());
+  ++list_builds_;
 }
 
 void DemSystem::build_cells() {
@@ -253,9 +360,13 @@ void DemSystem::build_cells() {
   for (int i = 0; i < n; ++i) cell_particles_[fill[cell_of_[i]]++] = i;
 }
 
-// Contact forces, torques and elastic energy of every particle at the current positions. The
+// Contact forces, torques and elastic energy of every particle at the packed state_. The
 // relative velocities are the current (half-step) velocities; the tangential spring grows by
-// g_t dt. Each particle computes all its own contacts and writes only its own slots.
+// g_t dt. Each list pair is evaluated once by its owner i (the lower index), which applies equal
+// and opposite forces and alone reads and writes the pair's spring. Threads take contiguous
+// ranges of owners with equal pair counts; thread 0 accumulates into force_, thread t > 0 into
+// its own buffer (a pair's j may lie in another thread's range), and the buffers are added in
+// thread order: no races, no atomics, the same result on every run with the same thread count.
 void DemSystem::compute_forces(double dt) {
   const int n = static_cast<int>(p_.size());
   const int prev = hist_cur_, next = 1 - hist_cur_;
@@ -265,191 +376,257 @@ void DemSystem::compute_forces(double dt) {
   const double ce_wall = DampingFactor(options_.wall_restitution);
   const double mu = options_.friction, mu_wall = options_.wall_friction;
   const double eta_t_ratio = options_.tangential_damping_ratio;
-  const double* X = p_.x.data();
-  const double* Y = p_.y.data();
-  const double* Z = p_.z.data();
-  const double* VX = p_.vx.data();
-  const double* VY = p_.vy.data();
-  const double* VZ = p_.vz.data();
-  const double* WX = p_.wx.data();
-  const double* WY = p_.wy.data();
-  const double* WZ = p_.wz.data();
-  const double* D = p_.diameter.data();
-  std::int64_t contacts = 0, wall_contacts = 0;
-  double max_overlap = 0.0;
-  double wf[18] = {0.0};
-  int overflow = -1;
+  const bool periodic_any = options_.periodic[0] || options_.periodic[1] || options_.periodic[2];
+  double length[3], half_length[3];
+  for (int a = 0; a < 3; ++a) {
+    length[a] = options_.box_max[a] - options_.box_min[a];
+    half_length[a] = options_.periodic[a] ? 0.5 * length[a] : std::numeric_limits<double>::max();
+  }
+  const double* S = state_.data();
+  const int* start = nbr_start_.data();
+  const int* nbr = nbr_.data();
+  const int pairs = start[n];
+  const bool parallel = n >= 512;
+  const int max_threads = parallel ? std::max(1, omp_get_max_threads()) : 1;
+  if (static_cast<int>(thread_force_.size()) < max_threads - 1) {
+    thread_force_.resize(max_threads - 1);
+  }
+  struct Totals {
+    std::int64_t contacts = 0, wall_contacts = 0;
+    double max_overlap = 0.0;
+    double wall_force[18] = {0.0};
+    int overflow = -1;
+  };
+  std::vector<Totals> totals(max_threads);
+  std::vector<int> range_begin(max_threads + 1, n), range_written_end(max_threads, 0);
 
-#pragma omp parallel for schedule(static) if (n >= 512) reduction(+ : contacts, wall_contacts, wf[:18]) \
-    reduction(max : max_overlap, overflow)
-  for (int i = 0; i < n; ++i) {
-    const double xi = X[i], yi = Y[i], zi = Z[i];
-    const double vxi = VX[i], vyi = VY[i], vzi = VZ[i];
-    const double wxi = WX[i], wyi = WY[i], wzi = WZ[i];
-    const double ri = 0.5 * D[i], mi = mass_[i];
-    const int old_count = hist_count_[prev][i];
-    const int* old_partner = &hist_partner_[prev][static_cast<std::size_t>(i) * kMaxContacts];
-    const double* old_xi = &hist_xi_[prev][static_cast<std::size_t>(i) * kMaxContacts * 3];
-    int* new_partner = &hist_partner_[next][static_cast<std::size_t>(i) * kMaxContacts];
-    double* new_xi = &hist_xi_[next][static_cast<std::size_t>(i) * kMaxContacts * 3];
-    int count = 0;
-    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0, energy = 0;
-
-    // One contact of i with unit normal (nx,ny,nz) from i towards the partner, overlap delta,
-    // partner contact-point velocity (px,py,pz) relative to lab, partner lever rj (0 for walls).
-    auto contact = [&](int partner, double nx, double ny, double nz, double delta, double m_eff,
-                       double c_e, double mu_f, double vjx, double vjy, double vjz, double rj,
-                       double wjx, double wjy, double wjz, double share, double* wall_out) {
-      const double eta_n = c_e * std::sqrt(kn * m_eff);
-      const double eta_t = eta_t_ratio * eta_n;
-      // Velocity of i's contact point relative to the partner's: g = v_i - v_j + (r_i w_i +
-      // r_j w_j) x n.
-      const double sx = ri * wxi + rj * wjx, sy = ri * wyi + rj * wjy, sz = ri * wzi + rj * wjz;
-      const double gx = vxi - vjx + (sy * nz - sz * ny);
-      const double gy = vyi - vjy + (sz * nx - sx * nz);
-      const double gz = vzi - vjz + (sx * ny - sy * nx);
-      const double gn = gx * nx + gy * ny + gz * nz;  // > 0: approaching
-      // Normal force magnitude (repulsive > 0). Not clipped at zero: the small tensile force
-      // at the end of a contact is what makes the rebound exactly e (closed-form damping).
-      const double fn = kn * delta + eta_n * gn;
-      const double gtx = gx - gn * nx, gty = gy - gn * ny, gtz = gz - gn * nz;
-      // Tangential spring: previous value rotated into the current tangent plane, then grown.
-      double xix = 0, xiy = 0, xiz = 0;
-      for (int s = 0; s < old_count; ++s) {
-        if (old_partner[s] == partner) {
-          xix = old_xi[3 * s];
-          xiy = old_xi[3 * s + 1];
-          xiz = old_xi[3 * s + 2];
-          const double along = xix * nx + xiy * ny + xiz * nz;
-          xix -= along * nx;
-          xiy -= along * ny;
-          xiz -= along * nz;
-          break;
+#pragma omp parallel if (parallel)
+  {
+    const int num_threads = omp_get_num_threads(), t = omp_get_thread_num();
+    // First owner of thread k: work = pairs + particles (walls, bookkeeping) split evenly.
+    auto split = [&](int k) {
+      if (k <= 0) return 0;
+      if (k >= num_threads) return n;
+      const double target = static_cast<double>(k) * (pairs + n) / num_threads;
+      int lo = 0, hi = n;
+      while (lo < hi) {
+        const int mid = lo + (hi - lo) / 2;
+        if (start[mid] + mid < target) {
+          lo = mid + 1;
+        } else {
+          hi = mid;
         }
       }
-      xix += gtx * dt;
-      xiy += gty * dt;
-      xiz += gtz * dt;
-      double ftx = -kt * xix - eta_t * gtx;
-      double fty = -kt * xiy - eta_t * gty;
-      double ftz = -kt * xiz - eta_t * gtz;
-      const double ft = std::sqrt(ftx * ftx + fty * fty + ftz * ftz);
-      const double limit = mu_f * std::fabs(fn);
-      if (ft > limit) {
-        // Sliding: force on the Coulomb cone, spring truncated to be consistent with it.
-        const double scale = ft > 0.0 ? limit / ft : 0.0;
-        ftx *= scale;
-        fty *= scale;
-        ftz *= scale;
-        xix = -(ftx + eta_t * gtx) / kt;
-        xiy = -(fty + eta_t * gty) / kt;
-        xiz = -(ftz + eta_t * gtz) / kt;
-      }
-      const double fcx = -fn * nx + ftx, fcy = -fn * ny + fty, fcz = -fn * nz + ftz;
-      fx += fcx;
-      fy += fcy;
-      fz += fcz;
-      // Torque (r_i n) x F_t.
-      tx += ri * (ny * ftz - nz * fty);
-      ty += ri * (nz * ftx - nx * ftz);
-      tz += ri * (nx * fty - ny * ftx);
-      energy += share * 0.5 * (kn * delta * delta + kt * (xix * xix + xiy * xiy + xiz * xiz));
-      if (wall_out != nullptr) {
-        wall_out[0] -= fcx;
-        wall_out[1] -= fcy;
-        wall_out[2] -= fcz;
-      }
-      if (count < kMaxContacts) {
-        new_partner[count] = partner;
-        new_xi[3 * count] = xix;
-        new_xi[3 * count + 1] = xiy;
-        new_xi[3 * count + 2] = xiz;
-        ++count;
-      } else {
-        overflow = std::max(overflow, i);
-      }
+      return lo;
     };
+    const int begin = split(t), end = split(t + 1);
+    // Highest index + 1 this thread writes: its owners and their (ascending) partners.
+    int written_end = end;
+    for (int i = begin; i < end; ++i) {
+      if (start[i + 1] > start[i]) written_end = std::max(written_end, nbr[start[i + 1] - 1] + 1);
+    }
+    range_begin[t] = begin;
+    range_written_end[t] = written_end;
+    std::fill(force_.begin() + 6 * static_cast<std::size_t>(begin),
+              force_.begin() + 6 * static_cast<std::size_t>(end), 0.0);
+    // Where this thread accumulates: force_ for thread 0, else its buffer, which covers only the
+    // indices [begin, written_end) (index j lives at j - base).
+    double* F = force_.data();
+    int base = 0;
+    if (t > 0) {
+      std::vector<double>& buffer = thread_force_[t - 1];
+      const std::size_t size = 6 * static_cast<std::size_t>(written_end - begin);
+      if (buffer.size() < size) buffer.resize(size);
+      std::fill(buffer.begin(), buffer.begin() + size, 0.0);
+      F = buffer.data();
+      base = begin;
+    }
+#pragma omp barrier
+    Totals tot;
+    for (int i = begin; i < end; ++i) {
+      const double* si = S + static_cast<std::size_t>(kStateStride) * i;
+      const double xi = si[0], yi = si[1], zi = si[2];
+      const double vxi = si[3], vyi = si[4], vzi = si[5];
+      const double wxi = si[6], wyi = si[7], wzi = si[8];
+      const double ri = si[9], mi = si[10];
+      const int old_count = hist_count_[prev][i];
+      const int* old_partner = &hist_partner_[prev][static_cast<std::size_t>(i) * kMaxContacts];
+      const double* old_xi = &hist_xi_[prev][static_cast<std::size_t>(i) * kMaxContacts * 3];
+      int* new_partner = &hist_partner_[next][static_cast<std::size_t>(i) * kMaxContacts];
+      double* new_xi = &hist_xi_[next][static_cast<std::size_t>(i) * kMaxContacts * 3];
+      int count = 0;
+      double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0, energy = 0;
 
-    // Particle-particle contacts from the 27 neighbouring cells.
-    const int c = cell_of_[i];
-    const int cx = c % ncell_[0], cy = (c / ncell_[0]) % ncell_[1],
-              cz = c / (ncell_[0] * ncell_[1]);
-    // Neighbour cell index along `axis` (wrapped on periodic axes, with the image shift of the
-    // positions); false if it lies outside a walled axis.
-    auto neighbour = [this](int axis, int k, int* wrapped, double* shift) {
-      *shift = 0.0;
-      *wrapped = k;
-      if (k >= 0 && k < ncell_[axis]) return true;
-      if (!options_.periodic[axis]) return false;
-      const double length = options_.box_max[axis] - options_.box_min[axis];
-      *shift = k < 0 ? -length : length;
-      *wrapped = (k + ncell_[axis]) % ncell_[axis];
-      return true;
-    };
-    for (int oz = -1; oz <= 1; ++oz) {
-      int kz;
-      double shz;
-      if (!neighbour(2, cz + oz, &kz, &shz)) continue;
-      for (int oy = -1; oy <= 1; ++oy) {
-        int ky;
-        double shy;
-        if (!neighbour(1, cy + oy, &ky, &shy)) continue;
-        for (int ox = -1; ox <= 1; ++ox) {
-          int kx;
-          double shx;
-          if (!neighbour(0, cx + ox, &kx, &shx)) continue;
-          const int cell = (kz * ncell_[1] + ky) * ncell_[0] + kx;
-          for (int s = cell_start_[cell]; s < cell_start_[cell + 1]; ++s) {
-            const int j = cell_particles_[s];
-            if (j == i) continue;
-            // Periodic image of j next to i: the shift of the wrapped cell.
-            const double dx = X[j] + shx - xi, dy = Y[j] + shy - yi, dz = Z[j] + shz - zi;
-            const double rsum = ri + 0.5 * D[j];
-            const double dist2 = dx * dx + dy * dy + dz * dz;
-            if (dist2 >= rsum * rsum || dist2 == 0.0) continue;
-            const double dist = std::sqrt(dist2);
-            const double inv = 1.0 / dist;
-            const double delta = rsum - dist;
-            const double mj = mass_[j];
-            contact(j, dx * inv, dy * inv, dz * inv, delta, mi * mj / (mi + mj), ce, mu, VX[j],
-                    VY[j], VZ[j], 0.5 * D[j], WX[j], WY[j], WZ[j], 0.5, nullptr);
-            ++contacts;
-            max_overlap = std::max(max_overlap, delta / std::min(D[i], D[j]));
+      // One contact of i with unit normal n (from i towards the partner), overlap delta, partner
+      // velocity vj, angular velocity wj and lever rj (all 0 for walls). Returns the force on i
+      // in fc and n x F_t in nft (the torque on i is r_i n x F_t; on a partner sphere j, whose
+      // normal and force are both reversed, it is r_j n x F_t).
+      auto contact = [&](int partner, double nx, double ny, double nz, double delta, double m_eff,
+                         double c_e, double mu_f, double vjx, double vjy, double vjz, double rj,
+                         double wjx, double wjy, double wjz, double* fc, double* nft) {
+        const double eta_n = c_e * std::sqrt(kn * m_eff);
+        const double eta_t = eta_t_ratio * eta_n;
+        // Velocity of i's contact point relative to the partner's: g = v_i - v_j + (r_i w_i +
+        // r_j w_j) x n.
+        const double sx = ri * wxi + rj * wjx, sy = ri * wyi + rj * wjy, sz = ri * wzi + rj * wjz;
+        const double gx = vxi - vjx + (sy * nz - sz * ny);
+        const double gy = vyi - vjy + (sz * nx - sx * nz);
+        const double gz = vzi - vjz + (sx * ny - sy * nx);
+        const double gn = gx * nx + gy * ny + gz * nz;  // > 0: approaching
+        // Normal force magnitude (repulsive > 0). Not clipped at zero: the small tensile force
+        // at the end of a contact is what makes the rebound exactly e (closed-form damping).
+        const double fn = kn * delta + eta_n * gn;
+        const double gtx = gx - gn * nx, gty = gy - gn * ny, gtz = gz - gn * nz;
+        // Tangential spring: previous value rotated into the current tangent plane, then grown.
+        double xix = 0, xiy = 0, xiz = 0;
+        for (int s = 0; s < old_count; ++s) {
+          if (old_partner[s] == partner) {
+            xix = old_xi[3 * s];
+            xiy = old_xi[3 * s + 1];
+            xiz = old_xi[3 * s + 2];
+            const double along = xix * nx + xiy * ny + xiz * nz;
+            xix -= along * nx;
+            xiy -= along * ny;
+            xiz -= along * nz;
+            break;
           }
         }
+        xix += gtx * dt;
+        xiy += gty * dt;
+        xiz += gtz * dt;
+        double ftx = -kt * xix - eta_t * gtx;
+        double fty = -kt * xiy - eta_t * gty;
+        double ftz = -kt * xiz - eta_t * gtz;
+        const double ft = std::sqrt(ftx * ftx + fty * fty + ftz * ftz);
+        const double limit = mu_f * std::fabs(fn);
+        if (ft > limit) {
+          // Sliding: force on the Coulomb cone, spring truncated to be consistent with it.
+          const double scale = ft > 0.0 ? limit / ft : 0.0;
+          ftx *= scale;
+          fty *= scale;
+          ftz *= scale;
+          xix = -(ftx + eta_t * gtx) / kt;
+          xiy = -(fty + eta_t * gty) / kt;
+          xiz = -(ftz + eta_t * gtz) / kt;
+        }
+        fc[0] = -fn * nx + ftx;
+        fc[1] = -fn * ny + fty;
+        fc[2] = -fn * nz + ftz;
+        nft[0] = ny * ftz - nz * fty;
+        nft[1] = nz * ftx - nx * ftz;
+        nft[2] = nx * fty - ny * ftx;
+        energy += 0.5 * (kn * delta * delta + kt * (xix * xix + xiy * xiy + xiz * xiz));
+        if (count < kMaxContacts) {
+          new_partner[count] = partner;
+          new_xi[3 * count] = xix;
+          new_xi[3 * count + 1] = xiy;
+          new_xi[3 * count + 2] = xiz;
+          ++count;
+        } else {
+          tot.overflow = std::max(tot.overflow, i);
+        }
+      };
+
+      // Particle-particle contacts of the pairs that i owns.
+      for (int k = start[i]; k < start[i + 1]; ++k) {
+        const int j = nbr[k];
+        const double* sj = S + static_cast<std::size_t>(kStateStride) * j;
+        double dx = sj[0] - xi, dy = sj[1] - yi, dz = sj[2] - zi;
+        if (periodic_any) {
+          // Nearest image: a touching pair is closer than d_max <= L/3.
+          dx = NearestImage(dx, length[0], half_length[0]);
+          dy = NearestImage(dy, length[1], half_length[1]);
+          dz = NearestImage(dz, length[2], half_length[2]);
+        }
+        const double rj = sj[9];
+        const double rsum = ri + rj;
+        const double dist2 = dx * dx + dy * dy + dz * dz;
+        if (dist2 >= rsum * rsum || dist2 == 0.0) continue;
+        const double dist = std::sqrt(dist2);
+        const double inv = 1.0 / dist;
+        const double delta = rsum - dist;
+        const double mj = sj[10];
+        double fc[3], nft[3];
+        contact(j, dx * inv, dy * inv, dz * inv, delta, mi * mj / (mi + mj), ce, mu, sj[3], sj[4],
+                sj[5], rj, sj[6], sj[7], sj[8], fc, nft);
+        fx += fc[0];
+        fy += fc[1];
+        fz += fc[2];
+        tx += ri * nft[0];
+        ty += ri * nft[1];
+        tz += ri * nft[2];
+        double* fj = F + 6 * static_cast<std::size_t>(j - base);
+        fj[0] -= fc[0];
+        fj[1] -= fc[1];
+        fj[2] -= fc[2];
+        fj[3] += rj * nft[0];
+        fj[4] += rj * nft[1];
+        fj[5] += rj * nft[2];
+        ++tot.contacts;
+        tot.max_overlap = std::max(tot.max_overlap, delta / (2.0 * std::min(ri, rj)));
+      }
+      // Walls: planes of the box on non-periodic axes; static, so the partner velocity is zero.
+      const double pos[3] = {xi, yi, zi};
+      for (int a = 0; a < 3; ++a) {
+        if (options_.periodic[a]) continue;
+        for (int side = 0; side < 2; ++side) {
+          const double delta =
+              side == 0 ? ri - (pos[a] - options_.box_min[a]) : ri - (options_.box_max[a] - pos[a]);
+          if (delta <= 0.0) continue;
+          double nrm[3] = {0.0, 0.0, 0.0};
+          nrm[a] = side == 0 ? -1.0 : 1.0;  // from the particle towards the wall
+          double fc[3], nft[3];
+          contact(-1 - (2 * a + side), nrm[0], nrm[1], nrm[2], delta, mi, ce_wall, mu_wall, 0.0,
+                  0.0, 0.0, 0.0, 0.0, 0.0, 0.0, fc, nft);
+          fx += fc[0];
+          fy += fc[1];
+          fz += fc[2];
+          tx += ri * nft[0];
+          ty += ri * nft[1];
+          tz += ri * nft[2];
+          double* wf = &tot.wall_force[3 * (2 * a + side)];
+          wf[0] -= fc[0];
+          wf[1] -= fc[1];
+          wf[2] -= fc[2];
+          ++tot.wall_contacts;
+          tot.max_overlap = std::max(tot.max_overlap, delta / (2.0 * ri));
+        }
+      }
+      hist_count_[next][i] = count;
+      double* fi = F + 6 * static_cast<std::size_t>(i - base);
+      fi[0] += fx;
+      fi[1] += fy;
+      fi[2] += fz;
+      fi[3] += tx;
+      fi[4] += ty;
+      fi[5] += tz;
+      elastic_[i] = energy;
+    }
+    totals[t] = tot;
+#pragma omp barrier
+    // Partner forces that other threads wrote into their buffers, added in thread order.
+    for (int u = 1; u < num_threads && range_begin[u] < end; ++u) {
+      const int lo = std::max(begin, range_begin[u]), hi = std::min(end, range_written_end[u]);
+      const double* buffer = thread_force_[u - 1].data();
+      for (int q = 6 * (lo - range_begin[u]), stop = 6 * (hi - range_begin[u]); q < stop; ++q) {
+        force_[6 * static_cast<std::size_t>(range_begin[u]) + q] += buffer[q];
       }
     }
-    // Walls: planes of the box on non-periodic axes; static, so the partner velocity is zero.
-    const double pos[3] = {xi, yi, zi};
-    for (int a = 0; a < 3; ++a) {
-      if (options_.periodic[a]) continue;
-      for (int side = 0; side < 2; ++side) {
-        const double delta =
-            side == 0 ? ri - (pos[a] - options_.box_min[a]) : ri - (options_.box_max[a] - pos[a]);
-        if (delta <= 0.0) continue;
-        double nrm[3] = {0.0, 0.0, 0.0};
-        nrm[a] = side == 0 ? -1.0 : 1.0;  // from the particle towards the wall
-        contact(-1 - (2 * a + side), nrm[0], nrm[1], nrm[2], delta, mi, ce_wall, mu_wall, 0.0, 0.0,
-                0.0, 0.0, 0.0, 0.0, 0.0, 1.0, &wf[3 * (2 * a + side)]);
-        ++wall_contacts;
-        max_overlap = std::max(max_overlap, delta / D[i]);
-      }
-    }
-    hist_count_[next][i] = count;
-    fx_[i] = fx;
-    fy_[i] = fy;
-    fz_[i] = fz;
-    tx_[i] = tx;
-    ty_[i] = ty;
-    tz_[i] = tz;
-    elastic_[i] = energy;
   }
   hist_cur_ = next;
-  contacts_ = contacts / 2;  // each pair was seen from both sides
-  wall_contacts_ = wall_contacts;
-  max_overlap_ = max_overlap;
-  std::copy(wf, wf + 18, wall_force_.begin());
-  overflow_particle_ = overflow;
+  Totals sum;
+  for (const Totals& tot : totals) {
+    sum.contacts += tot.contacts;
+    sum.wall_contacts += tot.wall_contacts;
+    sum.max_overlap = std::max(sum.max_overlap, tot.max_overlap);
+    for (int k = 0; k < 18; ++k) sum.wall_force[k] += tot.wall_force[k];
+    sum.overflow = std::max(sum.overflow, tot.overflow);
+  }
+  contacts_ = sum.contacts;
+  wall_contacts_ = sum.wall_contacts;
+  max_overlap_ = sum.max_overlap;
+  std::copy(sum.wall_force, sum.wall_force + 18, wall_force_.begin());
+  overflow_particle_ = sum.overflow;
 }
 
 void DemSystem::check_state(double dt) const {
@@ -472,7 +649,8 @@ void DemSystem::check_state(double dt) const {
   for (int i = 0; i < n; ++i) {
     const double v2 = p_.vx[i] * p_.vx[i] + p_.vy[i] * p_.vy[i] + p_.vz[i] * p_.vz[i];
     const double pos[3] = {p_.x[i], p_.y[i], p_.z[i]};
-    bool ok = std::isfinite(v2) && std::isfinite(fx_[i] + fy_[i] + fz_[i]);
+    bool ok =
+        std::isfinite(v2) && std::isfinite(force_[6 * i] + force_[6 * i + 1] + force_[6 * i + 2]);
     for (int a = 0; a < 3 && ok; ++a) {
       ok = std::isfinite(pos[a]) && (options_.periodic[a] || (pos[a] > options_.box_min[a] - tol &&
                                                               pos[a] < options_.box_max[a] + tol));
@@ -509,48 +687,61 @@ void DemSystem::step(double dt) {
   const int n = static_cast<int>(p_.size());
   const double gx = options_.gravity[0], gy = options_.gravity[1], gz = options_.gravity[2];
   const double h = 0.5 * dt;
-  double* X = p_.x.data();
-  double* Y = p_.y.data();
-  double* Z = p_.z.data();
-  // Kick (half) and drift.
-#pragma omp parallel for schedule(static) if (n >= 512)
+  double* pos[3] = {p_.x.data(), p_.y.data(), p_.z.data()};
+  double* vel[3] = {p_.vx.data(), p_.vy.data(), p_.vz.data()};
+  const double* built[3] = {x_built_.data(), y_built_.data(), z_built_.data()};
+  double lo[3], length[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = options_.box_min[a];
+    length[a] = options_.box_max[a] - options_.box_min[a];
+  }
+  // Kick (half), drift, wrap periodic axes into [min, max); pack the state for the pair loop and
+  // track the largest displacement since the list was built (nearest image on periodic axes).
+  double max_displacement2 = 0.0;
+#pragma omp parallel for schedule(static) if (n >= 512) reduction(max : max_displacement2)
   for (int i = 0; i < n; ++i) {
     const double im = inv_mass_[i], ii = inv_inertia_[i];
-    p_.vx[i] += h * ((fx_[i] + p_.fx_ext[i]) * im + gx);
-    p_.vy[i] += h * ((fy_[i] + p_.fy_ext[i]) * im + gy);
-    p_.vz[i] += h * ((fz_[i] + p_.fz_ext[i]) * im + gz);
-    p_.wx[i] += h * tx_[i] * ii;
-    p_.wy[i] += h * ty_[i] * ii;
-    p_.wz[i] += h * tz_[i] * ii;
-    X[i] += dt * p_.vx[i];
-    Y[i] += dt * p_.vy[i];
-    Z[i] += dt * p_.vz[i];
-  }
-  // Periodic axes: wrap into [min, max).
-  double* pos[3] = {X, Y, Z};
-  for (int a = 0; a < 3; ++a) {
-    if (!options_.periodic[a]) continue;
-    const double lo = options_.box_min[a], len = options_.box_max[a] - options_.box_min[a];
-    for (int i = 0; i < n; ++i) {
+    const double* f = &force_[6 * static_cast<std::size_t>(i)];
+    const double* f_ext[3] = {&p_.fx_ext[i], &p_.fy_ext[i], &p_.fz_ext[i]};
+    double* w[3] = {&p_.wx[i], &p_.wy[i], &p_.wz[i]};
+    double* s = &state_[static_cast<std::size_t>(kStateStride) * i];
+    double displacement2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double g = options_.gravity[a];
+      double& v = vel[a][i];
+      v += h * ((f[a] + *f_ext[a]) * im + g);
+      *w[a] += h * f[3 + a] * ii;
       double& q = pos[a][i];
-      if (q < lo || q >= lo + len) {
-        q -= len * std::floor((q - lo) / len);
-        if (q >= lo + len) q = lo;  // rounding
+      q += dt * v;
+      double moved = q - built[a][i];
+      if (options_.periodic[a]) {
+        if (q < lo[a] || q >= lo[a] + length[a]) {
+          q -= length[a] * std::floor((q - lo[a]) / length[a]);
+          if (q >= lo[a] + length[a]) q = lo[a];  // rounding
+        }
+        moved = NearestImage(q - built[a][i], length[a], 0.5 * length[a]);
       }
+      displacement2 += moved * moved;
+      s[a] = q;
+      s[3 + a] = v;
+      s[6 + a] = *w[a];
     }
+    max_displacement2 = std::max(max_displacement2, displacement2);
   }
-  build_cells();
+  // Rebuild when two particles may have closed the skin between them.
+  if (max_displacement2 > 0.25 * skin_ * skin_) build_neighbor_list();
   compute_forces(dt);
   // Kick (half) with the new forces.
 #pragma omp parallel for schedule(static) if (n >= 512)
   for (int i = 0; i < n; ++i) {
     const double im = inv_mass_[i], ii = inv_inertia_[i];
-    p_.vx[i] += h * ((fx_[i] + p_.fx_ext[i]) * im + gx);
-    p_.vy[i] += h * ((fy_[i] + p_.fy_ext[i]) * im + gy);
-    p_.vz[i] += h * ((fz_[i] + p_.fz_ext[i]) * im + gz);
-    p_.wx[i] += h * tx_[i] * ii;
-    p_.wy[i] += h * ty_[i] * ii;
-    p_.wz[i] += h * tz_[i] * ii;
+    const double* f = &force_[6 * static_cast<std::size_t>(i)];
+    p_.vx[i] += h * ((f[0] + p_.fx_ext[i]) * im + gx);
+    p_.vy[i] += h * ((f[1] + p_.fy_ext[i]) * im + gy);
+    p_.vz[i] += h * ((f[2] + p_.fz_ext[i]) * im + gz);
+    p_.wx[i] += h * f[3] * ii;
+    p_.wy[i] += h * f[4] * ii;
+    p_.wz[i] += h * f[5] * ii;
   }
   time_ += dt;
   ++steps_;
@@ -596,37 +787,57 @@ void DemSystem::sort_particles() {
   std::vector<int> order(cell_particles_.begin(), cell_particles_.end());
   std::vector<int> new_index(n);
   for (int k = 0; k < n; ++k) new_index[order[k]] = k;
+  // Contact history first (it may refuse): a pair's spring moves to the pair's new lower index,
+  // negated when the owner changes side (the spring seen from the partner is -xi); walls stay.
+  const int cur = hist_cur_;
+  std::vector<int> count(n, 0), partner(static_cast<std::size_t>(n) * kMaxContacts);
+  std::vector<double> xi(static_cast<std::size_t>(n) * kMaxContacts * 3);
+  for (int k = 0; k < n; ++k) {
+    const int o = order[k];
+    for (int s = 0; s < hist_count_[cur][o]; ++s) {
+      const std::size_t from = static_cast<std::size_t>(o) * kMaxContacts + s;
+      const int q = hist_partner_[cur][from];
+      int owner = k, other = q;
+      double sign = 1.0;
+      if (q >= 0) {
+        other = new_index[q];
+        if (other < k) {
+          std::swap(owner, other);
+          sign = -1.0;
+        }
+      }
+      if (count[owner] >= kMaxContacts) {
+        Fail("DEM: particle " + std::to_string(owner) + " has more than " +
+             std::to_string(kMaxContacts) + " contacts (limit of the contact history); " +
+             "overlaps are too large or the size ratio too wide; remedy: raise " +
+             "normal_stiffness or narrow the size distribution");
+      }
+      const std::size_t to = static_cast<std::size_t>(owner) * kMaxContacts + count[owner]++;
+      partner[to] = other;
+      for (int c = 0; c < 3; ++c) xi[3 * to + c] = sign * hist_xi_[cur][3 * from + c];
+    }
+  }
   auto permute = [&](auto& v) {
     auto copy = v;
     for (int k = 0; k < n; ++k) v[k] = copy[order[k]];
   };
-  for (auto* v : {&p_.x,        &p_.y,       &p_.z,     &p_.vx,     &p_.vy,     &p_.vz,
-                  &p_.wx,       &p_.wy,      &p_.wz,    &p_.fx_ext, &p_.fy_ext, &p_.fz_ext,
-                  &p_.diameter, &p_.density, &fx_,      &fy_,       &fz_,       &tx_,
-                  &ty_,         &tz_,        &elastic_, &mass_,     &inv_mass_, &inv_inertia_}) {
+  for (auto* v :
+       {&p_.x, &p_.y, &p_.z, &p_.vx, &p_.vy, &p_.vz, &p_.wx, &p_.wy, &p_.wz, &p_.fx_ext, &p_.fy_ext,
+        &p_.fz_ext, &p_.diameter, &p_.density, &elastic_, &mass_, &inv_mass_, &inv_inertia_}) {
     permute(*v);
   }
   permute(p_.id);
-  // Contact history: move each particle's slots and renumber particle partners.
-  const int cur = hist_cur_;
-  std::vector<int> count(n), partner(static_cast<std::size_t>(n) * kMaxContacts);
-  std::vector<double> xi(static_cast<std::size_t>(n) * kMaxContacts * 3);
+  const std::vector<double> force = force_;
   for (int k = 0; k < n; ++k) {
-    const int o = order[k];
-    count[k] = hist_count_[cur][o];
-    for (int s = 0; s < count[k]; ++s) {
-      const int q = hist_partner_[cur][static_cast<std::size_t>(o) * kMaxContacts + s];
-      partner[static_cast<std::size_t>(k) * kMaxContacts + s] = q >= 0 ? new_index[q] : q;
-      for (int c = 0; c < 3; ++c) {
-        xi[(static_cast<std::size_t>(k) * kMaxContacts + s) * 3 + c] =
-            hist_xi_[cur][(static_cast<std::size_t>(o) * kMaxContacts + s) * 3 + c];
-      }
-    }
+    for (int c = 0; c < 6; ++c)
+      force_[6 * static_cast<std::size_t>(k) + c] =
+          force[6 * static_cast<std::size_t>(order[k]) + c];
   }
   hist_count_[cur] = std::move(count);
   hist_partner_[cur] = std::move(partner);
   hist_xi_[cur] = std::move(xi);
-  build_cells();
+  pack_state();
+  build_neighbor_list();
 }
 
 // ---- Settling ----------------------------------------------------------------------------------

@@ -8,9 +8,12 @@
 // Gravity and an external force per particle supplied by the caller (gas drag and pressure force
 // of the coupling) act on every particle. Integration: velocity Verlet (kick-drift-kick); the
 // contact damping and the tangential-spring increment use the half-step velocity (as LAMMPS).
-// Neighbour search: linked cells of edge >= the largest diameter, rebuilt every step. Forces are
-// computed per particle over its neighbour cells (each pair twice), so every OpenMP thread writes
-// only its own particles: no races, results independent of the thread count.
+// Neighbour search: a half Verlet list (pairs i < j closer than R_i + R_j + skin), built from
+// linked cells and rebuilt only when a particle has moved more than skin/2 since the last build
+// (or after sort_particles() / reset_contacts()). Each pair is evaluated once and applies equal
+// and opposite forces. OpenMP: the particles are split into contiguous ranges of equal work
+// (pairs + particles); threads accumulate into their own force buffers, added in thread order, so
+// the results are deterministic for a fixed thread count (they differ in rounding between counts).
 //
 // Units: SI (m, kg, s, N). Axes: x width, y height (gravity along -y by default), z depth.
 // Contact model, parameters, time step and limits: docs/dem.md.
@@ -71,6 +74,10 @@ struct DemOptions {
   /// Divergence guard: stop when an overlap exceeds this fraction of the smaller diameter,
   /// (0, 0.5].
   double max_overlap_fraction = 0.2;
+  /// Verlet-list skin as a fraction of the largest diameter, [0, 1]. A larger skin means fewer
+  /// list rebuilds but more candidate pairs per step; 0 rebuilds the list every step. Reduced
+  /// automatically where a periodic axis is shorter than 3 (d_max + skin).
+  double neighbor_skin_fraction = 0.2;
   /// True if valid; otherwise *error names the field and its allowed range.
   bool IsValid(std::string* error) const;
 };
@@ -131,12 +138,18 @@ class DemSystem {
   std::array<double, 3> wall_force(Wall w) const;
   /// Largest overlap / smaller diameter at the last force evaluation.
   double max_overlap_fraction() const { return max_overlap_; }
+  /// Neighbour-list builds so far (constructor, reset_contacts, sort_particles included).
+  std::int64_t neighbor_list_builds() const { return list_builds_; }
+  /// Skin of the neighbour list [m]: neighbor_skin_fraction * d_max, or less (periodic axes).
+  double neighbor_skin() const { return skin_; }
   /// Reorders particles by linked cell (memory locality, faster steps); ids follow the
   /// particles. Indices change: call only between steps, before caller-side per-index data.
   void sort_particles();
 
  private:
   void build_cells();
+  void build_neighbor_list();
+  void pack_state();
   void compute_forces(double dt);
   void check_state(double dt) const;
 
@@ -147,14 +160,27 @@ class DemSystem {
   double time_ = 0.0;
   std::int64_t steps_ = 0;
   double d_max_ = 0.0, d_min_ = 0.0;
-  // Per-particle derived data and contact forces/torques.
+  // Per-particle derived data; contact force and torque, 6 per particle (fx fy fz tx ty tz).
   std::vector<double> inv_mass_, inv_inertia_, mass_;
-  std::vector<double> fx_, fy_, fz_, tx_, ty_, tz_, elastic_;
-  // Linked cells.
+  std::vector<double> force_, elastic_;
+  // Per-particle state read by the pair loop, packed (kStateStride per particle) so that a
+  // neighbour costs two cache lines instead of eleven: x y z vx vy vz wx wy wz r m.
+  std::vector<double> state_;
+  // Force buffers of OpenMP threads 1.. (thread 0 writes force_), each over the index range its
+  // thread writes, added in thread order.
+  std::vector<std::vector<double>> thread_force_;
+  // Linked cells (edge >= d_max + skin), used to build the neighbour list.
   std::array<int, 3> ncell_{1, 1, 1};
   std::array<double, 3> cell_size_{1.0, 1.0, 1.0};
   std::vector<int> cell_of_, cell_start_, cell_particles_;
-  // Tangential contact history, kMaxContacts slots per particle, double-buffered.
+  // Half Verlet list: neighbours j > i of particle i are nbr_[nbr_start_[i] .. nbr_start_[i+1]),
+  // ascending; positions at the last build decide the next one.
+  double skin_ = 0.0;
+  std::vector<int> nbr_start_, nbr_;
+  std::vector<double> x_built_, y_built_, z_built_;
+  std::int64_t list_builds_ = 0;
+  // Tangential contact history, double-buffered, kMaxContacts slots per particle. A pair's spring
+  // is kept by its lower index (the list owner) as seen from that particle; walls by the particle.
   std::vector<int> hist_count_[2], hist_partner_[2];
   std::vector<double> hist_xi_[2];
   int hist_cur_ = 0;
