@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "cli/file_util.h"
 #include "cli/progress.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/dataset.h"
@@ -34,11 +35,6 @@ struct ExportCommand {
   bool csv = false;
   std::string out;
 };
-
-bool file_exists(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
 
 /// A spec path, or a preset name ("quick", "standard", "paper") from data/campaigns.
 std::string resolve_spec_path(const std::string& spec) {

@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "cli/file_util.h"
 #include "cli/progress.h"
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
@@ -413,19 +414,6 @@ void run_bench(const CliContext& ctx, const BenchCommand& b) {
       "roofline          {:.2f} of bandwidth/304 B = {:.0f} MLUPS (goal >= "
       "0.8)\n",
       r.roofline_fraction, r.bandwidth_gbs * 1e3 / 304.0);
-}
-
-/// Quotes a path for the shell (single quotes; a quote inside is closed, escaped, reopened).
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char ch : s) {
-    if (ch == '\'') {
-      out += "'\\''";
-    } else {
-      out += ch;
-    }
-  }
-  return out + "'";
 }
 
 /// "gnuplot", "matplotlib" or "" (none available).

@@ -26,6 +26,7 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "cli/file_util.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/dataset.h"
@@ -77,36 +78,6 @@ std::vector<std::string> split_list(const std::string& text) {
   return items;
 }
 
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  return out + "'";
-}
-
-bool file_exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
-
-bool directory_exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-/// mkdir -p; throws UsageError naming --out if a component cannot be created.
-void make_directories(const std::string& path) {
-  std::string partial;
-  std::size_t pos = 0;
-  while (pos != std::string::npos) {
-    pos = path.find('/', pos + 1);
-    partial = path.substr(0, pos);
-    if (partial.empty() || directory_exists(partial)) continue;
-    if (::mkdir(partial.c_str(), 0777) != 0 && !directory_exists(partial)) {
-      throw UsageError(fmt::format("--out: cannot create directory '{}'", partial));
-    }
-  }
-}
-
 std::string utc_now() {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
@@ -114,33 +85,6 @@ std::string utc_now() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
-}
-
-std::string executable_dir() {
-  char buf[PATH_MAX];
-  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return "";
-  std::string path(buf, static_cast<std::size_t>(n));
-  return path.substr(0, path.rfind('/'));
-}
-
-/// The renderer: installed next to the executable (bin/../share/draglab), else the source tree's.
-std::string find_report_script() {
-  const std::string installed =
-      executable_dir() + "/../" + DRAGLAB_INSTALL_SHARE_DIR + "/draglab_report.py";
-  if (file_exists(installed)) return installed;
-  const std::string source = std::string(DRAGLAB_SOURCE_SCRIPTS_DIR) + "/draglab_report.py";
-  if (file_exists(source)) return source;
-  throw std::runtime_error(
-      fmt::format("the report renderer draglab_report.py was found neither at {} nor at {}",
-                  installed, source));
-}
-
-/// $DRAGLAB_PYTHON (for tests and unusual installs), else Debian's interpreter, which is the
-/// one that sees the python3-matplotlib package.
-std::string python_interpreter() {
-  const char* p = std::getenv("DRAGLAB_PYTHON");
-  return p && *p ? p : "/usr/bin/python3";
 }
 
 std::string law_label(const LawRecord& r, const std::string& role) {
@@ -532,9 +476,9 @@ ReportOutcome make_report(const CliContext& ctx, const Database& db, ReportComma
         "{} cannot import matplotlib: install the Debian package python3-matplotlib "
         "(apt-get install python3-matplotlib) and rerun, or render the figures later with "
         "'/usr/bin/python3 {} {} {}'. The bundle was written.",
-        python, find_report_script(), bundle_path, c.out_dir));
+        python, find_script("draglab_report.py"), bundle_path, c.out_dir));
   }
-  const std::string script = find_report_script();
+  const std::string script = find_script("draglab_report.py");
   // The script's messages go to stderr; stdout stays ours (results / JSON).
   const std::string command = shell_quote(python) + " " + shell_quote(script) + " " +
                               shell_quote(bundle_path) + " " + shell_quote(c.out_dir) +

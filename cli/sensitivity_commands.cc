@@ -28,6 +28,7 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "cli/file_util.h"
 #include "cli/progress.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/consumers/sensitivity.h"
@@ -72,60 +73,6 @@ std::vector<std::string> split_list(const std::string& text, const std::string& 
   return out;
 }
 
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char ch : s) out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  return out + "'";
-}
-
-bool file_exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
-
-bool directory_exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-/// mkdir -p; throws UsageError naming --out if a component cannot be created.
-void make_directories(const std::string& path) {
-  std::size_t pos = 0;
-  while (pos != std::string::npos) {
-    pos = path.find('/', pos + 1);
-    const std::string partial = path.substr(0, pos);
-    if (partial.empty() || directory_exists(partial)) continue;
-    if (::mkdir(partial.c_str(), 0777) != 0 && !directory_exists(partial))
-      throw UsageError(fmt::format("--out: cannot create directory '{}'", partial));
-  }
-}
-
-std::string executable_dir() {
-  char buf[PATH_MAX];
-  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) return "";
-  const std::string path(buf, static_cast<std::size_t>(n));
-  return path.substr(0, path.rfind('/'));
-}
-
-/// The figure script: installed next to the executable (bin/../share/draglab), else the source
-/// tree's (as `draglab report` finds draglab_report.py).
-std::string find_figure_script() {
-  const std::string installed =
-      executable_dir() + "/../" + DRAGLAB_INSTALL_SHARE_DIR + "/" + kFigureScript;
-  if (file_exists(installed)) return installed;
-  const std::string source = std::string(DRAGLAB_SOURCE_SCRIPTS_DIR) + "/" + kFigureScript;
-  if (file_exists(source)) return source;
-  throw std::runtime_error(fmt::format("the figure script {} was found neither at {} nor at {}",
-                                       kFigureScript, installed, source));
-}
-
-/// $DRAGLAB_PYTHON (tests, unusual installs), else Debian's interpreter with python3-matplotlib.
-std::string python_interpreter() {
-  const char* p = std::getenv("DRAGLAB_PYTHON");
-  return p && *p ? p : "/usr/bin/python3";
-}
-
 /// Writes JSON to `path` through a temporary file and a rename, so a reader never sees half.
 void write_json_file(const std::string& path, const nlohmann::json& j) {
   const std::string tmp = path + ".tmp";
@@ -148,10 +95,10 @@ void render(const CliContext& ctx, const std::string& bundle, const std::string&
     throw std::runtime_error(fmt::format(
         "{} cannot import matplotlib: install the Debian package python3-matplotlib and rerun, "
         "or draw the figure later with '/usr/bin/python3 {} {} {}'. The data {} were written.",
-        python, find_figure_script(), bundle, out_dir, bundle));
+        python, find_script(kFigureScript), bundle, out_dir, bundle));
   }
   std::remove(figure.c_str());  // so a stale figure is never taken for a new one
-  const std::string command = shell_quote(python) + " " + shell_quote(find_figure_script()) + " " +
+  const std::string command = shell_quote(python) + " " + shell_quote(find_script(kFigureScript)) + " " +
                               shell_quote(bundle) + " " + shell_quote(out_dir) +
                               (ctx.quiet ? " --quiet" : "") + " 1>&2";
   const int status = std::system(command.c_str());
