@@ -11,6 +11,31 @@
 namespace draglab {
 namespace cli {
 
+/// Remaining time of a job from its reported fraction done: the rate since the current pass
+/// began, extrapolated. Callers report either the fraction of the whole job (the stage text may
+/// change freely, e.g. "settle: KE = ...") or a fraction per stage that restarts from 0, so a pass
+/// begins at the first report and whenever the fraction drops.
+class EtaEstimate {
+ public:
+  /// fraction in [0, 1] at `elapsed_s` since the job started; returns the ETA in seconds, or -1
+  /// while less than 0.5 % of the pass is done (too little to extrapolate) or when finished.
+  double Observe(double fraction, double elapsed_s) {
+    if (!started_ || fraction < last_fraction_) {
+      started_ = true;
+      pass_start_s_ = elapsed_s;
+      pass_start_fraction_ = fraction;
+    }
+    last_fraction_ = fraction;
+    const double done = fraction - pass_start_fraction_;
+    if (done <= 0.005 || fraction >= 1.0) return -1.0;
+    return (elapsed_s - pass_start_s_) * (1.0 - fraction) / done;
+  }
+
+ private:
+  bool started_ = false;
+  double pass_start_s_ = 0.0, pass_start_fraction_ = 0.0, last_fraction_ = 0.0;
+};
+
 class ProgressLine {
  public:
   explicit ProgressLine(bool enabled)
@@ -21,17 +46,11 @@ class ProgressLine {
   void update(double fraction, const std::string& stage) {
     if (!enabled_) return;
     const auto now = Clock::now();
-    if (stage != stage_) {
-      stage_ = stage;
-      stage_start_ = now;
-    }
+    const double eta_s = eta_.Observe(fraction, seconds(start_, now));
     const double since_last = seconds(last_, now);
     if (since_last < (tty_ ? 0.2 : 10.0) && fraction < 1.0) return;
     last_ = now;
-    const double elapsed = seconds(stage_start_, now);
-    std::string eta = "?";
-    if (fraction > 0.01 && fraction < 1.0)
-      eta = format_seconds(elapsed * (1.0 - fraction) / fraction);
+    const std::string eta = eta_s >= 0.0 ? format_seconds(eta_s) : "?";
     std::fprintf(stderr, "%s[%s] %5.1f %%  elapsed %s  eta %s%s", tty_ ? "\r" : "", stage.c_str(),
                  100.0 * fraction, format_seconds(seconds(start_, now)).c_str(), eta.c_str(),
                  tty_ ? "   " : "\n");
@@ -58,8 +77,8 @@ class ProgressLine {
     return buf;
   }
   bool enabled_, tty_, printed_ = false;
-  Clock::time_point start_, last_, stage_start_;
-  std::string stage_;
+  Clock::time_point start_, last_;
+  EtaEstimate eta_;
 };
 
 /// Prints the campaign runner's own progress lines (they carry counts and the ETA already): on a

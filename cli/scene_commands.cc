@@ -240,6 +240,7 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
          {"gas_steps", r.gas_steps},
          {"dem_steps", r.dem_steps},
          {"wall_s", r.wall_s},
+         {"threads", r.threads},
          {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
          {"momentum_mismatch", r.momentum_mismatch},
          {"void_fraction_clamps", r.void_fraction_clamps},

@@ -188,4 +188,23 @@ assert len(r["baselines"]) == 2 and len(r["scenes"]) == 1, r
 assert not b["ergun@1"]["active"] and b["ergun@1"]["superseded_at"], b
 assert b["ergun@2"]["active"] and b["ergun@2"]["supersedes"] == b["ergun@1"]["id"], b
 '
+# Thread count: trajectories are bitwise reproducible at one thread count only (summation order),
+# so a baseline recorded at 1 thread must hold at 2 within the default tolerance (2 cells + 10 %
+# of D; measured on the quick scene: 5.50 vs 5.59 cm against 1.55 cm). The run reports its count.
+for t in 1 2; do
+  check "scene run at $t thread(s)" 0 env OMP_NUM_THREADS=$t "$draglab" --db "$db" scene run "$scene" --law ergun@1 --no-store --json
+  cp "$work/out" "$work/threads_$t.json"
+done
+pycheck "1 vs 2 threads within the default tolerance" '
+import json, sys
+a = json.load(open(sys.argv[1] + "/threads_1.json"))
+b = json.load(open(sys.argv[1] + "/threads_2.json"))
+assert a["threads"] == 1 and b["threads"] == 2, (a["threads"], b["threads"])
+assert a["umf_m_s"] == b["umf_m_s"], (a["umf_m_s"], b["umf_m_s"])
+assert (a["bubble_diameter_m"] is None) == (b["bubble_diameter_m"] is None), (a, b)
+if a["bubble_diameter_m"] is not None:
+    cell = max(0.03 / 4, 0.09 / 12)
+    tol = 2 * cell + 0.1 * a["bubble_diameter_m"]
+    assert abs(a["bubble_diameter_m"] - b["bubble_diameter_m"]) <= tol, (a["bubble_diameter_m"], b["bubble_diameter_m"], tol)
+'
 finish "cli.regress"

@@ -3,6 +3,8 @@
 
 #include "draglab/consumers/dpm_output.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -91,10 +93,11 @@ std::string DpmResult::BriefReport() const {
   s << "DPM " << scene << " with " << law << ": U_mf = " << Num(umf_m_s)
     << " m/s, background = " << Num(background_m_s) << " m/s (" << background_mode
     << "), eps_mf = " << eps_mf << "; settled packing eps = " << Num(eps_packing)
-    << ", its U_mf = " << Num(umf_packing_m_s) << " m/s\n  " << particles << " particles, settled bed "
-    << Num(settled_bed_height_m) << " m; " << gas_steps << " gas steps of " << Num(gas_dt_s)
-    << " s, " << dem_steps << " DEM steps of " << Num(dem_dt_s) << " s; wall " << Num(wall_s)
-    << " s (settling " << Num(settle_wall_s) << " s)\n  bubble D at t_ref = " << Num(t_ref_s)
+    << ", its U_mf = " << Num(umf_packing_m_s) << " m/s\n  " << particles
+    << " particles, settled bed " << Num(settled_bed_height_m) << " m; " << gas_steps
+    << " gas steps of " << Num(gas_dt_s) << " s, " << dem_steps << " DEM steps of " << Num(dem_dt_s)
+    << " s; wall " << Num(wall_s) << " s on " << threads << (threads == 1 ? " thread" : " threads")
+    << " (settling " << Num(settle_wall_s) << " s)\n  bubble D at t_ref = " << Num(t_ref_s)
     << " s: " << (bubble_at_t_ref ? Num(bubble_diameter_m) + " m" : std::string("none"))
     << "\n  gas mass imbalance (max rel.) " << Num(max_relative_mass_imbalance)
     << ", momentum mismatch " << Num(momentum_mismatch) << ", action-reaction max "
@@ -230,10 +233,11 @@ void DpmSimulation::Start(Particles settled) {
       result_.umf_packing_m_s = minimum_fluidization(*law_, s.particles, s.gas, mo).umf_m_s;
     } catch (const Error& e) {
       if (s.distributor.mode == BackgroundMode::kUmfPacking && opt_.background_override_m_s < 0.0)
-        throw Error(e.code(), "distributor.background = \"umf_packing\": the law's U_mf at the "
-                              "settled packing's eps = " + Num(result_.eps_packing) +
-                              " cannot be computed (" + e.what() +
-                              "); use background = \"umf\" or \"fixed\"");
+        throw Error(e.code(),
+                    "distributor.background = \"umf_packing\": the law's U_mf at the "
+                    "settled packing's eps = " +
+                        Num(result_.eps_packing) + " cannot be computed (" + e.what() +
+                        "); use background = \"umf\" or \"fixed\"");
       result_.umf_packing_m_s = 0.0;
     }
   }
@@ -568,6 +572,7 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   result_.momentum_mismatch =
       std::abs(total_momentum() - p_start - m.impulse_z) / (weight * std::max(m.time, 1e-30));
   result_.law_out_of_range = law_->out_of_range_count();
+  result_.threads = omp_get_max_threads();
   result_.wall_s = (settle_here ? 0.0 : result_.settle_wall_s) +
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result_;

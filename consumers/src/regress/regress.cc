@@ -158,6 +158,7 @@ std::string dpm_result_json(const DpmResult& r) {
                       {"settled_bed_height_m", r.settled_bed_height_m},
                       {"gas_dt_s", r.gas_dt_s},
                       {"dem_dt_s", r.dem_dt_s},
+                      {"threads", r.threads},
                       {"gas_steps", r.gas_steps},
                       {"dem_steps", r.dem_steps},
                       {"settle_wall_s", r.settle_wall_s},
