@@ -171,7 +171,8 @@ nlohmann::json regress_json(const consumers::RegressSummary& summary) {
                              {"tolerance", c.tolerance},
                              {"moved", c.moved}});
     }
-    const bool failed = e.outcome == RegressOutcome::kFailed;
+    const bool failed =
+        e.outcome == RegressOutcome::kFailed || e.outcome == RegressOutcome::kOutsideValidity;
     entries.push_back(
         {{"scene", e.scene_name},
          {"scene_hash", e.scene_hash},
@@ -193,6 +194,7 @@ nlohmann::json regress_json(const consumers::RegressSummary& summary) {
   return {{"moved", summary.count(RegressOutcome::kMoved)},
           {"ok", summary.count(RegressOutcome::kOk)},
           {"failed", summary.count(RegressOutcome::kFailed)},
+          {"outside_validity", summary.count(RegressOutcome::kOutsideValidity)},
           {"baselines_registered", summary.count(RegressOutcome::kBaselineRegistered)},
           {"no_baseline", summary.count(RegressOutcome::kNoBaseline)},
           {"runs", summary.runs},
@@ -213,6 +215,13 @@ void finish_regress(const CliContext& ctx, const consumers::RegressSummary& summ
     ctx.warn(fmt::format(
         "{} run(s) failed and were not compared (nothing stored for them); see the report",
         failed));
+  }
+  const int outside = summary.count(RegressOutcome::kOutsideValidity);
+  if (outside > 0) {
+    ctx.warn(fmt::format(
+        "{} check(s) not applicable: the scene leaves the law's validity box (the law cannot be "
+        "used there; not compared, nothing stored); see the report",
+        outside));
   }
   if (!summary.any_moved()) return;
   std::string moved;
@@ -249,7 +258,8 @@ void add_regress_commands(CLI::App& app, CliContext& ctx) {
       "  draglab regress\n"
       "  draglab regress --law ergun@2 --json\n"
       "  draglab regress list\n"
-      "Exit codes: 0 nothing moved (failed runs are reported, not counted as moved), 1 a "
+      "Exit codes: 0 nothing moved (failed runs and scenes outside a law's validity box are "
+      "reported, not counted as moved), 1 a "
       "prediction moved, 2 bad input.");
 
   auto* reg = regress->add_subcommand(

@@ -8,7 +8,8 @@
 #   ergun@3  s = 1.5:   U_mf moves by about -20 % (the Ergun quadratic; measured -0.27 m/s of
 #                       1.336) -> MOVED, exit 1;
 #   ergun@4  s = 1, phi box 0.2-0.5: the bed at eps_mf = 0.42 (phi 0.58) is outside it, so the
-#                       run fails before the DPM starts -> reported as failed, nothing stored.
+#                       run stops before the DPM starts -> reported as outside the law's
+#                       validity box (not a move), nothing stored.
 # Reference for the baseline: ergun@1's U_mf of these particles at eps_mf = 0.42 is 1.336 m/s
 # (docs/scenes.md, Kunii-Levenspiel quadratic; the scene shares the seed bed's particles and gas).
 # Also: registering twice needs --replace (which keeps the old baseline as superseded), stored
@@ -149,18 +150,19 @@ ok "MOVED row for ergun@3" grep -q "ergun@3 .*umf_m_s .*MOVED" "$work/out"
 check "single version within tolerance" 0 "$draglab" --db "$db" regress --law ergun@2
 check "single version that moved" 1 "$draglab" --db "$db" regress --law ergun@3
 
-# A version whose run fails: reported as failed (not moved), nothing stored.
+# A version whose validity box the scene leaves: reported as not applicable (not moved), nothing
+# stored.
 ok "make ergun@4 (phi box 0.2-0.5)" new_ergun_version 1.0 0.5 4
 after_fit="$(counts)"
 check "failed run is not a move" 0 "$draglab" --db "$db" regress --law ergun@4 --json
 cp "$work/out" "$work/failed.json"
-ok "stderr warns about the failed run" grep -q "failed" "$work/err"
+ok "stderr warns about the validity box" grep -q "validity box" "$work/err"
 pycheck "ergun@4 failed with the reason" '
 import json, sys
 r = json.load(open(sys.argv[1] + "/failed.json"))
-assert r["failed"] == 1 and r["moved"] == 0, r
+assert r["outside_validity"] == 1 and r["failed"] == 0 and r["moved"] == 0, r
 e = r["entries"][0]
-assert e["outcome"] == "failed" and e["result_id"] is None and "validity" in e["error"], e
+assert e["outcome"] == "outside_validity" and e["result_id"] is None and "validity" in e["error"], e
 '
 same_counts "a failed run stored nothing" "$after_fit"
 sed 's/^seed = 3/seed = 4/' "$scene" >"$work/other.toml"

@@ -236,26 +236,27 @@ TEST_F(RegressPlan, StoredResultsOfNewerVersionsAreComparedWithoutRunning) {
   EXPECT_EQ(s.entries[1].tolerances.umf_rel, 0.25);
 }
 
-TEST_F(RegressPlan, AFailedRunIsReportedAsFailedAndStoresNothing) {
+TEST_F(RegressPlan, ASceneOutsideTheLawsValidityBoxIsNotApplicableAndStoresNothing) {
   NewErgun(1.0, true, true);  // ergun@2: its phi box ends at 0.5, the bed is at 0.58
   const std::int64_t before = Results();
   int planned = -1;
   const RegressSummary s = run_regression(
       *db_, RegressOptions(), [&](int, int runs, double, const std::string&) { planned = runs; });
   ASSERT_EQ(s.entries.size(), 1u);
-  EXPECT_EQ(s.entries[0].outcome, RegressOutcome::kFailed);
+  EXPECT_EQ(s.entries[0].outcome, RegressOutcome::kOutsideValidity);
   EXPECT_FALSE(s.any_moved());
   EXPECT_EQ(s.entries[0].result_id, 0);
   EXPECT_NE(s.entries[0].error.find("validity"), std::string::npos) << s.entries[0].error;
   EXPECT_EQ(s.runs, 1);
   EXPECT_EQ(Results(), before);
-  EXPECT_NE(s.FullReport().find("FAILED"), std::string::npos);
+  EXPECT_NE(s.FullReport().find("NOT APPLICABLE"), std::string::npos);
+  EXPECT_NE(s.BriefReport().find("1 outside the law's validity box"), std::string::npos);
   EXPECT_TRUE(planned == -1 || planned == 1);  // it fails before the DPM reports progress
 
   // Single-law mode: the same failure, and no baseline is registered for a new name either.
   RegressOptions single;
   single.law = "ergun@2";
-  EXPECT_EQ(run_regression(*db_, single).entries[0].outcome, RegressOutcome::kFailed);
+  EXPECT_EQ(run_regression(*db_, single).entries[0].outcome, RegressOutcome::kOutsideValidity);
   EXPECT_EQ(Results(), before);
 }
 

@@ -214,6 +214,8 @@ const char* to_string(RegressOutcome outcome) {
       return "moved";
     case RegressOutcome::kFailed:
       return "failed";
+    case RegressOutcome::kOutsideValidity:
+      return "outside_validity";
     case RegressOutcome::kBaselineRegistered:
       return "baseline_registered";
     case RegressOutcome::kNoBaseline:
@@ -234,6 +236,9 @@ std::string RegressSummary::BriefReport() const {
     << " s): " << count(RegressOutcome::kMoved) << " moved, " << count(RegressOutcome::kOk)
     << " ok, " << count(RegressOutcome::kFailed) << " failed, "
     << count(RegressOutcome::kBaselineRegistered) << " baseline(s) registered";
+  if (count(RegressOutcome::kOutsideValidity) > 0) {
+    s << ", " << count(RegressOutcome::kOutsideValidity) << " outside the law's validity box";
+  }
   if (count(RegressOutcome::kNoBaseline) > 0) {
     s << ", " << count(RegressOutcome::kNoBaseline) << " without baseline";
   }
@@ -258,6 +263,10 @@ std::string RegressSummary::FullReport() const {
     switch (e.outcome) {
       case RegressOutcome::kFailed:
         s << head << "FAILED (not compared, nothing stored): " << e.error << "\n";
+        continue;
+      case RegressOutcome::kOutsideValidity:
+        s << head << "NOT APPLICABLE, the scene leaves the law's validity box (not compared, "
+          << "nothing stored): " << e.error << "\n";
         continue;
       case RegressOutcome::kBaselineRegistered:
         s << head << "baseline registered (result #" << e.result_id << ": U_mf "
@@ -428,7 +437,8 @@ RegressSummary run_regression(Database& db, const RegressOptions& options,
       try {
         result = run_scene(db, *p.scene, p.record, options.dpm, &e.warnings, on_progress);
       } catch (const Error& error) {
-        e.outcome = RegressOutcome::kFailed;
+        e.outcome = error.code() == ErrorCode::kOutOfValidity ? RegressOutcome::kOutsideValidity
+                                                              : RegressOutcome::kFailed;
         e.error = error.what();
         e.wall_s = seconds_since(run_start);
         ++summary.runs;

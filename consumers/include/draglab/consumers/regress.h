@@ -60,13 +60,16 @@ std::vector<MetricComparison> compare_metrics(const ConsumerMetrics& baseline,
                                               const RegressionTolerances& tolerances);
 
 enum class RegressOutcome {
-  kOk,                  ///< Every metric within its tolerance.
-  kMoved,               ///< At least one metric moved beyond its tolerance.
-  kFailed,              ///< The run failed (RegressEntry::error); nothing stored.
+  kOk,      ///< Every metric within its tolerance.
+  kMoved,   ///< At least one metric moved beyond its tolerance.
+  kFailed,  ///< The run failed (RegressEntry::error); nothing stored.
+  /// The scene leaves the law's validity box (RegressEntry::error says where): the law cannot
+  /// be used there, so there is nothing to compare; nothing stored. Not a move.
+  kOutsideValidity,
   kBaselineRegistered,  ///< Single-law mode: no baseline existed; this result is it now.
   kNoBaseline,          ///< Single-law mode, draft or retracted version without a baseline.
 };
-/// "ok", "moved", "failed", "baseline_registered", "no_baseline".
+/// "ok", "moved", "failed", "outside_validity", "baseline_registered", "no_baseline".
 const char* to_string(RegressOutcome outcome);
 
 /// One (scene, law version) of a regression check.
