@@ -217,6 +217,8 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
                         {"bed_height_m", smp.bed_height_m},
                         {"pressure_drop_pa", smp.pressure_drop_pa}});
     }
+    const double cell_size_m = std::max(scene.geometry.width_m / scene.grid.cells_x,
+                                        scene.geometry.height_m / scene.grid.cells_y);
     ctx.print_json(
         {{"scene", r.scene},
          {"scene_hash", r.scene_hash},
@@ -245,10 +247,14 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
          {"momentum_mismatch", r.momentum_mismatch},
          {"void_fraction_clamps", r.void_fraction_clamps},
          {"drag_out_of_range", r.law_out_of_range},
-         {"numerical_uncertainty", nullptr},
-         {"numerical_uncertainty_reason",
-          "one grid and one packing realization run; the uncertainty needs two grids or two "
-          "realizations (draglab sensitivity)"}});
+         // One run: the bound of the bubble boundary on the grid, one gas cell (the larger
+         // side). The packing-realization spread adds in quadrature; `draglab sensitivity`
+         // measures it (0-0.5 mm on the quick scene, 5 mm cells: the cell dominates).
+         {"numerical_uncertainty",
+          r.bubble_at_t_ref ? nlohmann::json(cell_size_m) : nlohmann::json(nullptr)},
+         {"numerical_uncertainty_method",
+          "one gas cell on the bubble boundary (the larger cell side); the packing-realization "
+          "spread is not included: draglab sensitivity adds it in quadrature"}});
     return;
   }
   std::cout << r.BriefReport() << "\n";

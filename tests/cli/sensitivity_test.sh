@@ -180,6 +180,12 @@ assert run["seed"] == 6
 expected = r["bubble_diameter_m"] if r["bubble_diameter_m"] is not None else 0.0
 assert run["bubble_diameter_m"] == expected, (run["bubble_diameter_m"], expected)
 assert run["gas_steps"] == r["gas_steps"] and run["dem_steps"] == r["dem_steps"], (run, r)
+# One run: its uncertainty is the boundary bound, one cell, the same h the sensitivity uses.
+if r["bubble_diameter_m"] is not None:
+    assert r["numerical_uncertainty"] == run["cell_size_m"], (r["numerical_uncertainty"], run)
+else:
+    assert r["numerical_uncertainty"] is None, r
+assert "sensitivity" in r["numerical_uncertainty_method"], r
 '
 
 # `scene run` stores its result (scene text, law content hash, metrics) unless --no-store.
