@@ -98,8 +98,8 @@ void render(const CliContext& ctx, const std::string& bundle, const std::string&
         python, find_script(kFigureScript), bundle, out_dir, bundle));
   }
   std::remove(figure.c_str());  // so a stale figure is never taken for a new one
-  const std::string command = shell_quote(python) + " " + shell_quote(find_script(kFigureScript)) + " " +
-                              shell_quote(bundle) + " " + shell_quote(out_dir) +
+  const std::string command = shell_quote(python) + " " + shell_quote(find_script(kFigureScript)) +
+                              " " + shell_quote(bundle) + " " + shell_quote(out_dir) +
                               (ctx.quiet ? " --quiet" : "") + " 1>&2";
   const int status = std::system(command.c_str());
   if (status != 0 || !file_exists(figure)) {
@@ -159,6 +159,15 @@ nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySumm
   for (const auto& lr : s.laws) {
     nlohmann::json runs = nlohmann::json::array();
     for (const auto& r : lr.runs) {
+      // Column arrays: a few hundred samples per run stay readable and small.
+      nlohmann::json t = nlohmann::json::array(), d = nlohmann::json::array(),
+                     centroid = nlohmann::json::array(), bed = nlohmann::json::array();
+      for (const consumers::DpmSample& smp : r.series) {
+        t.push_back(smp.t_s);
+        d.push_back(smp.bubble_diameter_m);
+        centroid.push_back(smp.bubble_centroid_m);
+        bed.push_back(smp.bed_height_m);
+      }
       runs.push_back({{"seed", r.seed},
                       {"cells_x", r.cells_x},
                       {"cells_y", r.cells_y},
@@ -175,7 +184,12 @@ nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySumm
                       {"momentum_mismatch", r.momentum_mismatch},
                       {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
                       {"void_fraction_clamps", r.void_fraction_clamps},
-                      {"drag_out_of_range", r.drag_out_of_range}});
+                      {"drag_out_of_range", r.drag_out_of_range},
+                      {"series",
+                       {{"t_s", t},
+                        {"bubble_diameter_m", d},
+                        {"bubble_centroid_m", centroid},
+                        {"bed_height_m", bed}}}});
     }
     nlohmann::json law = {{"law", lr.law},
                           {"umf_m_s", lr.umf_m_s},

@@ -9,7 +9,8 @@ DATA.json is either
     aspect) at t_ref after injection, particles drawn to their diameter and coloured by their
     initial layer in alternating contrasting colours (as the experiment's coloured layers, so
     mixing shows), the eps = threshold contour of the bubble over them, and the title
-    "law@v  D = x.x +- y.y cm";
+    "law@v  D = x.x +- y.y cm"; and OUT_DIR/bubble_series.png, D and the bubble's centroid
+    height against time per law and run, t_ref marked;
   - work_precision.json (format "draglab_work_precision" version 1): writes
     OUT_DIR/work_precision.png, the bubble diameter and its error against wall time.
 Both are described in docs/scenes.md ("Sensitivity and work-precision"). This script only
@@ -160,6 +161,44 @@ def draw_fig4(data, out_dir, quiet):
     log(quiet, "wrote " + path)
 
 
+def draw_bubble_series(data, out_dir, quiet):
+    """OUT_DIR/bubble_series.png: D and the bubble's centroid height against time after
+    injection, one colour per law, one line style per packing realization (or grid), t_ref
+    marked. Shows whether the snapshot falls while the bubble grows, holds or rains out. Data
+    without time series (older files) draw nothing."""
+    laws = data["laws"]
+    if not laws or not all(r.get("series") for law in laws for r in law["runs"]):
+        return
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    styles = ("-", "--", ":", "-.")
+    for i, law in enumerate(laws):
+        for k, run in enumerate(law["runs"]):
+            series = run["series"]
+            t = np.asarray(series["t_s"], dtype=float)
+            keep = t >= 0.0
+            label = "%s (seed %d, %dx%d)" % (law["law"], run["seed"], run["cells_x"], run["cells_y"])
+            style = dict(color=colours[i % len(colours)], ls=styles[k % len(styles)], lw=1.4)
+            left.plot(t[keep], 100 * np.asarray(series["bubble_diameter_m"])[keep], label=label,
+                      **style)
+            centroid = 100 * np.asarray(series["bubble_centroid_m"], dtype=float)[keep]
+            right.plot(t[keep], np.where(centroid > 0, centroid, np.nan), **style)
+    for ax in (left, right):
+        ax.axvline(data["t_ref_s"], color="0.4", ls="--", lw=1)
+        ax.set_xlabel("time after injection [s]")
+        ax.grid(alpha=0.3)
+    left.set_ylabel("bubble diameter D [cm]")
+    right.set_ylabel("bubble centroid height [cm]")
+    left.legend(fontsize=7, loc="lower center")
+    fig.suptitle("%s: the bubble against time (dashed: t_ref = %g s)" % (
+        data["scene"], data["t_ref_s"]), fontsize=10)
+    fig.tight_layout()
+    path = os.path.join(out_dir, "bubble_series.png")
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    log(quiet, "wrote " + path)
+
+
 def draw_work_precision(data, out_dir, quiet):
     rows = data["rows"]
     if not rows:
@@ -220,6 +259,7 @@ def main(argv):
     os.makedirs(args[1], exist_ok=True)
     if kind == "draglab_sensitivity":
         draw_fig4(data, args[1], quiet)
+        draw_bubble_series(data, args[1], quiet)
     else:
         draw_work_precision(data, args[1], quiet)
     return 0

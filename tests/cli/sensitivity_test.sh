@@ -139,6 +139,14 @@ for law, printed in zip(s["laws"], out["laws"]):
     assert all(r["reached_t_ref"] for r in runs), runs
     assert all(r["wall_s"] > 0 and r["gas_steps"] > 0 and r["dem_steps"] > r["gas_steps"] for r in runs)
     assert all(abs(r["cell_size_m"] - h) < 1e-15 for r in runs), runs
+    # Each run carries its bubble time series; the sample nearest t_ref holds its D.
+    for r in runs:
+        ts = r["series"]
+        t = ts["t_s"]
+        assert len(t) >= 3 and all(b > a for a, b in zip(t, t[1:])), t
+        assert all(len(ts[k]) == len(t) for k in ("bubble_diameter_m", "bubble_centroid_m", "bed_height_m"))
+        i = min(range(len(t)), key=lambda k: abs(t[k] - s["t_ref_s"]))
+        assert ts["bubble_diameter_m"][i] == r["bubble_diameter_m"], (ts["bubble_diameter_m"][i], r)
     n = len(d)
     mean = sum(d) / n
     se = math.sqrt(sum((x - mean) ** 2 for x in d) / (n - 1) / n)
@@ -224,6 +232,7 @@ assert 10e3 <= len(data) <= 5e6, len(data)
 '
 if [ "$have_matplotlib" -eq 1 ]; then
   ok "fig4.png is a plausible PNG" "$py" -c "$png_check" "$work" sens/fig4.png
+  ok "bubble_series.png is a plausible PNG" "$py" -c "$png_check" "$work" sens/bubble_series.png
   ok "stdout names the figure" grep -q '"figure": ".*fig4.png"' "$work/sens_stdout.json"
 else
   echo "note: /usr/bin/python3 has no matplotlib; figures not checked"

@@ -98,6 +98,7 @@ SensitivityRun MakeRun(const DpmResult& r, const Scene& s) {
   run.dem_steps = r.dem_steps;
   run.gas_dt_s = r.gas_dt_s;
   run.dem_dt_s = r.dem_dt_s;
+  run.series = r.series;
   run.momentum_mismatch = r.momentum_mismatch;
   run.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
   run.void_fraction_clamps = r.void_fraction_clamps;

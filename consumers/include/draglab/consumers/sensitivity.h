@@ -98,6 +98,9 @@ struct SensitivityRun {
   double max_relative_mass_imbalance = 0.0;  ///< dpm.h.
   std::int64_t void_fraction_clamps = 0;
   std::uint64_t drag_out_of_range = 0;  ///< Clamped/extrapolated drag evaluations.
+  /// The bubble time series of the run (dpm.h DpmSample): shows whether t_ref falls while the
+  /// bubble grows, holds or rains out.
+  std::vector<DpmSample> series;
 };
 
 /// D with its numerical uncertainty [m] (see the file comment for the two methods).
