@@ -47,6 +47,15 @@ def log(quiet, message):
         sys.stderr.write(message + "\n")
 
 
+def save_figure(fig, out_dir, name, quiet):
+    """Lays out, writes OUT_DIR/NAME at 130 dpi, closes the figure and says so."""
+    fig.tight_layout()
+    path = os.path.join(out_dir, name)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    log(quiet, "wrote " + path)
+
+
 def finite(x):
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
@@ -154,11 +163,7 @@ def draw_fig4(data, out_dir, quiet):
                "\u03b5 = %.2f contour of the bubble; \u00b1 from %s (sensitivity.json)" % (
                    data["scene"], data["t_ref_s"], threshold, data["uncertainty"]["method"]))
     fig.suptitle(textwrap.fill(caption, width=int(16 * fig_w)), fontsize=9)
-    fig.tight_layout()
-    path = os.path.join(out_dir, "fig4.png")
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    log(quiet, "wrote " + path)
+    save_figure(fig, out_dir, "fig4.png", quiet)
 
 
 def draw_bubble_series(data, out_dir, quiet):
@@ -192,11 +197,7 @@ def draw_bubble_series(data, out_dir, quiet):
     left.legend(fontsize=7, loc="lower center")
     fig.suptitle("%s: the bubble against time (dashed: t_ref = %g s)" % (
         data["scene"], data["t_ref_s"]), fontsize=10)
-    fig.tight_layout()
-    path = os.path.join(out_dir, "bubble_series.png")
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    log(quiet, "wrote " + path)
+    save_figure(fig, out_dir, "bubble_series.png", quiet)
 
 
 def draw_work_precision(data, out_dir, quiet):
@@ -236,11 +237,7 @@ def draw_work_precision(data, out_dir, quiet):
     right.tick_params(axis="y", which="minor", labelsize=7)
     fig.suptitle("work-precision of %s on %s (grid/contact steps per point)" % (
         data["law"], data["scene"]), fontsize=10)
-    fig.tight_layout()
-    path = os.path.join(out_dir, "work_precision.png")
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    log(quiet, "wrote " + path)
+    save_figure(fig, out_dir, "work_precision.png", quiet)
 
 
 def main(argv):
