@@ -33,6 +33,8 @@
 #include "bench_util.h"
 #include "draglab/consumers/dem.h"
 
+using draglab::bench::OptionInteger;
+using draglab::bench::OptionValue;
 using draglab::bench::ParseNumber;
 using draglab::bench::ParseThreadList;
 using draglab::consumers::DemOptions;
@@ -57,15 +59,8 @@ int main(int argc, char** argv) {
   try {
     for (int a = 1; a < argc; ++a) {
       const std::string arg = argv[a];
-      auto value = [&]() -> const char* {
-        if (a + 1 >= argc) throw std::invalid_argument(arg + ": missing value");
-        return argv[++a];
-      };
-      auto integer = [&]() {
-        const double v = ParseNumber(arg, value());
-        if (v != static_cast<int>(v)) throw std::invalid_argument(arg + ": not an integer");
-        return static_cast<int>(v);
-      };
+      auto value = [&] { return OptionValue(argc, argv, &a); };
+      auto integer = [&] { return OptionInteger(argc, argv, &a); };
       if (arg == "--n") {
         n = integer();
         n_given = true;

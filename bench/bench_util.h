@@ -27,6 +27,22 @@ inline double ParseNumber(const std::string& option, const char* text) {
   return v;
 }
 
+/// The value of the option argv[*index] (the next argument); advances *index past it. Throws
+/// std::invalid_argument naming the option when it is the last argument.
+inline const char* OptionValue(int argc, char** argv, int* index) {
+  const std::string option = argv[*index];
+  if (*index + 1 >= argc) throw std::invalid_argument(option + ": missing value");
+  return argv[++*index];
+}
+
+/// OptionValue as an integer; throws std::invalid_argument naming the option otherwise.
+inline int OptionInteger(int argc, char** argv, int* index) {
+  const std::string option = argv[*index];
+  const double v = ParseNumber(option, OptionValue(argc, argv, index));
+  if (v != static_cast<int>(v)) throw std::invalid_argument(option + ": not an integer");
+  return static_cast<int>(v);
+}
+
 /// "1,2" -> {1, 2}: OpenMP thread counts, each an integer in [1, 256].
 inline std::vector<int> ParseThreadList(const char* text) {
   std::vector<int> out;
