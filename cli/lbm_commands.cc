@@ -52,6 +52,7 @@ struct SolverOptions {
   std::int64_t max_steps = 200000;
   double tolerance = 1e-6;
   int threads = 0;
+  double min_gap_nodes = 0.0;  // opt-in gap check; 0 = run sub-node gaps and report them
 };
 
 struct RunCommand {
@@ -108,10 +109,12 @@ Case load_case(const CaseOptions& o) {
   const arrays::Lattice lattice = arrays::lattice_from_string(o.array);
   const double max_phi = arrays::close_packing_phi(lattice);
   if (std::isnan(o.phi)) throw UsageError("--phi is required with --array");
-  if (!std::isfinite(o.phi) || o.phi <= 0.0 || o.phi >= max_phi) {
+  // Close packing (touching spheres, Zick & Homsy's densest case) is allowed: the contacts are
+  // sub-node gaps, run and reported like those of random packings.
+  if (!std::isfinite(o.phi) || o.phi <= 0.0 || o.phi > max_phi * (1.0 + 1e-12)) {
     throw UsageError(fmt::format(
-        "--phi = {} is outside (0, {:.6f}) for --array {} (below close packing: touching spheres "
-        "leave no gap to resolve)",
+        "--phi = {} is outside (0, {:.6f}] for --array {} (the upper end is close packing: "
+        "touching spheres)",
         o.phi, max_phi, o.array));
   }
   if (o.cells < 1 || o.cells > 16) throw UsageError("--cells must lie in [1, 16]");
@@ -139,19 +142,18 @@ void check_resolution(const arrays::Packing& p, double d, const std::string& fie
     throw UsageError(fmt::format("{} = {} is outside [{}, {}] lattice units per diameter", field, d,
                                  kMinResolution, kMaxResolution));
   }
-  const double gap = arrays::min_gap_lattice_units(p, d);
-  if (gap < run.min_gap_nodes) {
-    if (gap <= 0.0) {
+  if (run.min_gap_nodes > 0.0) {
+    const double gap = arrays::min_gap_lattice_units(p, d);
+    if (gap < run.min_gap_nodes) {
       throw UsageError(fmt::format(
-          "{} = {}: spheres touch or overlap (smallest gap {:.3g} lattice units): no resolution "
-          "resolves the gap; lower --phi",
-          field, d, gap));
+          "{} = {}: the smallest gap between spheres spans {:.3g} lattice units, below "
+          "--min-gap-nodes = {}{}; drop --min-gap-nodes to run the under-resolved gaps (they are "
+          "reported, and a d sweep estimates their error)",
+          field, d, gap, run.min_gap_nodes,
+          gap > 0.0 ? fmt::format(" (use {} >= {:.2f})", field,
+                                  std::ceil(d * run.min_gap_nodes / gap * 100.0) / 100.0)
+                    : std::string(" (the spheres touch or overlap)")));
     }
-    const double needed = d * run.min_gap_nodes / gap;
-    throw UsageError(fmt::format(
-        "{} = {} is too low for the gaps: the smallest gap between spheres spans {:.3g} lattice "
-        "units (at least {} needed); use {} >= {}",
-        field, d, gap, run.min_gap_nodes, field, std::ceil(needed * 100.0) / 100.0));
   }
   // Populations (19 per node) plus flags, links and fields: generous per-node budget.
   const double bytes_per_node = precision == "float" ? 110.0 : 200.0;
@@ -181,6 +183,11 @@ lbm::RunOptions run_options(const SolverOptions& s) {
   r.max_steps = s.max_steps;
   r.tolerance = s.tolerance;
   r.threads = s.threads;
+  r.min_gap_nodes = s.min_gap_nodes;
+  if (!std::isfinite(s.min_gap_nodes) || s.min_gap_nodes < 0.0 || s.min_gap_nodes > 100.0) {
+    throw UsageError(
+        fmt::format("--min-gap-nodes = {} is outside [0, 100] (0 = no check)", s.min_gap_nodes));
+  }
   if (s.max_steps < 1) throw UsageError("--max-steps must be >= 1");
   if (s.threads < 0) throw UsageError("--threads must be >= 0 (0 = all)");
   std::string error;
@@ -232,7 +239,13 @@ nlohmann::json run_json(const lbm::RunResult& r, const lbm::RunOptions& o, doubl
                       {"superficial_velocity", r.superficial_velocity},
                       {"collision", lbm::to_string(o.collision)},
                       {"boundary", lbm::to_string(o.boundary)},
-                      {"precision", lbm::to_string(o.precision)}};
+                      {"precision", lbm::to_string(o.precision)},
+                      {"narrow_gap_pairs", r.narrow_gap_pairs},
+                      {"min_gap_nodes", number_or_null(r.min_gap_nodes)},
+                      {"narrow_gap_fluid_fraction", r.narrow_gap_fluid_fraction},
+                      {"fallback_links", r.fallback_links},
+                      {"boundary_links", r.boundary_links},
+                      {"warnings", r.warnings}};
   if (o.collision == lbm::Collision::kTrt) j["magic"] = o.magic;
   j["d_hydrodynamic"] = o.use_hydrodynamic_diameter ? nlohmann::json(o.hydrodynamic_diameter)
                                                     : nlohmann::json(nullptr);
@@ -366,6 +379,12 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
       std::cout << fmt::format("momentum balance {:.2g} relative\n", r.momentum_balance_rel);
     }
     std::cout << fmt::format("Mach max         {:.3g}\n", r.mach_max);
+    if (r.narrow_gap_pairs > 0 || r.narrow_gap_fluid_fraction > 0.0) {
+      std::cout << fmt::format(
+          "sub-node gaps    {} sphere pairs closer than one node (smallest {:.3g}), {:.2f} % of "
+          "fluid nodes in one-node gaps\n",
+          r.narrow_gap_pairs, r.min_gap_nodes, 100.0 * r.narrow_gap_fluid_fraction);
+    }
     std::cout << fmt::format("run              {}, {} steps, {:.2f} s, {:.1f} MFLUPS\n",
                              r.converged ? "converged" : "NOT CONVERGED", r.steps, r.wall_s,
                              r.mflups);
@@ -374,6 +393,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
                                lbm::xdmf_path_for(c.fields));
     }
   }
+  for (const std::string& w : r.warnings) ctx.info("warning: " + w);
   if (!r.converged) {
     throw std::runtime_error("the run did not converge: " + r.diagnosis +
                              " (no drag value reported)");
@@ -405,9 +425,9 @@ void run_bench(const CliContext& ctx, const BenchCommand& b) {
       "phi = 0.4 packing {:.1f} MFLUPS (fluid nodes), {:.2f} x all-fluid "
       "(goal >= 0.8)\n",
       r.mflups_fluid_packing, r.mflups > 0 ? r.mflups_fluid_packing / r.mflups : 0.0);
-  std::cout << fmt::format(
-      "  same, halfway bounce-back {:.1f} MFLUPS, {:.2f} x all-fluid\n", r.mflups_fluid_packing_bb,
-      r.mflups > 0 ? r.mflups_fluid_packing_bb / r.mflups : 0.0);
+  std::cout << fmt::format("  same, halfway bounce-back {:.1f} MFLUPS, {:.2f} x all-fluid\n",
+                           r.mflups_fluid_packing_bb,
+                           r.mflups > 0 ? r.mflups_fluid_packing_bb / r.mflups : 0.0);
   std::cout << fmt::format("bandwidth         {:.1f} GB/s (in-place update kernel)\n",
                            r.bandwidth_gbs);
   std::cout << fmt::format(
@@ -668,7 +688,7 @@ void add_case_options(CLI::App* cmd, CaseOptions* o) {
   cmd->add_option("--packing", o->packing_file, "Packing HDF5 file (draglab pack)");
   cmd->add_option("--array", o->array, "Ordered array instead: sc, bcc or fcc")
       ->check(CLI::IsMember({"sc", "bcc", "fcc"}));
-  cmd->add_option("--phi", o->phi, "Solids fraction of the array, (0, close packing)");
+  cmd->add_option("--phi", o->phi, "Solids fraction of the array, (0, close packing]");
   cmd->add_option("--cells", o->cells, "Unit cells per box edge of the array, [1, 16]")
       ->capture_default_str();
 }
@@ -701,6 +721,10 @@ void add_solver_options(CLI::App* cmd, SolverOptions* s, bool with_re) {
                   "Relative drag change per characteristic time at convergence")
       ->capture_default_str();
   cmd->add_option("--threads", s->threads, "OpenMP threads (0 = all)")->capture_default_str();
+  cmd->add_option("--min-gap-nodes", s->min_gap_nodes,
+                  "Refuse packings whose smallest sphere gap spans fewer lattice units (0 = off: "
+                  "sub-node gaps are run and reported)")
+      ->capture_default_str();
 }
 
 }  // namespace
@@ -742,6 +766,7 @@ void add_lbm_commands(CLI::App& app, CliContext& ctx) {
       "  draglab lbm run --array sc --phi 0.125 --d 16 --re 0 --json\n"
       "  draglab lbm run --packing p.h5 --d 20 --re 50 --collision trt --boundary ibb\n"
       "  draglab lbm run --array fcc --phi 0.5 --d 24 --re 100 --collision rr\n"
+      "  draglab lbm run --array sc --phi 0.5235987755982988 --d 24 --re 0   # touching\n"
       "  draglab lbm run --array sc --phi 0.2 --d 12 --re 0 --boundary bb --calibrate\n"
       "  draglab lbm run --array sc --phi 0.1 --d 16 --re 0 --fields flow.h5");
   run->callback([&ctx, rc] { ctx.action = [&ctx, rc] { run_lbm(ctx, *rc); }; });

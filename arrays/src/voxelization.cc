@@ -26,6 +26,7 @@
 #include <utility>
 #include <vector>
 
+#include "cell_list.h"
 #include "draglab/drag_db/error.h"
 
 #if defined(_OPENMP)
@@ -289,6 +290,116 @@ double wall_fraction(double wx, double wy, double wz, const std::array<int, 3>& 
   if (!(t >= kMinLinkFraction)) t = kMinLinkFraction;
   if (t > 1.0) t = 1.0;
   return t;
+}
+
+/// An image of a sphere whose surface comes within one link of another sphere's surface: its
+/// index, its centre relative to that sphere's centre and its squared radius (lattice units).
+struct NearSphere {
+  std::int64_t index;
+  double ox, oy, oz;
+  double radius_squared;
+};
+
+/// For each sphere, the images of the spheres (its own other images included) whose surface gap
+/// to it is below one D3Q19 link (sqrt 2 lattice spacings): the only surfaces a boundary link of
+/// that sphere can cross before its own. Fills the pair part of `gaps`.
+std::vector<std::vector<NearSphere>> near_spheres(const Packing& packing, const LatticeShape& shape,
+                                                  GapSummary* gaps) {
+  const std::size_t n = packing.size();
+  std::vector<std::vector<NearSphere>> near(n);
+  gaps->narrow_pairs = 0;
+  gaps->min_gap_nodes = std::numeric_limits<double>::infinity();
+  if (n == 0) return near;
+  const double link = std::sqrt(2.0) * shape.dx * (1.0 + 1e-9);
+  const double largest_radius = *std::max_element(packing.radii.begin(), packing.radii.end());
+  std::vector<Vec3> centers(n);
+  for (std::size_t s = 0; s < n; ++s) {
+    for (int a = 0; a < 3; ++a) {
+      centers[s][a] = internal::wrap_into_box(packing.centers[s][a], packing.box_length[a]);
+    }
+  }
+  internal::PeriodicCellList cells(packing.box_length, 2.0 * largest_radius + link, n);
+  cells.Build(centers);
+  for (std::size_t s = 0; s < n; ++s) {
+    const double reach = packing.radii[s] + largest_radius + link;
+    cells.ForEachNear(centers[s], reach, [&](int j, const Vec3& shift) {
+      const bool self = static_cast<std::size_t>(j) == s;
+      if (self && shift[0] == 0.0 && shift[1] == 0.0 && shift[2] == 0.0) return;
+      Vec3 offset;
+      double distance2 = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        offset[a] = centers[static_cast<std::size_t>(j)][a] + shift[a] - centers[s][a];
+        distance2 += offset[a] * offset[a];
+      }
+      const double rj = packing.radii[static_cast<std::size_t>(j)];
+      const double gap = std::sqrt(distance2) - packing.radii[s] - rj;
+      if (!(gap < link)) return;
+      near[s].push_back({j, offset[0] / shape.dx, offset[1] / shape.dx, offset[2] / shape.dx,
+                         (rj / shape.dx) * (rj / shape.dx)});
+      // Each unordered pair of images once: from its lower index, or (own images) from the
+      // image whose shift is lexicographically positive.
+      const bool first =
+          self ? (shift[0] != 0.0 ? shift[0] > 0.0
+                                  : (shift[1] != 0.0 ? shift[1] > 0.0 : shift[2] > 0.0))
+               : static_cast<std::size_t>(j) > s;
+      if (first) {
+        gaps->min_gap_nodes = std::min(gaps->min_gap_nodes, gap / shape.dx);
+        if (gap < shape.dx) ++gaps->narrow_pairs;
+      }
+    });
+  }
+  return near;
+}
+
+/// Where a link from a fluid node at w (relative to the owner's centre, lattice units) along c
+/// first enters one of the near spheres, if before `best` (the owner's wall fraction): updates
+/// best and the sphere that owns the link. Same root formula as wall_fraction.
+void first_crossing(double wx, double wy, double wz, const std::array<int, 3>& c,
+                    const std::vector<NearSphere>& near, double* best, std::int64_t* owner) {
+  const double a = static_cast<double>(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+  for (const NearSphere& other : near) {
+    const double x = wx - other.ox, y = wy - other.oy, z = wz - other.oz;
+    const double b = x * c[0] + y * c[1] + z * c[2];
+    if (!(b < 0.0)) continue;  // moving away from that centre: no entry ahead
+    const double g = (x * x + y * y + z * z) - other.radius_squared;
+    const double discriminant = b * b - a * g;
+    if (!(discriminant >= 0.0)) continue;  // the line misses it
+    double t = g > 0.0 ? g / (std::sqrt(discriminant) - b) : 0.0;
+    if (!(t >= kMinLinkFraction)) t = kMinLinkFraction;
+    if (t < *best) {
+      *best = t;
+      *owner = other.index;
+    }
+  }
+}
+
+/// Fluid nodes with solid nodes on both sides along some D3Q19 direction.
+std::int64_t count_narrow_fluid_nodes(const VoxelGrid& grid, std::int64_t* fluid) {
+  const std::int64_t nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
+  std::int64_t narrow = 0, fluid_count = 0;
+  const std::uint8_t* solid = grid.solid.data();
+#pragma omp parallel for reduction(+ : narrow, fluid_count) if (grid.num_nodes() > kParallelMinNodes)
+  for (std::int64_t k = 0; k < nz; ++k) {
+    for (std::int64_t j = 0; j < ny; ++j) {
+      for (std::int64_t i = 0; i < nx; ++i) {
+        if (solid[i + nx * (j + ny * k)]) continue;
+        ++fluid_count;
+        for (int q = 1; q < kD3Q19; q += 2) {
+          const auto& c = kD3Q19Velocities[q];
+          const std::int64_t f =
+              wrap(i + c[0], nx) + nx * (wrap(j + c[1], ny) + ny * wrap(k + c[2], nz));
+          const std::int64_t b =
+              wrap(i - c[0], nx) + nx * (wrap(j - c[1], ny) + ny * wrap(k - c[2], nz));
+          if (solid[f] && solid[b]) {
+            ++narrow;
+            break;
+          }
+        }
+      }
+    }
+  }
+  *fluid = fluid_count;
+  return narrow;
 }
 
 /// Links ordered by fluid node, then direction: one integer comparison (nodes < 2^40), and a
@@ -591,7 +702,16 @@ VoxelGrid voxelize(const Packing& packing, const VoxelizationOptions& options,
   // Pass 2: links. Shared nodes are set aside with the spheres that contain them.
   const bool has_shared = any_shared.load();
   std::vector<std::vector<std::int64_t>> shared_nodes(has_shared ? packing.size() : 0);
-  std::vector<std::vector<std::pair<std::int64_t, BoundaryLink>>> shared_links(shared_nodes.size());
+  // A link kept aside: of a shared solid node (kept only by that node's owner), or one whose
+  // first surface crossing is another sphere's (`target`).
+  struct AsideLink {
+    std::int64_t solid_node;
+    std::int64_t target;
+    BoundaryLink link;
+  };
+  std::vector<std::vector<AsideLink>> shared_links(shared_nodes.size());
+  std::vector<std::vector<AsideLink>> foreign_links(packing.size());
+  const std::vector<std::vector<NearSphere>> near = near_spheres(packing, shape, &grid.gaps);
   {
     ThrottledProgress throttle(progress, "voxelize: boundary links");
     const std::int64_t nx = shape.n[0], ny = shape.n[1], nz = shape.n[2];
@@ -620,10 +740,14 @@ VoxelGrid voxelize(const Packing& packing, const VoxelizationOptions& options,
           BoundaryLink link;
           link.fluid_node = static_cast<std::uint64_t>(x_index);
           link.direction = static_cast<std::uint8_t>(q);
-          link.q = wall_fraction(node.wx - c[0], node.wy - c[1], node.wz - c[2], c,
-                                 sphere.radius_squared);
+          const double fx = node.wx - c[0], fy = node.wy - c[1], fz = node.wz - c[2];
+          link.q = wall_fraction(fx, fy, fz, c, sphere.radius_squared);
+          std::int64_t target = s;
+          if (!near[s].empty()) first_crossing(fx, fy, fz, c, near[s], &link.q, &target);
           if (shared) {
-            shared_links[s].emplace_back(node.index, link);
+            shared_links[s].push_back({node.index, target, link});
+          } else if (target != s) {
+            foreign_links[s].push_back({node.index, target, link});
           } else {
             pending.push_back({link,
                                static_cast<std::uint32_t>(rank_k(xk) * rank_j.size() + rank_j(xj)),
@@ -636,30 +760,41 @@ VoxelGrid voxelize(const Packing& packing, const VoxelizationOptions& options,
     });
   }
 
+  // Links whose wall is on another sphere, and links of shared nodes kept by their owner (the
+  // lowest-index sphere that contains the node), move to the sphere they belong to.
+  std::vector<char> touched(packing.size(), 0);
+  for (std::int64_t s = 0; s < num_spheres; ++s) {
+    for (const AsideLink& aside : foreign_links[s]) {
+      grid.links[aside.target].push_back(aside.link);
+      touched[aside.target] = 1;
+    }
+  }
   if (has_shared) {
-    // A shared node belongs to the lowest-index sphere that contains it.
     std::vector<std::pair<std::int64_t, std::int64_t>> node_owner;  // (node, sphere)
     for (std::int64_t s = 0; s < num_spheres; ++s) {
       for (std::int64_t node : shared_nodes[s]) node_owner.emplace_back(node, s);
     }
     std::sort(node_owner.begin(), node_owner.end());
     for (std::int64_t s = 0; s < num_spheres; ++s) {
-      if (shared_links[s].empty()) continue;
-      auto& sphere_links = grid.links[s];
-      for (const auto& [node, link] : shared_links[s]) {
+      for (const AsideLink& aside : shared_links[s]) {
         const auto owner = std::lower_bound(node_owner.begin(), node_owner.end(),
-                                            std::make_pair(node, std::int64_t{-1}));
-        if (owner != node_owner.end() && owner->first == node && owner->second == s) {
-          sphere_links.push_back(link);
+                                            std::make_pair(aside.solid_node, std::int64_t{-1}));
+        if (owner != node_owner.end() && owner->first == aside.solid_node && owner->second == s) {
+          grid.links[aside.target].push_back(aside.link);
+          touched[aside.target] = 1;
         }
       }
-      std::sort(sphere_links.begin(), sphere_links.end(), LinkOrder());
-      sphere_links.shrink_to_fit();
     }
     const std::int64_t num_nodes = grid.num_nodes();
 #pragma omp parallel for if (num_nodes > kParallelMinNodes)
     for (std::int64_t p = 0; p < num_nodes; ++p) flags[p] &= kSolidBit;
   }
+  for (std::size_t s = 0; s < packing.size(); ++s) {
+    if (!touched[s]) continue;
+    std::sort(grid.links[s].begin(), grid.links[s].end(), LinkOrder());
+    grid.links[s].shrink_to_fit();
+  }
+  grid.gaps.narrow_fluid_nodes = count_narrow_fluid_nodes(grid, &grid.gaps.fluid_nodes);
   return grid;
 }
 

@@ -39,7 +39,6 @@ Extrapolation extrapolate_inverse_d(const std::vector<double>& d, const std::vec
 /// Re and resolution of a realization sees the same geometry.
 std::uint64_t packing_seed(std::uint64_t spec_seed, int phi_index, int realization);
 
-
 /// SHA-256 of the packing's box, centres and diameters written as %.17g.
 std::string packing_hash(const arrays::Packing& packing);
 
@@ -47,20 +46,15 @@ std::string packing_hash(const arrays::Packing& packing);
 arrays::RandomPackingOptions packing_options(const CampaignSpec& spec, double phi,
                                              std::uint64_t seed);
 
-/// Default minimum gap in lattice units at the coarsest resolution: the engine needs >= 1 node
-/// across every gap; 20 % margin covers the voxelizer's rounding of the box to whole nodes (the
-/// realised d differs from the requested one by <= 0.5 / nodes per edge, ~2 % for 16 spheres at
-/// d = 10). A larger gap would push the padded solids fraction of dense packings towards jamming.
-constexpr double kDefaultGapNodes = 1.2;
-
 /// Largest solids fraction of the spheres padded by min_gap/2 accepted in a spec: the packing
 /// generator's "safe" limit for monodisperse spheres (arrays: they jam near 0.64). Close to it
 /// a small box can still jam (measured: phi = 0.4 with gap 0.15, padded 0.608, 16 spheres jammed
 /// in both attempts); such units fail with the generator's diagnosis. Keep padded <= ~0.58.
 constexpr double kMaxPaddedPhi = 0.62;
 
-/// The minimum surface gap (in d) the packings of `spec` use: spec.min_gap, or kDefaultGapNodes
-/// lattice units at the coarsest resolution when it is 0.
+/// The minimum surface gap (in d) the packings of `spec` use: spec.min_gap. The default 0 packs
+/// the equilibrium hard-sphere structure (as the seed's LB studies did), with near contacts that
+/// the engine runs as sub-node gaps; a forced gap changes the structure and raises F (docs).
 double effective_min_gap(const CampaignSpec& spec);
 
 /// The spec stored as CampaignSpec::to_json() text.

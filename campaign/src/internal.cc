@@ -130,11 +130,7 @@ std::string packing_hash(const arrays::Packing& packing) {
   return draglab::sha256_hex(text);
 }
 
-double effective_min_gap(const CampaignSpec& spec) {
-  if (spec.min_gap > 0.0 || spec.resolutions.empty()) return spec.min_gap;
-  const double coarsest = *std::min_element(spec.resolutions.begin(), spec.resolutions.end());
-  return coarsest > 0.0 ? kDefaultGapNodes / coarsest : 0.0;
-}
+double effective_min_gap(const CampaignSpec& spec) { return spec.min_gap; }
 
 arrays::RandomPackingOptions packing_options(const CampaignSpec& spec, double phi,
                                              std::uint64_t seed) {

@@ -168,8 +168,7 @@ bool CampaignSpec::IsValid(std::string* error) const {
   }
   if (!(min_gap >= 0.0 && min_gap <= 0.5)) {
     return fail(error, "[packing] min_gap = " + fmt(min_gap) +
-                           " is outside [0, 0.5] diameters (0 = 1.2 lattice units at the coarsest "
-                           "resolution)");
+                           " is outside [0, 0.5] diameters (0 = no forced gap)");
   }
   if (!check_list(resolutions, "[lbm] resolutions", kMinResolution, kMaxResolution,
                   "lattice units per diameter", error)) {
@@ -197,22 +196,19 @@ bool CampaignSpec::IsValid(std::string* error) const {
                            "' needs at least 2 [lbm] resolutions (3 for the measured order of "
                            "richardson); with one resolution use extrapolation = \"finest\"");
   }
-  // The padded spheres must be packable, and (default gap) every gap must span >= 1 node.
+  // The padded spheres must be packable.
   const double gap = internal::effective_min_gap(*this);
   for (double p : phi) {
     if (distribution == "mono") {
       const double padded = p * std::pow(1.0 + gap, 3);
       if (padded > internal::kMaxPaddedPhi) {
         const double max_gap = std::cbrt(internal::kMaxPaddedPhi / p) - 1.0;
-        return fail(
-            error,
-            "[grid] phi = " + fmt(p) + " with a minimum gap of " + fmt(gap) +
-                " diameters pads the spheres to a solids fraction " + fmt(padded) + " above " +
-                fmt(internal::kMaxPaddedPhi) +
-                " (random packings of padded spheres jam); the gap must be <= " + fmt(max_gap) +
-                (min_gap == 0.0 ? " diameters, i.e. the coarsest [lbm] resolution >= " +
-                                      fmt(std::ceil(internal::kDefaultGapNodes / max_gap))
-                                : " diameters ([packing] min_gap)"));
+        return fail(error,
+                    "[grid] phi = " + fmt(p) + " with a minimum gap of " + fmt(gap) +
+                        " diameters pads the spheres to a solids fraction " + fmt(padded) +
+                        " above " + fmt(internal::kMaxPaddedPhi) +
+                        " (random packings of padded spheres jam); [packing] min_gap must be <= " +
+                        fmt(max_gap) + " diameters (0, the default, packs without a forced gap)");
       }
       if (box_size == 0.0) {
         const double edge = std::cbrt(spheres * M_PI / (6.0 * p));

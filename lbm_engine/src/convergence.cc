@@ -253,6 +253,7 @@ ConvergenceResult run_convergence(const ConvergenceOptions& options,
   resolutions.erase(std::unique(resolutions.begin(), resolutions.end()), resolutions.end());
   // Refuse resolutions that do not resolve the gaps before spending any time.
   for (double d : resolutions) {
+    if (!(options.run.min_gap_nodes > 0.0)) break;  // opt-in check
     const double gap = arrays::min_gap_lattice_units(options.packing, d);
     if (gap < options.run.min_gap_nodes) {
       throw Error(ErrorCode::kInvalidArgument,

@@ -161,6 +161,9 @@ std::string RunResult::FullReport() const {
       << "Mach (max)           " << format("%.4g", mach_max) << "\n"
       << "momentum balance     " << format("%.3g", momentum_balance_rel) << " (relative)\n"
       << "mass change          " << format("%.3g", mass_change_rel) << " (relative)\n"
+      << "sub-node gaps        " << narrow_gap_pairs << " sphere pairs below one node (smallest "
+      << format("%.3g", min_gap_nodes) << "), " << format("%.3g", 100.0 * narrow_gap_fluid_fraction)
+      << " % of fluid nodes in one-node gaps\n"
       << "fluid nodes / links  " << fluid_nodes << " / " << boundary_links << " (" << fallback_links
       << " interpolation fallbacks)\n"
       << "steps                " << steps << " (characteristic time " << characteristic_steps

@@ -68,8 +68,8 @@ TEST(CampaignSpec, ParsesEveryField) {
   EXPECT_EQ(s.extrapolation, "richardson");
   std::string error;
   EXPECT_TRUE(s.IsValid(&error)) << error;
-  // Default gap: 1.2 lattice units at the coarsest resolution.
-  EXPECT_DOUBLE_EQ(internal::effective_min_gap(s), 0.12);
+  // Default: no forced gap (the hard-sphere structure; the engine runs sub-node gaps).
+  EXPECT_DOUBLE_EQ(internal::effective_min_gap(s), 0.0);
 }
 
 TEST(CampaignSpec, JsonRoundTripIsCanonical) {
@@ -155,12 +155,22 @@ TEST(CampaignSpec, OtherRangesAndTypes) {
             std::string::npos);
 }
 
-TEST(CampaignSpec, GapThatCannotBeResolvedIsRefusedWithTheRemedy) {
-  // phi = 0.5 with the default gap 1.2/10: padded solids fraction 0.70 > 0.62; the gap may be
-  // at most (0.62/0.5)^(1/3) - 1 = 0.0743, i.e. 1.2 nodes need d >= 16.2.
-  const std::string m = parse_error(edit("phi = [0.1, 0.3]", "phi = [0.1, 0.5]"));
+TEST(CampaignSpec, ForcedGapThatJamsIsRefusedWithTheLimit) {
+  // phi = 0.5 with a forced gap of 0.12 d: padded solids fraction 0.5 * 1.12^3 = 0.70 > 0.62;
+  // the gap may be at most (0.62/0.5)^(1/3) - 1 = 0.0743 d.
+  std::string text = edit("phi = [0.1, 0.3]", "phi = [0.1, 0.5]");
+  text.replace(text.find("spheres = 16"), 12, "spheres = 16\nmin_gap = 0.12");
+  const std::string m = parse_error(text);
   EXPECT_NE(m.find("[grid] phi = 0.5"), std::string::npos) << m;
-  EXPECT_NE(m.find("coarsest [lbm] resolution >= 17"), std::string::npos) << m;
+  EXPECT_NE(m.find("min_gap must be <= 0.0743"), std::string::npos) << m;
+}
+
+TEST(CampaignSpec, DensePhiWithoutAForcedGapIsValid) {
+  // The seed's range: phi up to 0.6 packs without a forced gap (sub-node gaps are run).
+  const CampaignSpec s =
+      parse_campaign_spec_text(edit("phi = [0.1, 0.3]", "phi = [0.5, 0.6]"), "spec.toml");
+  std::string error;
+  EXPECT_TRUE(s.IsValid(&error)) << error;
 }
 
 TEST(CampaignSpec, PresetsParseAndAreFitWorthy) {

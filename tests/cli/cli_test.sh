@@ -144,8 +144,13 @@ grep -q -- "--re" "$work/err" || { echo "FAIL: Re message does not name --re"; f
 check "lbm Re too high" 2 "$draglab" lbm run --array sc --phi 0.1 --d 8 --re 1e5
 check "lbm phi above close packing" 2 "$draglab" lbm run --array sc --phi 0.6 --d 8 --re 0
 grep -q -- "--phi" "$work/err" || { echo "FAIL: phi message does not name --phi"; failures=$((failures + 1)); }
-check "lbm gap too small" 2 "$draglab" lbm run --array sc --phi 0.5 --d 8 --re 0
+check "lbm gap too small (opt-in check)" 2 "$draglab" lbm run --array sc --phi 0.5 --d 8 --re 0 --min-gap-nodes 1
 grep -q "lattice units" "$work/err" || { echo "FAIL: gap message without the gap in lattice units"; failures=$((failures + 1)); }
+check "lbm --min-gap-nodes out of range" 2 "$draglab" lbm run --array sc --phi 0.5 --d 8 --re 0 --min-gap-nodes -1
+# Touching spheres (SC close packing) are run by default and their contacts reported.
+check "lbm touching sc" 0 "$draglab" lbm run --array sc --phi 0.5235987755982988 --d 12 --re 0 --json --threads 1
+json_check "lbm touching sc json" "j['converged'] and j['narrow_gap_pairs'] == 3 and j['narrow_gap_fluid_fraction'] > 0 and 38 < j['K'] < 46 and any('gaps below one lattice spacing' in w for w in j['warnings'])"
+
 check "lbm unknown collision" 2 "$draglab" lbm run --array sc --phi 0.1 --d 8 --re 0 --collision mrt
 check "lbm unknown scheme" 2 "$draglab" lbm convergence --array sc --phi 0.1 --re 0 --d 6 --schemes foo-bb
 check "lbm missing packing" 2 "$draglab" lbm run --packing "$work/none.h5" --d 8 --re 0

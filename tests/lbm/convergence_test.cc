@@ -131,8 +131,10 @@ TEST(ConvergenceOptions, BadInputIsNamed) {
   o.resolutions = {8.0};
   o.schemes.clear();
   EXPECT_FALSE(o.IsValid(&error));
-  // Gaps: SC near close packing leaves less than a lattice unit between spheres at d = 8.
+  // Gaps (opt-in check): SC near close packing leaves less than a lattice unit between spheres at
+  // d = 8.
   ConvergenceOptions dense;
+  dense.run.min_gap_nodes = 1.0;
   sc.phi = 0.52;
   dense.packing = arrays::generate_ordered_packing(sc);
   dense.resolutions = {8.0};

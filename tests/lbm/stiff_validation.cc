@@ -5,9 +5,9 @@
 // Cases and expected outcomes:
 //  a. phi = 0.6 random packing (27 spheres, d = 16, Stokes, TRT + interpolated bounce-back).
 //     Hard-sphere packings this dense have near contacts far below one lattice unit (the smallest
-//     gap is computed here independently with arrays::min_gap_lattice_units), so with the default
-//     min_gap_nodes = 1 the engine must refuse the resolution as bad input (kInvalidArgument,
-//     naming the gap). With the gap check off it must converge: Stokes flow is linear and stable,
+//     gap is computed here independently with arrays::min_gap_lattice_units), so with the opt-in
+//     check min_gap_nodes = 1 the engine must refuse the resolution as bad input (kInvalidArgument,
+//     naming the gap). By default (no check) it must converge: Stokes flow is linear and stable,
 //     the momentum balance holds, and F is near the van der Hoef 2005 fit (37.85 at phi = 0.6):
 //     within 20 % for one packing at d = 16 (mean gaps of 0.1-0.2 d are only 2-3 nodes wide, so
 //     the near-contact regions are under-resolved; realization scatter at N = 27 is several %).
@@ -52,6 +52,7 @@ TEST(StiffValidation, DenseRandomPackingPhi06) {
   const double smallest_gap = arrays::min_gap_lattice_units(packing, d);
   report("stiff phi=0.6 smallest gap (lattice units)", std::to_string(smallest_gap));
   RunOptions options = stokes_options(Collision::kTrt, Boundary::kInterpolated, kFastStokesTau);
+  options.min_gap_nodes = 1.0;
   if (smallest_gap < options.min_gap_nodes) {
     try {
       lbm::run(packing, d, options);
@@ -59,10 +60,11 @@ TEST(StiffValidation, DenseRandomPackingPhi06) {
     } catch (const Error& e) {
       EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
       EXPECT_TRUE(contains(e.what(), "gap")) << e.what();
-      report("stiff phi=0.6 default gap check", e.what());
+      report("stiff phi=0.6 opt-in gap check", e.what());
     }
   }
-  options.min_gap_nodes = 0.0;
+  options.min_gap_nodes = RunOptions().min_gap_nodes;  // the default: no check
+  EXPECT_EQ(options.min_gap_nodes, 0.0);
   const RunResult r = lbm::run(packing, d, options);
   char text[128];
   std::snprintf(text, sizeof(text), "vs vdH05 %+.3e, fallback links %lld of %lld | ",

@@ -18,10 +18,18 @@
 // stored as kMinLinkFraction so that q stays in (0, 1] (the wall is still at the fluid node to
 // working precision; putting it at q = 1 would misplace it by a whole link). Because the solid
 // node is strictly inside, q < 1 mathematically; rounding can give at most q = 1. Links are
-// assigned to the sphere that contains the solid node; where two spheres overlap (not a valid
-// packing, but touching spheres can share a node through rounding) the lowest sphere index owns
-// the node, and q is the crossing of that sphere's surface. A link that clips a different
-// sphere between two nodes that are outside it still takes q from the owner of its solid node.
+// assigned to the sphere whose surface the link crosses first: q is the first surface crossing
+// along the link over the owner of the solid node and every sphere image near it. Where spheres
+// are closer than a lattice spacing (touching, in contact, or with sub-node gaps, the normal
+// case of dense random packings), a link from a fluid node in the gap can clip a neighbour
+// before it reaches the sphere that owns its solid node; its wall is then on that neighbour, and
+// so is its momentum exchange. Where two spheres overlap (touching spheres can share a node
+// through rounding) the lowest sphere index owns the solid node.
+//
+// Under-resolved gaps are measured, not refused: VoxelGrid::gaps counts the sphere pairs (and
+// image pairs) whose surface gap is below one lattice spacing, and the fluid nodes with solid
+// nodes on both sides along a lattice direction (a gap one node wide there, where interpolated
+// bounce-back falls back to the halfway rule).
 #pragma once
 
 #include <array>
@@ -60,12 +68,29 @@ struct VoxelizationOptions {
   bool IsValid(std::string* error) const;
 };
 
+/// Sub-node gaps of a voxelized packing (see the header comment).
+struct GapSummary {
+  /// Sphere pairs (a pair of distinct images counted once, a sphere's own images included) whose
+  /// surface gap is below one lattice spacing (touching and overlapping pairs included).
+  std::int64_t narrow_pairs = 0;
+  /// Smallest surface gap over pairs closer than one link (sqrt 2 lattice spacings), in lattice
+  /// units (< 0: overlap); +infinity if no pair is that close.
+  double min_gap_nodes = 0.0;
+  /// Fluid nodes whose two neighbours along some D3Q19 direction are both solid.
+  std::int64_t narrow_fluid_nodes = 0;
+  std::int64_t fluid_nodes = 0;
+  double narrow_fluid_fraction() const {
+    return fluid_nodes > 0 ? static_cast<double>(narrow_fluid_nodes) / fluid_nodes : 0.0;
+  }
+};
+
 /// Solid flags and boundary links of a packing on a lattice.
 struct VoxelGrid {
   std::array<std::int64_t, 3> dims{0, 0, 0};
   double dx = 1.0;                               ///< Node spacing in d_ref.
   std::vector<std::uint8_t> solid;               ///< 1 = solid, 0 = fluid; size nx*ny*nz.
   std::vector<std::vector<BoundaryLink>> links;  ///< links[s]: boundary links of sphere s.
+  GapSummary gaps;                               ///< Filled by voxelize().
 
   std::int64_t num_nodes() const { return dims[0] * dims[1] * dims[2]; }
   std::int64_t index(std::int64_t i, std::int64_t j, std::int64_t k) const {

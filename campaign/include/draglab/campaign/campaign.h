@@ -29,19 +29,20 @@ namespace campaign {
 /// A campaign spec (TOML). Every field is validated by IsValid and by parse_campaign_spec, which
 /// names the field and the allowed range in its Error(kInvalidArgument).
 struct CampaignSpec {
-  std::string name;                 ///< [campaign] name, non-empty.
-  std::string description;          ///< [campaign] description (optional).
-  std::vector<double> phi;          ///< [grid] phi: solids fractions, each in [0.05, 0.6].
-  std::vector<double> re;           ///< [grid] re: target Re (superficial), each in [0, 1000].
-  int realizations = 1;             ///< [grid] realizations per (phi, Re), [1, 100].
-  std::uint64_t seed = 1;           ///< [grid] seed: base seed of the packings.
-  int spheres = 16;                 ///< [packing] spheres per box, [1, 100000] (or box_size).
-  double box_size = 0.0;            ///< [packing] box edge in diameters (> 0 overrides spheres).
+  std::string name;                   ///< [campaign] name, non-empty.
+  std::string description;            ///< [campaign] description (optional).
+  std::vector<double> phi;            ///< [grid] phi: solids fractions, each in [0.05, 0.6].
+  std::vector<double> re;             ///< [grid] re: target Re (superficial), each in [0, 1000].
+  int realizations = 1;               ///< [grid] realizations per (phi, Re), [1, 100].
+  std::uint64_t seed = 1;             ///< [grid] seed: base seed of the packings.
+  int spheres = 16;                   ///< [packing] spheres per box, [1, 100000] (or box_size).
+  double box_size = 0.0;              ///< [packing] box edge in diameters (> 0 overrides spheres).
   std::string distribution = "mono";  ///< [packing] mono, bi or lognormal.
-  double size_ratio = 2.0;          ///< [packing] bidisperse d_large/d_small.
-  double large_fraction = 0.5;      ///< [packing] bidisperse volume share of the large spheres.
-  double sigma = 0.2;               ///< [packing] lognormal sigma of ln d.
-  double min_gap = 0.0;             ///< [packing] min surface gap in d; 0 = 1.2/min(resolutions).
+  double size_ratio = 2.0;            ///< [packing] bidisperse d_large/d_small.
+  double large_fraction = 0.5;        ///< [packing] bidisperse volume share of the large spheres.
+  double sigma = 0.2;                 ///< [packing] lognormal sigma of ln d.
+  double min_gap =
+      0.0;  ///< [packing] forced min surface gap in d; 0 = none (hard-sphere structure).
   std::vector<double> resolutions;  ///< [lbm] resolutions d (lattice units per diameter), >= 4.
   std::string collision = "trt";    ///< [lbm] trt, bgk or rr.
   std::string boundary = "ibb";     ///< [lbm] ibb or bb.
@@ -94,8 +95,7 @@ struct RunCampaignOptions {
   int jobs = 0;         ///< Parallel units; 0 = number of cores.
   bool resume = false;  ///< Continue the campaign of the same name (same spec hash required).
   /// Progress: units finished (done + failed), total, and a status line (ETA included).
-  std::function<void(std::int64_t finished, std::int64_t total, const std::string& line)>
-      progress;
+  std::function<void(std::int64_t finished, std::int64_t total, const std::string& line)> progress;
 };
 
 /// Creates the campaign (or, with resume, finds it; resume also creates a missing one) and runs

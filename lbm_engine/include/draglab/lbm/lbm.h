@@ -15,8 +15,13 @@
 // hydrodynamic diameter when RunOptions::use_hydrodynamic_diameter is set).
 //
 // Limits: Mach number max|u| sqrt(3) < mach_limit (default 0.3 stops the run; 0.1 warns), tau >
-// 1/2 strictly (tau - 1/2 < 1e-3 is refused for BGK and TRT), resolution such that the smallest
-// gap between spheres spans at least min_gap_nodes lattice units. A run that diverges or does not
+// 1/2 strictly (tau - 1/2 < 1e-3 is refused for BGK and TRT). Spheres closer than a lattice
+// spacing (touching, in contact, sub-node gaps: dense random arrays at any practical resolution)
+// are normal input: a node inside any sphere is solid, a link takes its wall at the first surface
+// it crosses, and an interpolated link whose second node is solid bounces back halfway. The run
+// reports how many sphere pairs have gaps below one node and the fraction of fluid nodes in
+// such gaps (RunResult::narrow_gap_*), with a warning; min_gap_nodes > 0 turns that into a
+// refusal (opt-in). A run that diverges or does not
 // converge within max_steps reports converged = false and a diagnosis, and never a drag value
 // (F etc. are NaN and run() throws draglab::Error unless RunOptions::throw_on_failure is false).
 //
@@ -59,8 +64,9 @@
 // against Sangani-Acrivos (phi 0.027 - 0.216, d 8 - 24), plus 0.35 sqrt|Lambda - 3/16| for the
 // viscosity-dependent wall of BGK (Lambda = (tau - 1/2)^2), regularized ((tau - 1/2)/2) or TRT
 // with another Lambda, and a growth with Re from the thinning boundary layer: sqrt(1 + Re/10) for
-// bounce-back (first order), 1 + Re/10 for the interpolated wall (second order; src/error_model.cc).
-// It is an a-priori scale for one run; campaigns should still extrapolate in d.
+// bounce-back (first order), 1 + Re/10 for the interpolated wall (second order;
+// src/error_model.cc). It is an a-priori scale for one run; campaigns should still extrapolate in
+// d.
 #pragma once
 
 #include <array>
@@ -113,8 +119,10 @@ struct RunOptions {
   double re_tolerance = 0.01;  ///< Achieved Re within this relative band of the target.
   double tolerance = 1e-6;     ///< Relative drag change per characteristic time at convergence.
   std::int64_t max_steps = 200000;
-  double mach_limit = 0.3;     ///< max |u| sqrt(3) above this stops the run.
-  double min_gap_nodes = 1.0;  ///< Smallest sphere gap must span this many lattice units.
+  double mach_limit = 0.3;  ///< max |u| sqrt(3) above this stops the run.
+  /// Opt-in check: refuse a packing whose smallest sphere gap spans fewer lattice units (0 = off,
+  /// the default: sub-node gaps are run and reported).
+  double min_gap_nodes = 0.0;
   bool use_hydrodynamic_diameter = false;  ///< Normalise with a calibrated d_h (bounce-back).
   double hydrodynamic_diameter = 0.0;      ///< d_h in lattice units when the above is set.
   int threads = 0;                         ///< OpenMP threads; 0 = all.
@@ -158,6 +166,12 @@ struct RunResult {
   std::int64_t boundary_links = 0;    ///< Links of all bodies.
   /// Interpolated links that fell back to halfway bounce-back (second node solid).
   std::int64_t fallback_links = 0;
+  /// Sphere pairs (images included) with a surface gap below one lattice spacing; -1 if unknown
+  /// (a grid not made by arrays::voxelize).
+  std::int64_t narrow_gap_pairs = 0;
+  double min_gap_nodes = 0.0;  ///< Smallest gap of pairs closer than one link (lattice units).
+  /// Fraction of fluid nodes with solid nodes on both sides along a lattice direction.
+  double narrow_gap_fluid_fraction = 0.0;
   double tau_minus = 0.0;             ///< TRT odd relaxation time (= tau for BGK / regularized).
   bool stokes_mode = false;           ///< Linear equilibrium used.
   double mass_change_rel = 0.0;       ///< (fluid mass at end - at start) / start.
