@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -121,6 +122,59 @@ Dataset build_and_report(const CliContext& ctx, Database& db, std::int64_t campa
     for (const auto& n : method["notes"]) ctx.info("dataset: " + n.get<std::string>());
   }
   return d;
+}
+
+struct PlanCommand {
+  std::string spec;
+  int jobs = 0;
+  double node_update_ns = 0.0;
+};
+
+/// `campaign plan`: units, memory and predicted time; a spec that cannot fit is bad input.
+void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
+  const campaign::CampaignSpec spec = campaign::parse_campaign_spec(resolve_spec_path(c.spec));
+  if (c.jobs < 0 || c.jobs > 1024) throw UsageError("--jobs must be in [0, 1024] (0 = all cores)");
+  if (!std::isfinite(c.node_update_ns) || c.node_update_ns < 0.0) {
+    throw UsageError("--node-update-ns must be >= 0 (0 = measure on this machine)");
+  }
+  const int jobs =
+      c.jobs > 0 ? c.jobs : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+  if (c.node_update_ns == 0.0) ctx.info("campaign plan: timing the engine on this machine (~1 s)");
+  const campaign::CampaignPlan plan = campaign::plan_campaign(spec, jobs, c.node_update_ns * 1e-9);
+  if (ctx.json) {
+    nlohmann::json points = nlohmann::json::array();
+    for (const campaign::PlannedPoint& p : plan.points) {
+      points.push_back({{"phi", p.phi},
+                        {"re", p.re},
+                        {"resolution", p.resolution},
+                        {"units", p.units},
+                        {"fluid_nodes", p.fluid_nodes},
+                        {"steps", p.steps},
+                        {"unit_seconds", p.unit_seconds},
+                        {"memory_bytes", p.memory_bytes}});
+    }
+    ctx.print_json({{"campaign", spec.name},
+                    {"units", plan.units},
+                    {"jobs", plan.jobs},
+                    {"node_update_seconds", plan.node_update_seconds},
+                    {"core_seconds", plan.core_seconds},
+                    {"wall_seconds", plan.wall_seconds},
+                    {"largest_unit_memory_bytes", plan.largest_unit_memory_bytes},
+                    {"machine_memory_bytes", plan.machine_memory_bytes},
+                    {"fits_in_memory", plan.fits_in_memory},
+                    {"points", points}});
+  } else {
+    std::cout << fmt::format("campaign {}\n", spec.name) << plan.FullReport();
+  }
+  if (!plan.fits_in_memory) {
+    throw UsageError(fmt::format(
+        "[lbm] resolutions: the largest unit needs about {:.1f} GiB, {:.1f} GiB for {} workers: "
+        "more than 80 % of this machine's {:.1f} GiB; lower the resolution, the spheres per "
+        "box, or --jobs",
+        plan.largest_unit_memory_bytes / 1073741824.0,
+        plan.largest_unit_memory_bytes * plan.jobs / 1073741824.0, plan.jobs,
+        plan.machine_memory_bytes / 1073741824.0));
+  }
 }
 
 void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
@@ -395,6 +449,24 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
         "One process at a time runs a campaign (a lock file next to the database guards it).\n"
         "When every unit has finished, the dataset is built and its id printed.");
     cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_campaign_command(ctx, *o); }; });
+  }
+  {
+    auto* cmd = campaign->add_subcommand(
+        "plan", "Units, memory and predicted run time of a spec, before any work");
+    auto o = std::make_shared<PlanCommand>();
+    cmd->add_option("spec", o->spec, "Spec file (TOML) or preset name: quick, standard, paper")
+        ->required();
+    cmd->add_option("--jobs", o->jobs, "Workers the prediction assumes (0 = all cores)")
+        ->capture_default_str();
+    cmd->add_option("--node-update-ns", o->node_update_ns,
+                    "Time per fluid-node update on one core, ns (0 = measure it here, ~1 s)")
+        ->capture_default_str();
+    cmd->footer(
+        "Prediction: fluid nodes x the engine's step model (lbm::predicted_steps) x the\n"
+        "measured time per node update, units scheduled longest first on --jobs workers.\n"
+        "Exit 2 if the largest unit does not fit in memory for --jobs workers.\n"
+        "Examples:\n  draglab campaign plan quick\n  draglab campaign plan paper --jobs 64 --json");
+    cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_plan_command(ctx, *o); }; });
   }
   {
     auto* cmd = campaign->add_subcommand("status",

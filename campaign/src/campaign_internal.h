@@ -60,8 +60,8 @@ double effective_min_gap(const CampaignSpec& spec);
 /// The spec stored as CampaignSpec::to_json() text.
 CampaignSpec spec_from_json(const std::string& text);
 
-/// Relative cost estimate of a unit (fluid nodes x steps, with an empirical factor for the
-/// non-linear scheme at Re > 0): used only for the order of work and the ETA.
+/// Cost of a unit in fluid-node updates: fluid nodes x lbm::predicted_steps. Orders the work,
+/// drives the ETA, and (times the measured seconds per update) the plan's predicted time.
 double unit_cost_estimate(const CampaignSpec& spec, double phi, double re, double resolution);
 
 }  // namespace internal

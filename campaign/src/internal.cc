@@ -8,6 +8,7 @@
 #include "campaign_internal.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/lbm/lbm.h"
 
 namespace draglab {
 namespace campaign {
@@ -157,13 +158,8 @@ double unit_cost_estimate(const CampaignSpec& spec, double phi, double re, doubl
   const int n = packing_options(spec, phi, 1).n;
   const double edge = std::cbrt(n * M_PI / (6.0 * phi));  // box edge in diameters
   const double fluid_nodes = std::pow(edge * resolution, 3) * (1.0 - phi);
-  // Steps to converge scale with the viscous time d^2/nu in Stokes flow (nu = 1/3), and with the
-  // advective time d/U at Re > 0 (U fixed by the Mach budget); both are 300 at d = 10. The
-  // factor at Re > 0 is empirical (full equilibrium, slower approach to steady state): the quick
-  // preset's units at d = 10 took 0.5 - 3 s in Stokes flow and 2 - 70 s at Re 5 - 50.
-  const double steps = re > 0.0 ? 30.0 * resolution : 3.0 * resolution * resolution;
-  const double re_factor = re > 0.0 ? 20.0 * std::pow(std::max(re, 1.0) / 50.0, 0.3) : 1.0;
-  return fluid_nodes * steps * re_factor;
+  return fluid_nodes *
+         lbm::predicted_steps(phi, re, resolution, lbm::collision_from_string(spec.collision));
 }
 
 }  // namespace internal

@@ -534,6 +534,17 @@ RunResult run_checked(const arrays::VoxelGrid& grid, double phi_exact, const Run
 
 }  // namespace
 
+double predicted_steps(double phi, double re, double d, Collision collision) {
+  const double stokes_tau = collision == Collision::kTrt ? 1.5 : 1.0;
+  const double budget_u =
+      (re == 0.0 ? kStokesMaxSpeed : kBudgetMaxSpeed) * (1.0 - phi) / kPoreSpeedFactor;
+  const double tau = re == 0.0 ? stokes_tau : std::min(stokes_tau, 0.5 + 3.0 * budget_u * d / re);
+  const double nu = (tau - 0.5) / 3.0;
+  const double characteristic = d * d / (nu * (1.0 + re));
+  const double darcy = d * d / (nu * phi * bvk2007_estimate(phi, re));
+  return std::max(2.5 * characteristic, 0.9 * darcy);
+}
+
 RunResult run(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
               const ProgressCallback& progress) {
   return run_checked(grid, phi_exact, options, nullptr, progress);

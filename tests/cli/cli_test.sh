@@ -147,6 +147,12 @@ grep -q -- "--phi" "$work/err" || { echo "FAIL: phi message does not name --phi"
 check "lbm gap too small (opt-in check)" 2 "$draglab" lbm run --array sc --phi 0.5 --d 8 --re 0 --min-gap-nodes 1
 grep -q "lattice units" "$work/err" || { echo "FAIL: gap message without the gap in lattice units"; failures=$((failures + 1)); }
 check "lbm --min-gap-nodes out of range" 2 "$draglab" lbm run --array sc --phi 0.5 --d 8 --re 0 --min-gap-nodes -1
+# campaign plan: units, memory, predicted time, before any work; a spec that cannot fit is exit 2.
+check "campaign plan" 0 "$draglab" campaign plan quick --jobs 2 --node-update-ns 50 --json
+json_check "campaign plan json" "j['units'] == 60 and j['wall_seconds'] > 0 and j['fits_in_memory'] and len(j['points']) == 20"
+printf '[campaign]\nname = "huge"\n[grid]\nphi = [0.1]\nre = [0]\nrealizations = 1\n[lbm]\nresolutions = [500]\n[dataset]\nextrapolation = "finest"\n' > "$work/huge.toml"
+check "campaign plan too big" 2 "$draglab" campaign plan "$work/huge.toml" --jobs 2 --node-update-ns 50
+grep -q "GiB" "$work/err" || { echo "FAIL: plan memory message without GiB"; failures=$((failures + 1)); }
 # Touching spheres (SC close packing) are run by default and their contacts reported.
 check "lbm touching sc" 0 "$draglab" lbm run --array sc --phi 0.5235987755982988 --d 12 --re 0 --json --threads 1
 json_check "lbm touching sc json" "j['converged'] and j['narrow_gap_pairs'] == 3 and j['narrow_gap_fluid_fraction'] > 0 and 38 < j['K'] < 46 and any('gaps below one lattice spacing' in w for w in j['warnings'])"

@@ -108,6 +108,41 @@ struct RunCampaignOptions {
 CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
                             const RunCampaignOptions& options);
 
+/// Predicted cost of one (phi, Re, resolution) point of a spec (all its realizations).
+struct PlannedPoint {
+  double phi = 0.0, re = 0.0, resolution = 0.0;
+  int units = 0;              ///< Realizations.
+  double fluid_nodes = 0.0;   ///< Per unit.
+  double steps = 0.0;         ///< Per unit: lbm::predicted_steps.
+  double unit_seconds = 0.0;  ///< Predicted run time of one unit on one core.
+  double memory_bytes = 0.0;  ///< Per unit (populations, flags, links: generous).
+};
+
+/// What `draglab campaign plan` predicts before any work: units, memory and run time, from the
+/// engine's step model (lbm::predicted_steps) and this machine's measured time per fluid-node
+/// update (a short timed run, or the given value). Limits: the step model is within a factor
+/// ~2.6 per unit (median 1.2) where it was calibrated (phi <= 0.4, Re <= 25, d = 10); beyond that
+/// it is an extrapolation, and units that fail (Mach limit, tau near 1/2) are not predicted.
+struct CampaignPlan {
+  std::vector<PlannedPoint> points;
+  std::int64_t units = 0;
+  int jobs = 1;
+  double node_update_seconds = 0.0;  ///< Seconds per fluid-node update, one core.
+  double core_seconds = 0.0;         ///< Sum over units.
+  /// Longest-first schedule of the units on `jobs` workers (as the runner orders them).
+  double wall_seconds = 0.0;
+  double largest_unit_memory_bytes = 0.0;
+  double machine_memory_bytes = 0.0;  ///< 0 if unknown.
+  bool fits_in_memory = true;         ///< largest_unit_memory_bytes x jobs <= 80 % of the machine.
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+/// Plans `spec` (which must be valid) for `jobs` workers (>= 1). node_update_seconds > 0 uses
+/// that value; 0 measures it with a short run (about a second, one thread). Throws
+/// Error(kInvalidArgument) for an invalid spec or jobs outside [1, 1024].
+CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_update_seconds = 0.0);
+
 /// Status by id (decimal) or name; throws Error(kNotFound).
 CampaignStatus campaign_status(const Database& db, const std::string& id_or_name);
 std::vector<CampaignStatus> list_campaigns(const Database& db);

@@ -183,6 +183,15 @@ struct RunResult {
   std::string FullReport() const;
 };
 
+/// A-priori number of time steps a run with the automatic relaxation time (RunOptions::tau == 0)
+/// needs to converge at tolerance ~1e-5, for planning (draglab campaign plan): the larger of
+/// 2.5 characteristic times d^2/(nu (1 + Re)) and 0.9 times d^2/(nu phi F), the viscous time of
+/// the Darcy relaxation of the mean flow (permeability ~ d^2/(18 phi F)), with F the BVK 2007
+/// estimate. Calibrated on the measured step counts of 60 units (phi 0.1 - 0.4, Re 0 - 25,
+/// d = 10): every unit within a factor 2.6, median 1.2 (docs/campaigns.md). phi in (0, 1),
+/// re >= 0, d > 0.
+double predicted_steps(double phi, double re, double d, Collision collision = Collision::kTrt);
+
 /// Runs to steady state on a voxelized geometry (flow along +x). `phi_exact` is the exact solids
 /// fraction (Packing::phi()) or <= 0 to use the lattice one.
 RunResult run(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,

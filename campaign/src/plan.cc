@@ -1,0 +1,154 @@
+// plan.cc: plan_campaign -- units, memory and predicted run time of a spec before any work.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <queue>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "campaign_internal.h"
+#include "draglab/arrays/packing.h"
+#include "draglab/arrays/voxelization.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/lbm/lbm.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+constexpr double kBytesPerNode = 200.0;  // populations, flags, links: generous (as check_memory)
+constexpr double kMemoryShare = 0.8;
+
+std::string format(const char* fmt, double x) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, fmt, x);
+  return buffer;
+}
+
+std::string duration(double seconds) {
+  if (seconds < 120.0) return format("%.0f s", seconds);
+  if (seconds < 7200.0) return format("%.1f min", seconds / 60.0);
+  if (seconds < 2.0 * 86400.0) return format("%.1f h", seconds / 3600.0);
+  if (seconds < 730.0 * 86400.0) return format("%.1f days", seconds / 86400.0);
+  return format("%.1f years", seconds / (365.25 * 86400.0));
+}
+
+/// Seconds per fluid-node update on one core: a fixed number of steps of the full (non-linear)
+/// kernel with interpolated bounce-back on a 16-sphere phi = 0.2 packing at d = 16 (a box of the
+/// size of small campaign units, 56^3 nodes, beyond the private caches).
+double measure_node_update_seconds() {
+  arrays::RandomPackingOptions po;
+  po.phi = 0.2;
+  po.n = 16;
+  po.seed = 1;
+  const arrays::Packing packing = arrays::generate_random_packing(po);
+  lbm::RunOptions ro;
+  ro.re = 10.0;
+  ro.max_steps = 400;
+  ro.threads = 1;
+  ro.throw_on_failure = false;  // the step limit is the point: it stops before convergence
+  const lbm::RunResult r = lbm::run(packing, 16.0, ro);
+  if (!(r.mflups > 0.0)) {
+    throw Error(ErrorCode::kInternal, "campaign plan: the timing run measured no speed");
+  }
+  return 1e-6 / r.mflups;
+}
+
+double machine_memory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
+}
+
+}  // namespace
+
+CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_update_seconds) {
+  std::string error;
+  if (!spec.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, error);
+  if (jobs < 1 || jobs > 1024) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "campaign plan: jobs = " + std::to_string(jobs) + " is outside [1, 1024]");
+  }
+  if (!(node_update_seconds >= 0.0) || !std::isfinite(node_update_seconds)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "campaign plan: node_update_seconds must be >= 0 (0 = measure)");
+  }
+  CampaignPlan plan;
+  plan.jobs = jobs;
+  plan.node_update_seconds =
+      node_update_seconds > 0.0 ? node_update_seconds : measure_node_update_seconds();
+  const lbm::Collision collision = lbm::collision_from_string(spec.collision);
+  std::vector<double> unit_seconds;
+  for (double phi : spec.phi) {
+    const int n = internal::packing_options(spec, phi, 1).n;
+    const double edge = std::cbrt(n * M_PI / (6.0 * phi));  // box edge in diameters
+    for (double re : spec.re) {
+      for (double d : spec.resolutions) {
+        PlannedPoint p;
+        p.phi = phi;
+        p.re = re;
+        p.resolution = d;
+        p.units = spec.realizations;
+        const double nodes = std::pow(edge * d, 3);
+        p.fluid_nodes = nodes * (1.0 - phi);
+        p.steps = lbm::predicted_steps(phi, re, d, collision);
+        p.unit_seconds = p.fluid_nodes * p.steps * plan.node_update_seconds;
+        p.memory_bytes = nodes * kBytesPerNode;
+        plan.units += p.units;
+        plan.core_seconds += p.units * p.unit_seconds;
+        plan.largest_unit_memory_bytes = std::max(plan.largest_unit_memory_bytes, p.memory_bytes);
+        for (int r = 0; r < p.units; ++r) unit_seconds.push_back(p.unit_seconds);
+        plan.points.push_back(p);
+      }
+    }
+  }
+  // Longest first onto the least loaded worker, as the runner hands out its units.
+  std::sort(unit_seconds.begin(), unit_seconds.end(), std::greater<double>());
+  std::priority_queue<double, std::vector<double>, std::greater<double>> load;
+  for (int w = 0; w < jobs; ++w) load.push(0.0);
+  for (double t : unit_seconds) {
+    const double least = load.top();
+    load.pop();
+    load.push(least + t);
+  }
+  while (!load.empty()) {
+    plan.wall_seconds = std::max(plan.wall_seconds, load.top());
+    load.pop();
+  }
+  plan.machine_memory_bytes = machine_memory();
+  plan.fits_in_memory =
+      plan.machine_memory_bytes <= 0.0 ||
+      plan.largest_unit_memory_bytes * jobs <= kMemoryShare * plan.machine_memory_bytes;
+  return plan;
+}
+
+std::string CampaignPlan::BriefReport() const {
+  return std::to_string(units) + " units, predicted " + duration(wall_seconds) + " on " +
+         std::to_string(jobs) + " worker" + (jobs == 1 ? "" : "s") + " (" +
+         format("%.3g", core_seconds) + " core-seconds), largest unit " +
+         format("%.2g", largest_unit_memory_bytes / 1073741824.0) + " GiB" +
+         (fits_in_memory ? "" : ": DOES NOT FIT in memory");
+}
+
+std::string CampaignPlan::FullReport() const {
+  std::ostringstream out;
+  out << "phi     Re      d      units  fluid nodes  steps     unit time   memory/unit\n";
+  for (const PlannedPoint& p : points) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%-7.3g %-7.4g %-6.4g %-6d %-12.3g %-9.3g %-11s %.2g GiB\n",
+                  p.phi, p.re, p.resolution, p.units, p.fluid_nodes, p.steps,
+                  duration(p.unit_seconds).c_str(), p.memory_bytes / 1073741824.0);
+    out << line;
+  }
+  out << "time per fluid-node update (one core, measured): "
+      << format("%.3g", node_update_seconds * 1e9) << " ns\n";
+  out << BriefReport() << "\n";
+  return out.str();
+}
+
+}  // namespace campaign
+}  // namespace draglab

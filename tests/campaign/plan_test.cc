@@ -1,0 +1,97 @@
+// campaign plan: units, memory and predicted time of a spec, before any work.
+//
+// References: the plan's arithmetic is checked against sums written out here (units = phi x Re
+// x realizations x resolutions; core time = sum of fluid nodes x predicted steps x the given
+// time per update); the longest-first schedule against its bounds (the wall time is at least the
+// core time over the workers and at least the longest unit, and at most their sum); the step
+// model against its defining formula (lbm.h: max of 2.5 characteristic times and 0.9 Darcy
+// times, with the engine's own choice of tau).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "campaign_internal.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/lbm/lbm.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+CampaignSpec small_spec() {
+  return parse_campaign_spec_text(R"(
+[campaign]
+name = "plan-test"
+[grid]
+phi = [0.1, 0.4]
+re = [0, 20]
+realizations = 3
+seed = 1
+[packing]
+spheres = 16
+[lbm]
+resolutions = [10, 14, 20]
+[dataset]
+extrapolation = "richardson"
+)",
+                                  "plan.toml");
+}
+
+TEST(CampaignPlan, UnitsAndCoreTimeAreTheSumsOfThePoints) {
+  const CampaignSpec spec = small_spec();
+  const double t = 50e-9;
+  const CampaignPlan plan = plan_campaign(spec, 2, t);
+  EXPECT_EQ(plan.units, 2 * 2 * 3 * 3);
+  ASSERT_EQ(plan.points.size(), 12u);
+  double core = 0.0, longest = 0.0;
+  for (const PlannedPoint& p : plan.points) {
+    const double edge = std::cbrt(16 * M_PI / (6.0 * p.phi));
+    EXPECT_NEAR(p.fluid_nodes, std::pow(edge * p.resolution, 3) * (1.0 - p.phi),
+                1e-9 * p.fluid_nodes);
+    EXPECT_DOUBLE_EQ(p.steps, lbm::predicted_steps(p.phi, p.re, p.resolution));
+    EXPECT_NEAR(p.unit_seconds, p.fluid_nodes * p.steps * t, 1e-12 * p.unit_seconds);
+    core += p.units * p.unit_seconds;
+    longest = std::max(longest, p.unit_seconds);
+  }
+  EXPECT_NEAR(plan.core_seconds, core, 1e-9 * core);
+  EXPECT_GE(plan.wall_seconds, core / 2.0 * (1.0 - 1e-12));
+  EXPECT_GE(plan.wall_seconds, longest);
+  EXPECT_LE(plan.wall_seconds, core / 2.0 + longest);
+  // One worker: the wall time is the core time.
+  EXPECT_NEAR(plan_campaign(spec, 1, t).wall_seconds, core, 1e-9 * core);
+  EXPECT_TRUE(plan.fits_in_memory);
+  EXPECT_NE(plan.BriefReport().find("36 units"), std::string::npos) << plan.BriefReport();
+}
+
+TEST(CampaignPlan, StepModelFollowsItsFormula) {
+  // Stokes (tau = 1.5, nu = 1/3) at phi = 0.4, d = 10: the characteristic time d^2/nu = 300
+  // steps dominates (2.5 x 300 = 750 > 0.9 x 300/(0.4 F), F ~ 11.8).
+  EXPECT_NEAR(lbm::predicted_steps(0.4, 0.0, 10.0), 750.0, 1e-9);
+  // More steps at higher resolution and, at fixed d, at higher Re in dilute arrays (smaller nu).
+  EXPECT_GT(lbm::predicted_steps(0.1, 25.0, 20.0), lbm::predicted_steps(0.1, 25.0, 10.0));
+  EXPECT_GT(lbm::predicted_steps(0.1, 25.0, 10.0), lbm::predicted_steps(0.1, 5.0, 10.0));
+}
+
+TEST(CampaignPlan, BadInputIsRefused) {
+  const CampaignSpec spec = small_spec();
+  EXPECT_THROW(plan_campaign(spec, 0, 1e-8), Error);
+  EXPECT_THROW(plan_campaign(spec, 2, -1.0), Error);
+  CampaignSpec huge = spec;
+  huge.resolutions = {400.0, 450.0, 500.0};
+  const CampaignPlan plan = plan_campaign(huge, 2, 1e-8);
+  EXPECT_FALSE(plan.fits_in_memory);  // (4.4 x 500)^3 nodes x 200 B: ~2 TB
+  EXPECT_NE(plan.BriefReport().find("DOES NOT FIT"), std::string::npos);
+}
+
+TEST(CampaignPlan, MeasuresTheTimePerUpdateWhenNotGiven) {
+  const CampaignPlan plan = plan_campaign(small_spec(), 1);
+  EXPECT_GT(plan.node_update_seconds, 1e-10);  // faster than 10 G updates/s per core: no
+  EXPECT_LT(plan.node_update_seconds, 1e-5);   // slower than 0.1 M updates/s: no
+}
+
+}  // namespace
+}  // namespace campaign
+}  // namespace draglab
