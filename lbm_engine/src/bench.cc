@@ -4,19 +4,28 @@
 //
 // Each figure is the median over `repeat` timed runs (the machines this runs on are shared VMs
 // whose speed moves by 15-25 % between runs; the median is the robust summary).
-//  - mflups: 100^3 all-fluid periodic box, double, TRT (full equilibrium), 100 steps per run.
-//  - mflups_fluid_packing: fluid-node updates per second on a phi = 0.4 random packing of 200
-//    spheres at d = 16 (about 10^6 nodes, 0.6 10^6 fluid), double, TRT with the default
-//    interpolated bounce-back (its link pass included), 100 steps per run;
-//    mflups_fluid_packing_bb: the same with halfway bounce-back (no link pass).
-//  - bandwidth_gbs: b = s * b over 2^27 doubles (1 GiB, several times any last-level cache),
-//    counted as 16 bytes per element (read + write back, no write-allocate), best of 5 passes
-//    per run (STREAM's convention), median over runs.
+// Every working set is at least 4 times the last-level cache (read from sysconf / sysfs; 32 MiB
+// assumed if unknown), so that the figures are memory-bound rates and not cache rates (a 100^3
+// box, 152 MB of populations, runs from a 480 MiB L3 and reads above the DRAM roofline):
+//  - mflups: all-fluid periodic box of edge max(100, (4 LLC / 152 B)^(1/3)) nodes, double, TRT
+//    (full equilibrium), 100 steps per run.
+//  - mflups_fluid_packing: fluid-node updates per second on a phi = 0.4 random packing at d = 16
+//    (max(200, 4 LLC / (5362 nodes x 152 B)) spheres: about 5362 nodes per sphere, 60 % fluid),
+//    double, TRT with the default interpolated bounce-back (its link pass included), 100 steps
+//    per run; mflups_fluid_packing_bb: the same with halfway bounce-back (no link pass).
+//  - bandwidth_gbs: b = s * b over max(1 GiB, 4 LLC) of doubles, counted as 16 bytes per element
+//    (read + write back, no write-allocate), best of 5 passes per run (STREAM's convention),
+//    median over runs.
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "draglab/arrays/packing.h"
@@ -63,8 +72,28 @@ double time_solver(const arrays::VoxelGrid& grid, Boundary boundary, int threads
   return static_cast<double>(lattice.num_fluid()) * 2.0 * pairs / s / 1e6;
 }
 
-double update_bandwidth_gbs(int threads) {
-  const std::int64_t n = std::int64_t{1} << 27;
+/// Largest cache size the system reports (sysconf, else sysfs), or 32 MiB if none is known.
+double last_level_cache_bytes() {
+  double bytes = 0.0;
+#if defined(_SC_LEVEL3_CACHE_SIZE)
+  bytes = std::max(bytes, static_cast<double>(sysconf(_SC_LEVEL3_CACHE_SIZE)));
+#endif
+  for (int index = 0; index < 8; ++index) {
+    std::ifstream in("/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) + "/size");
+    std::string text;
+    if (!(in >> text) || text.empty()) continue;
+    double value = std::atof(text.c_str());
+    if (text.back() == 'K') value *= 1024.0;
+    if (text.back() == 'M') value *= 1048576.0;
+    bytes = std::max(bytes, value);
+  }
+  return bytes > 0.0 ? bytes : 32.0 * 1048576.0;
+}
+
+constexpr double kCacheMultiple = 4.0;
+constexpr double kBytesPerNode = 19.0 * 8.0;  // double populations
+
+double update_bandwidth_gbs(int threads, std::int64_t n) {
   std::unique_ptr<double, decltype(&std::free)> buffer(
       static_cast<double*>(std::aligned_alloc(64, static_cast<std::size_t>(n) * sizeof(double))),
       &std::free);
@@ -99,14 +128,23 @@ BenchResult benchmark(int threads, int repeat) {
   BenchResult result;
   result.threads = threads;
 
+  const double cache = last_level_cache_bytes();
+  result.last_level_cache_bytes = cache;
+  const auto edge = static_cast<std::int64_t>(
+      std::max(100.0, std::ceil(std::cbrt(kCacheMultiple * cache / kBytesPerNode))));
+  result.box_edge = edge;
+  const std::int64_t bandwidth_doubles = static_cast<std::int64_t>(
+      std::max(static_cast<double>(std::int64_t{1} << 27), kCacheMultiple * cache / 8.0));
   arrays::VoxelGrid box;
-  box.dims = {100, 100, 100};
+  box.dims = {edge, edge, edge};
   box.dx = 1.0 / 16.0;
   box.solid.assign(static_cast<std::size_t>(box.num_nodes()), 0);
 
   arrays::RandomPackingOptions packing_options;
   packing_options.phi = 0.4;
-  packing_options.n = 200;
+  packing_options.n = static_cast<int>(
+      std::max(200.0, std::ceil(kCacheMultiple * cache / (5362.0 * kBytesPerNode))));
+  result.packing_spheres = packing_options.n;
   packing_options.seed = 1;
   const arrays::Packing packing = arrays::generate_random_packing(packing_options);
   arrays::VoxelizationOptions vox;
@@ -119,7 +157,7 @@ BenchResult benchmark(int threads, int repeat) {
     box_rate.push_back(time_solver(box, Boundary::kHalfwayBounceBack, threads, 100));
     packing_rate.push_back(time_solver(grid, Boundary::kInterpolated, threads, 100));
     packing_bb_rate.push_back(time_solver(grid, Boundary::kHalfwayBounceBack, threads, 100));
-    bandwidth.push_back(update_bandwidth_gbs(threads));
+    bandwidth.push_back(update_bandwidth_gbs(threads, bandwidth_doubles));
   }
   result.mflups = median(box_rate);
   result.mflups_fluid_packing = median(packing_rate);

@@ -214,15 +214,19 @@ RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
                           const ProgressCallback& progress = nullptr);
 
 /// Performance measurement (`draglab lbm bench`): medians of `repeat` interleaved runs (see
-/// src/bench.cc); about 10 s per repeat on a 2-core machine. threads = 0: all.
+/// src/bench.cc); working sets >= 4x the last-level cache. threads = 0: all.
 struct BenchResult {
-  double mflups = 0.0;                   ///< 100^3 all-fluid periodic box, double, TRT.
+  double mflups = 0.0;                   ///< All-fluid periodic box (box_edge^3), double, TRT.
   double mflups_fluid_packing = 0.0;     ///< Fluid-node updates/s on a phi = 0.4 random packing
                                          ///< (TRT, interpolated bounce-back: the default scheme).
   double mflups_fluid_packing_bb = 0.0;  ///< Same packing, halfway bounce-back (no link pass).
   double bandwidth_gbs = 0.0;            ///< STREAM-like in-place update kernel.
   double roofline_fraction = 0.0;        ///< mflups / (bandwidth / 304 bytes).
   int threads = 0;
+  /// Working sets are >= 4x this: the all-fluid box edge and the packing's sphere count.
+  double last_level_cache_bytes = 0.0;
+  std::int64_t box_edge = 0;
+  int packing_spheres = 0;
 };
 BenchResult benchmark(int threads = 0, int repeat = 5);
 
