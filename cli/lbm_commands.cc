@@ -241,7 +241,7 @@ nlohmann::json run_json(const lbm::RunResult& r, const lbm::RunOptions& o, doubl
                       {"boundary", lbm::to_string(o.boundary)},
                       {"precision", lbm::to_string(o.precision)},
                       {"narrow_gap_pairs", r.narrow_gap_pairs},
-                      {"min_gap_nodes", number_or_null(r.min_gap_nodes)},
+                      {"smallest_gap_nodes", number_or_null(r.smallest_gap_nodes)},
                       {"narrow_gap_fluid_fraction", r.narrow_gap_fluid_fraction},
                       {"fallback_links", r.fallback_links},
                       {"boundary_links", r.boundary_links},
@@ -383,7 +383,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
       std::cout << fmt::format(
           "sub-node gaps    {} sphere pairs closer than one node (smallest {:.3g}), {:.2f} % of "
           "fluid nodes in one-node gaps\n",
-          r.narrow_gap_pairs, r.min_gap_nodes, 100.0 * r.narrow_gap_fluid_fraction);
+          r.narrow_gap_pairs, r.smallest_gap_nodes, 100.0 * r.narrow_gap_fluid_fraction);
     }
     std::cout << fmt::format("run              {}, {} steps, {:.2f} s, {:.1f} MFLUPS\n",
                              r.converged ? "converged" : "NOT CONVERGED", r.steps, r.wall_s,

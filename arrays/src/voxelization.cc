@@ -308,7 +308,7 @@ std::vector<std::vector<NearSphere>> near_spheres(const Packing& packing, const 
   const std::size_t n = packing.size();
   std::vector<std::vector<NearSphere>> near(n);
   gaps->narrow_pairs = 0;
-  gaps->min_gap_nodes = std::numeric_limits<double>::infinity();
+  gaps->smallest_gap_nodes = std::numeric_limits<double>::infinity();
   if (n == 0) return near;
   const double link = std::sqrt(2.0) * shape.dx * (1.0 + 1e-9);
   const double largest_radius = *std::max_element(packing.radii.begin(), packing.radii.end());
@@ -343,7 +343,7 @@ std::vector<std::vector<NearSphere>> near_spheres(const Packing& packing, const 
                                   : (shift[1] != 0.0 ? shift[1] > 0.0 : shift[2] > 0.0))
                : static_cast<std::size_t>(j) > s;
       if (first) {
-        gaps->min_gap_nodes = std::min(gaps->min_gap_nodes, gap / shape.dx);
+        gaps->smallest_gap_nodes = std::min(gaps->smallest_gap_nodes, gap / shape.dx);
         if (gap < shape.dx) ++gaps->narrow_pairs;
       }
     });

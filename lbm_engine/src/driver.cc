@@ -234,13 +234,13 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   result.fallback_links = links.fallback_links;
   result.memory_bytes = solver->bytes() + lattice.memory_bytes() + links.memory_bytes();
   result.narrow_gap_pairs = grid.gaps.narrow_pairs;
-  result.min_gap_nodes = grid.gaps.min_gap_nodes;
+  result.smallest_gap_nodes = grid.gaps.smallest_gap_nodes;
   result.narrow_gap_fluid_fraction = grid.gaps.narrow_fluid_fraction();
   if (grid.gaps.narrow_pairs > 0 || grid.gaps.narrow_fluid_nodes > 0) {
     result.warnings.push_back(
         std::to_string(grid.gaps.narrow_pairs) +
         " sphere pairs have gaps below one lattice spacing (smallest " +
-        fmt("%.3g", grid.gaps.min_gap_nodes) + " lattice units) and " +
+        fmt("%.3g", grid.gaps.smallest_gap_nodes) + " lattice units) and " +
         fmt("%.3g", 100.0 * grid.gaps.narrow_fluid_fraction()) +
         " % of the fluid nodes lie in gaps one node wide: under-resolved gaps, run as the "
         "literature does (first-order bounce-back there); extrapolate in d for the error");

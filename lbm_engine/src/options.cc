@@ -162,7 +162,7 @@ std::string RunResult::FullReport() const {
       << "momentum balance     " << format("%.3g", momentum_balance_rel) << " (relative)\n"
       << "mass change          " << format("%.3g", mass_change_rel) << " (relative)\n"
       << "sub-node gaps        " << narrow_gap_pairs << " sphere pairs below one node (smallest "
-      << format("%.3g", min_gap_nodes) << "), " << format("%.3g", 100.0 * narrow_gap_fluid_fraction)
+      << format("%.3g", smallest_gap_nodes) << "), " << format("%.3g", 100.0 * narrow_gap_fluid_fraction)
       << " % of fluid nodes in one-node gaps\n"
       << "fluid nodes / links  " << fluid_nodes << " / " << boundary_links << " (" << fallback_links
       << " interpolation fallbacks)\n"

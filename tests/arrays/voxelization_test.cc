@@ -737,7 +737,7 @@ TEST(Voxelization, TouchingSimpleCubicReportsItsContactsAsSubNodeGaps) {
   const VoxelGrid grid = voxelize(sc, options);
   expect_consistent(sc, grid);
   EXPECT_EQ(grid.gaps.narrow_pairs, 3);
-  EXPECT_NEAR(grid.gaps.min_gap_nodes, 0.0, 1e-9);
+  EXPECT_NEAR(grid.gaps.smallest_gap_nodes, 0.0, 1e-9);
   // Fluid nodes near the contacts have solid neighbours on both sides along some direction.
   EXPECT_GT(grid.gaps.narrow_fluid_nodes, 0);
   EXPECT_LT(grid.gaps.narrow_fluid_fraction(), 0.5);
@@ -762,7 +762,7 @@ TEST(Voxelization, LinksInSubNodeGapsTakeTheFirstSurfaceTheyCross) {
   const VoxelGrid grid = voxelize(packing, options);
   expect_consistent(packing, grid);
   EXPECT_EQ(grid.gaps.narrow_pairs, 2);
-  EXPECT_NEAR(grid.gaps.min_gap_nodes, 0.0, 0.31);
+  EXPECT_NEAR(grid.gaps.smallest_gap_nodes, 0.0, 0.31);
   EXPECT_GT(grid.gaps.narrow_fluid_nodes, 0);
   // A dense hard-sphere packing (phi = 0.55, near contacts) at a coarse resolution: some links do
   // clip a neighbour first, i.e. belong to a sphere that does not contain their solid node.

@@ -107,7 +107,7 @@ TEST_P(DenseSimpleCubic, ConvergesInResolutionThroughSubNodeGaps) {
     K.push_back(run.K);
     report("dense sc phi=" + fixed(phi, 4) + " d=" + fixed(sc.d, 1),
            "K=" + fixed(run.K) + " narrow pairs " + std::to_string(run.narrow_gap_pairs) +
-               " (smallest gap " + fixed(run.min_gap_nodes, 3) +
+               " (smallest gap " + fixed(run.smallest_gap_nodes, 3) +
                " nodes), fluid in one-node gaps " +
                fixed(100.0 * run.narrow_gap_fluid_fraction, 3) + " %, fallback links " +
                std::to_string(run.fallback_links) + " | " + format_run(run));
@@ -146,7 +146,7 @@ TEST_P(DenseRandom, ExtrapolatedMeanAgreesWithVanDerHoef2005) {
       report("dense random phi=" + fixed(phi, 2) + " seed=" + std::to_string(seed) +
                  " d=" + fixed(resolutions[k], 0),
              "F=" + fixed(run.F) + " narrow pairs " + std::to_string(run.narrow_gap_pairs) +
-                 " (smallest " + fixed(run.min_gap_nodes, 4) + " nodes), fluid in one-node gaps " +
+                 " (smallest " + fixed(run.smallest_gap_nodes, 4) + " nodes), fluid in one-node gaps " +
                  fixed(100.0 * run.narrow_gap_fluid_fraction, 3) + " % | " + format_run(run));
     }
   }

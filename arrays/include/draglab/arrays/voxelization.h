@@ -75,7 +75,7 @@ struct GapSummary {
   std::int64_t narrow_pairs = 0;
   /// Smallest surface gap over pairs closer than one link (sqrt 2 lattice spacings), in lattice
   /// units (< 0: overlap); +infinity if no pair is that close.
-  double min_gap_nodes = 0.0;
+  double smallest_gap_nodes = 0.0;
   /// Fluid nodes whose two neighbours along some D3Q19 direction are both solid.
   std::int64_t narrow_fluid_nodes = 0;
   std::int64_t fluid_nodes = 0;

@@ -169,7 +169,7 @@ struct RunResult {
   /// Sphere pairs (images included) with a surface gap below one lattice spacing; -1 if unknown
   /// (a grid not made by arrays::voxelize).
   std::int64_t narrow_gap_pairs = 0;
-  double min_gap_nodes = 0.0;  ///< Smallest gap of pairs closer than one link (lattice units).
+  double smallest_gap_nodes = 0.0;  ///< Smallest gap of pairs closer than one link (lattice units).
   /// Fraction of fluid nodes with solid nodes on both sides along a lattice direction.
   double narrow_gap_fluid_fraction = 0.0;
   double tau_minus = 0.0;             ///< TRT odd relaxation time (= tau for BGK / regularized).
