@@ -16,6 +16,10 @@ namespace draglab {
 namespace cli {
 namespace {
 
+// The literature laws every comparison shows as published.
+constexpr const char* kComparedLaws[] = {"vdh2004@1", "bvk2007@1", "tang2015@1", "tenneti2011@1",
+                                         "hill_koch_ladd@1"};
+
 struct FitArgs {
   std::string dataset_id;
   std::string data_csv;
@@ -28,6 +32,8 @@ struct FitArgs {
   int cv = 5;
   int bootstrap = 0;
   bool no_global = false;
+  std::string select = "auto";
+  bool compare_forms = false;
   std::string publish;
 };
 
@@ -103,6 +109,7 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
   options.cv_folds = args.cv;
   options.bootstrap = args.bootstrap;
   options.global_check = !args.no_global;
+  options.selection = fitter::selection_from_string(args.select);
   std::string why;
   if (!options.IsValid(&why)) {
     // Name the command-line options rather than the FitOptions fields.
@@ -161,6 +168,25 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
     }
   }
 
+  std::vector<fitter::FormComparisonRow> form_rows;
+  if (args.compare_forms) {
+    std::vector<std::shared_ptr<Law>> loaded;
+    std::vector<const Law*> published;
+    if (db) {
+      for (const char* ref : kComparedLaws) {
+        try {
+          loaded.push_back(db->load(ref, RangePolicy::kExtrapolate));
+          published.push_back(loaded.back().get());
+        } catch (const Error& e) {
+          ctx.warn(fmt::format("form comparison: {} skipped ({})", ref, e.what()));
+        }
+      }
+    }
+    ctx.info("comparing forms (4 refits with subset selection, " +
+             std::to_string(published.size()) + " laws as published)");
+    form_rows = fitter::compare_forms(points, published, args.cv, options.seed);
+  }
+
   LawRecord stored;
   if (publishing) {
     if (args.dataset_id.empty()) {
@@ -212,6 +238,13 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
         {"bootstrap_stddev", boot},
         {"notes", fit.notes},
         {"comparison", comparison}};
+    out["selection"] = {{"performed", fit.selection.performed},
+                        {"requested", fit.selection.requested},
+                        {"undetermined", fit.selection.undetermined},
+                        {"least_separable", fit.selection.inseparable},
+                        {"chosen", fit.selection.chosen}};
+    if (args.compare_forms)
+      out["form_comparison"] = nlohmann::json::parse(fitter::form_comparison_json_text(form_rows));
     ctx.print_json(out);
   } else {
     std::cout << fit.FullReport();
@@ -219,6 +252,11 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
     std::cout << fmt::format("  {:<22} {:>10} {:>10}\n", "law", "rms", "max");
     for (const Comparison& c : comparisons) {
       std::cout << fmt::format("  {:<22} {:>9.2f}% {:>9.2f}%\n", c.law, 100 * c.rms, 100 * c.max);
+    }
+    if (args.compare_forms) {
+      std::cout << "\nForms compared on the same points (refits with subset selection; CV = "
+                   "k-fold cross-validation):\n"
+                << fitter::form_comparison_markdown(form_rows);
     }
   }
   if (publishing) {
@@ -276,6 +314,15 @@ void add_fit_commands(CLI::App& app, CliContext& ctx) {
   cmd->add_option("--bootstrap", args->bootstrap, "Bootstrap resamples (0 = off)")
       ->capture_default_str();
   cmd->add_flag("--no-global", args->no_global, "Skip the NLopt multi-start global check");
+  cmd->add_option("--select", args->select,
+                  "auto: when the data do not determine every free parameter (95 % interval "
+                  "wider than the value), fit the largest determined subset (ties: lowest AICc) "
+                  "and print the candidates; off: fit the free set as given")
+      ->check(CLI::IsMember({"auto", "off"}))
+      ->capture_default_str();
+  cmd->add_flag("--compare-forms", args->compare_forms,
+                "Also compare Eq. 6 (n = 3 and n free), bvk2007 and tang2015 refitted, and the "
+                "literature laws as published, on the same points (rms, max, CV error, AICc)");
   cmd->add_option("--publish", args->publish,
                   "Store the fit as a new draft version of law NAME (freeze it with "
                   "`draglab law publish NAME@V`)");
@@ -284,6 +331,7 @@ void add_fit_commands(CLI::App& app, CliContext& ctx) {
       "  draglab fit --dataset 3fa2c01b9e77 --publish vdh2004_refit\n"
       "  draglab fit --data mydata.csv --free a,n,b,c0,c1,c2 --bootstrap 200\n"
       "  draglab fit --dataset 3fa2 --form bvk2007 --objective minimax --json\n"
+      "  draglab fit --dataset 3fa2 --compare-forms\n"
       "  draglab law publish vdh2004_refit@1");
   cmd->callback([&ctx, args] { ctx.action = [&ctx, args] { run_fit(ctx, *args); }; });
 

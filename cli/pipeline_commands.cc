@@ -333,6 +333,13 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
                     {"chi2_per_dof", fit.chi2_per_dof},
                     {"global_agrees", fit.global_agrees},
                     {"constraints_satisfied", fit.constraints_satisfied},
+                    {"selection",
+                     {{"performed", fit.selection.performed},
+                      {"requested", fit.selection.requested},
+                      {"undetermined", fit.selection.undetermined},
+                      {"least_separable", fit.selection.inseparable},
+                      {"chosen", fit.selection.chosen}}},
+                    {"undetermined", fit.undetermined()},
                     {"comparison", comparison},
                     {"report", report_file},
                     {"regress", checked ? regress_json(check) : nlohmann::json(nullptr)},
@@ -375,33 +382,24 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
   out << "\n";
   {
     // Say plainly which coefficients these data do not pin down (95 % half-width above the
-    // value), and the strongest correlation between free parameters (the usual reason).
-    std::vector<std::string> weak;
-    const std::size_t n = fit.names.size();
-    double worst = 0.0;
-    std::string pair;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!fit.is_free[i]) continue;
-      const char* label = fit.form == "vdh2004" && i < 8 ? seed_names[i] : fit.names[i].c_str();
-      if (0.5 * (fit.ci95_high[i] - fit.ci95_low[i]) > std::abs(fit.values[i])) {
-        weak.push_back(label);
-      }
-      for (std::size_t j = i + 1; j < n; ++j) {
-        if (!fit.is_free[j]) continue;
-        const double cii = fit.covariance[i * n + i], cjj = fit.covariance[j * n + j];
-        if (!(cii > 0.0 && cjj > 0.0)) continue;
-        const double r = fit.covariance[i * n + j] / std::sqrt(cii * cjj);
-        if (std::abs(r) > std::abs(worst)) {
-          worst = r;
-          pair = std::string(label) + " and " +
-                 (fit.form == "vdh2004" && j < 8 ? seed_names[j] : fit.names[j].c_str());
-        }
-      }
+    // value) and what the fitter did about it.
+    auto join = [](const std::vector<std::string>& items) {
+      std::string text;
+      for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;
+      return text;
+    };
+    const std::vector<std::string> weak = fit.undetermined();
+    if (fit.selection.performed) {
+      out << "  Subset selection: these data do not determine " << join(fit.selection.undetermined)
+          << " of " << join(fit.selection.requested)
+          << " (least separable: " << fit.selection.inseparable << ");\n  fitted the largest "
+          << "determined subset " << join(fit.selection.chosen)
+          << ", the others fixed at their printed values (draglab fit prints the candidates).\n";
     }
     if (!weak.empty()) {
-      std::string list;
-      for (const std::string& w : weak) list += (list.empty() ? "" : ", ") + w;
-      out << "  Not determined by these data (95 % interval wider than the value): " << list
+      std::string pair;
+      const double worst = fit.strongest_correlation(&pair);
+      out << "  Not determined by these data (95 % interval wider than the value): " << join(weak)
           << fmt::format(
                  ";\n  strongest correlation {:.3f} ({}). Fix some (draglab fit --free) or add "
                  "data over a wider phi and Re range (--preset standard).\n",

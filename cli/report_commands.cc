@@ -31,6 +31,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/fitter/fit.h"
 
 namespace draglab {
 namespace cli {
@@ -447,6 +448,16 @@ ReportOutcome make_report(const CliContext& ctx, const Database& db, ReportComma
                            rl.law->reference(), s.outside, in.dataset.points.size()));
     }
   }
+  // Forms refitted and laws as published on the same points (the seed's comparison of forms).
+  std::vector<fitter::FitPoint> fit_points;
+  for (const DatasetPoint& p : in.dataset.points)
+    fit_points.push_back({p.phi, p.re, p.F, p.F_uncertainty});
+  std::vector<const Law*> published;
+  for (const ReportLaw& rl : in.laws) {
+    if (rl.role == "reference") published.push_back(rl.law.get());
+  }
+  const nlohmann::json form_comparison = nlohmann::json::parse(
+      fitter::form_comparison_json_text(fitter::compare_forms(fit_points, published, 5, 1)));
   nlohmann::json bundle = {{"format", "draglab_report_bundle"},
                            {"format_version", 1},
                            {"generated_at", utc_now()},
@@ -455,6 +466,7 @@ ReportOutcome make_report(const CliContext& ctx, const Database& db, ReportComma
                            {"conventions", conventions_json()},
                            {"dataset", dataset_json(in.dataset, in.source)},
                            {"laws", laws},
+                           {"form_comparison", form_comparison},
                            {"missing_laws", in.missing},
                            {"campaign_id", in.campaign_id},
                            {"units", units_json(in.units)}};

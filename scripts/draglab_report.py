@@ -285,6 +285,10 @@ def fmt(x, digits=4):
     return "%.*g" % (digits, x) if finite(x) else "-"
 
 
+def pct(x):
+    return "%.2f %%" % (100 * x) if finite(x) else "-"
+
+
 def coefficient_table(law):
     lines = ["| parameter | value | 95 % interval | unit |", "|---|---|---|---|"]
     ci = law.get("ci95")
@@ -367,6 +371,24 @@ def write_markdown(bundle, out_dir, drawn, work_note):
             missing["reference"], missing.get("reason", "")))
     md += ["", "Points outside a law's validity box are evaluated by extrapolating its formula "
            "(range policy `extrapolate`); the figures draw those parts of the curves thin.", ""]
+    rows = bundle.get("form_comparison") or []
+    if rows:
+        md += ["## Forms compared", "",
+               "Each form refitted to these points (free parameters chosen by the subset "
+               "selection: the largest set the data determine, ties by AICc) beside the laws as "
+               "published. CV = 5-fold cross-validation RMS relative error (for a law as "
+               "published nothing was fitted, so it equals its RMS error).", "",
+               "| law | fitted parameters | RMS rel. error | max rel. error | CV RMS | AICc |",
+               "|---|---|---|---|---|---|"]
+        for r in rows:
+            if r.get("error"):
+                md.append("| %s | refit failed: %s | | | | |" % (r["label"], r["error"]))
+                continue
+            md.append("| %s | %s | %s | %s | %s | %s |" % (
+                r["label"], ", ".join(r.get("free") or []) or "none (as published)",
+                pct(r.get("rms_rel_err")), pct(r.get("max_rel_err")),
+                pct(r.get("cv_rms_rel_err")), fmt(r.get("aicc"))))
+        md.append("")
     md += ["## Conventions", ""]
     for key, text in bundle.get("conventions", {}).items():
         md.append("- %s: %s" % (key, text))

@@ -54,6 +54,14 @@ RobustLoss robust_loss_from_string(const std::string& s) {
               "loss '" + s + "' is unknown (allowed: none, huber, cauchy)");
 }
 
+const char* to_string(Selection s) { return s == Selection::kOff ? "off" : "auto"; }
+
+Selection selection_from_string(const std::string& s) {
+  if (s == "off") return Selection::kOff;
+  if (s == "auto") return Selection::kLargestDetermined;
+  throw Error(ErrorCode::kInvalidArgument, "selection '" + s + "' is unknown (allowed: auto, off)");
+}
+
 bool FitOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& message) {
     if (error) *error = message;
@@ -96,6 +104,7 @@ std::string FitOptions::to_json() const {
   j["cv_folds"] = cv_folds;
   j["bootstrap"] = bootstrap;
   j["seed"] = seed;
+  j["selection"] = to_string(selection);
   return j.dump();
 }
 
@@ -314,17 +323,10 @@ std::vector<double> relative_errors(const Law& law, const std::vector<FitPoint>&
   return errors;
 }
 
-FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options) {
-  std::string why;
-  if (!options.IsValid(&why)) throw Error(ErrorCode::kInvalidArgument, "fit options: " + why);
-  const LawForm& form = fit_form(options.form);
-  const int num_params = form.num_parameters;
+namespace internal {
 
-  Model model;
-  model.form = &form;
-  model.params = form.default_parameters();
-  for (const auto& [name, value] : options.initial)
-    model.params[parameter_index(form, name)] = value;
+std::vector<bool> requested_free(const LawForm& form, const FitOptions& options) {
+  const int num_params = form.num_parameters;
   std::vector<bool> is_free(num_params, false);
   if (options.free.empty()) {
     if (form.key() == "vdh2004") {
@@ -342,6 +344,29 @@ FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options
       is_free[k] = true;
     }
   }
+  if (std::none_of(is_free.begin(), is_free.end(), [](bool f) { return f; })) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "form " + form.key() +
+                    " has no free parameter to fit (it has no parameters, or --free names "
+                    "none): choose a form with parameters or name them with --free");
+  }
+  return is_free;
+}
+
+const LawForm& checked_form(const std::string& key) { return fit_form(key); }
+
+FitResult fit_requested(const std::vector<FitPoint>& points, const FitOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw Error(ErrorCode::kInvalidArgument, "fit options: " + why);
+  const LawForm& form = fit_form(options.form);
+  const int num_params = form.num_parameters;
+
+  Model model;
+  model.form = &form;
+  model.params = form.default_parameters();
+  for (const auto& [name, value] : options.initial)
+    model.params[parameter_index(form, name)] = value;
+  const std::vector<bool> is_free = requested_free(form, options);
   for (int k = 0; k < num_params; ++k) {
     if (!is_free[k]) continue;
     model.free_index.push_back(k);
@@ -565,6 +590,8 @@ FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options
   }
   return result;
 }
+
+}  // namespace internal
 
 }  // namespace fitter
 }  // namespace draglab

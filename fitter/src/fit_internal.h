@@ -73,6 +73,14 @@ bool minimax_fit(const Model& m, const std::vector<FitPoint>& points, const Cons
                  const std::vector<double>& z_start, std::vector<double>* z_out,
                  double* max_rel_err, std::string* message);
 
+/// The requested free parameters of `form` (FitOptions::free, or the form's default set); throws
+/// Error(kInvalidArgument) for an unknown or repeated name, or when none is free.
+std::vector<bool> requested_free(const LawForm& form, const FitOptions& options);
+/// The form to fit by key; throws Error(kInvalidArgument) for an unknown or polydisperse form.
+const LawForm& checked_form(const std::string& key);
+/// fit_law with the requested free set as it is (no subset selection).
+FitResult fit_requested(const std::vector<FitPoint>& points, const FitOptions& options);
+
 }  // namespace internal
 }  // namespace fitter
 }  // namespace draglab

@@ -57,6 +57,40 @@ std::string FitResult::FullReport() const {
            "\n";
   }
   out += "Ceres: " + ceres_report + "\n";
+  if (selection.performed) {
+    auto join = [](const std::vector<std::string>& items) {
+      std::string text;
+      for (std::size_t i = 0; i < items.size(); ++i) text += (i ? "," : "") + items[i];
+      return text;
+    };
+    out += fmt::format(
+        "Subset selection: requested {} not determined ({} not; least separable: {}); the "
+        "largest determined subset is fitted (ties: lowest AICc). Candidates ({} fitted):\n",
+        join(selection.requested),
+        selection.undetermined.empty() ? std::string("flat direction")
+                                       : join(selection.undetermined),
+        selection.inseparable, selection.candidates.size());
+    out += fmt::format("  {:<28} {:>3} {:>12} {:>12} {:>9}  {}\n", "free", "k", "chi2", "AICc",
+                       "rms", "determined");
+    const std::size_t shown = std::min<std::size_t>(selection.candidates.size(), 12);
+    for (std::size_t i = 0; i < shown; ++i) {
+      const SubsetCandidate& c = selection.candidates[i];
+      const bool chosen = c.free == selection.chosen;
+      if (!c.fitted) {
+        out += fmt::format("  {:<28} {:>3} {:>12} {:>12} {:>9}  fit failed\n", join(c.free),
+                           c.free.size(), "-", "-", "-");
+        continue;
+      }
+      out += fmt::format("  {:<28} {:>3} {:>12.6g} {:>12.6g} {:>8.3f}%  {}{}\n", join(c.free),
+                         c.free.size(), c.chi2, c.aicc, 100 * c.rms_rel_err,
+                         c.determined ? "yes" : "no (" + join(c.undetermined) + ")",
+                         chosen ? "  <- chosen" : "");
+    }
+    if (shown < selection.candidates.size()) {
+      out += fmt::format("  ({} more, all smaller or undetermined)\n",
+                         selection.candidates.size() - shown);
+    }
+  }
   for (const std::string& note : notes) out += "note: " + note + "\n";
   return out;
 }
@@ -96,6 +130,12 @@ LawRecord fitted_record(const FitResult& result, const FitOptions& options, cons
     if (result.is_free[k]) free.push_back(result.names[k]);
   }
   settings["free_parameters"] = free;
+  if (result.selection.performed) {
+    settings["selection"] = {{"requested", result.selection.requested},
+                             {"undetermined", result.selection.undetermined},
+                             {"least_separable", result.selection.inseparable},
+                             {"chosen", result.selection.chosen}};
+  }
   // The fit's own 95 % intervals (Student t with the fit's dof), so that reports show exactly
   // what the fitter reported rather than re-deriving them from the covariance.
   nlohmann::json ci95 = nlohmann::json::object();

@@ -75,6 +75,53 @@ check "publishing twice is refused (immutable: exit 1)" 1 "$draglab" --db "$db" 
 if grep -q immutable "$work/err"; then passed=$((passed + 1)); else
   echo "FAIL publishing twice: no 'immutable' in the message"; failures=$((failures + 1)); fi
 
+# Narrow data (phi <= 0.3, Re <= 5 of the same Eq. 6): the fit says which coefficients are not
+# determined and fits the largest determined subset; --select off fits all five as asked.
+"$py" - "$work/eq6.csv" "$work/narrow.csv" <<'PY'
+import sys
+rows = [l for l in open(sys.argv[1]) if not l.startswith("#")]
+with open(sys.argv[2], "w") as f:
+    f.write(rows[0])
+    for l in rows[1:]:
+        phi, re = (float(x) for x in l.split(",")[:2])
+        if phi <= 0.3 and re <= 5.0:
+            f.write(l)
+PY
+check "fit selects a determined subset" 0 "$draglab" --db "$db" fit --data "$work/narrow.csv" --json
+cp "$work/out" "$work/narrow.json"
+pycheck "selection: chosen subset, every interval narrower than its value" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/narrow.json"))
+s = r["selection"]
+assert s["performed"] and s["undetermined"], s
+assert set(r["free"]) == set(s["chosen"]) and len(s["chosen"]) < 5, (r["free"], s)
+for k in r["free"]:
+    lo, hi = r["ci95"][k]
+    assert (hi - lo) / 2 < abs(r["params"][k]), (k, lo, hi)
+'
+check "fit --select off fits the requested set" 0 "$draglab" --db "$db" fit --data "$work/narrow.csv" \
+  --select off --json
+pycheck "select off: all five free" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/out"))
+assert sorted(r["free"]) == ["c10", "c11", "c12", "k0", "k1"] and not r["selection"]["performed"], r
+'
+check "fit --compare-forms" 0 "$draglab" --db "$db" fit --data "$work/eq6.csv" --compare-forms --json
+pycheck "form comparison: Eq. 6 refit fits its own data, every row present" '
+import json, sys
+rows = json.load(open(sys.argv[1] + "/out"))["form_comparison"]
+labels = [r["label"] for r in rows]
+assert labels[:4] == ["Eq. 6 (vdh2004) refit, n = 3", "Eq. 6 (vdh2004) refit, n free",
+                      "bvk2007 refit", "tang2015 refit"], labels
+assert "vdh2004@1 as published" in labels and "tang2015@1 as published" in labels, labels
+assert rows[0]["error"] == "" and rows[0]["rms_rel_err"] < 1e-6, rows[0]
+printed = rows[labels.index("vdh2004@1 as published")]
+assert printed["rms_rel_err"] > 0.01 and printed["cv_rms_rel_err"] == printed["rms_rel_err"], printed
+'
+check "fit --select bogus" 2 "$draglab" --db "$db" fit --data "$work/eq6.csv" --select bogus
+check "fit of a form with nothing to fit" 2 "$draglab" --db "$db" fit --data "$work/eq6.csv" \
+  --form schiller_naumann
+
 # Bad input: exit 2, and the database is not changed.
 before="$(md5sum "$db" | cut -d" " -f1)"
 check "unknown form" 2 "$draglab" --db "$db" fit --data "$work/eq6.csv" --form nosuch --publish x

@@ -104,6 +104,8 @@ TEST(Fit, IntervalsCoverTheTruthAtAbout95Percent) {
   options.global_check = false;
   options.check_constraints = false;
   options.cv_folds = 0;
+  // Coverage is a property of a fixed free set; a data-dependent subset selection is not.
+  options.selection = Selection::kOff;
   const int draws = 200;
   std::vector<int> covered(truth.size(), 0);
   std::vector<int> free_index;
@@ -305,8 +307,10 @@ TEST(Fit, StokesOnlyDataCannotDetermineInertialParameters) {
   for (double phi : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6}) grid.push_back({phi, 0.0});
   const auto points =
       synthetic("vdh2004", find_law_form("vdh2004").default_parameters(), 0.01, 2, grid);
+  FitOptions off;
+  off.selection = Selection::kOff;
   try {
-    fit_law(points, FitOptions());
+    fit_law(points, off);
     FAIL() << "expected an error";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
@@ -320,6 +324,113 @@ TEST(Fit, StokesOnlyDataCannotDetermineInertialParameters) {
   FitOptions options;
   options.free = {"a", "b"};
   EXPECT_NO_THROW(fit_law(points, options));
+  // With the selection (the default) the same request fits the Stokes pair k0, k1 and says why.
+  const FitResult selected = fit_law(points, FitOptions());
+  EXPECT_TRUE(selected.selection.performed);
+  EXPECT_EQ(selected.selection.chosen, (std::vector<std::string>{"k0", "k1"}));
+  EXPECT_TRUE(selected.undetermined().empty());
+}
+
+// Eq. 6's five C0/C1 coefficients on a grid like the quick preset's (phi 0.1-0.4, Re 0-25, 3 %
+// noise): Re spans too little for c10, c11, c12 and b to separate. The selection must return a
+// fit whose every 95 % interval is narrower than its value, the largest such subset (no larger
+// determined candidate), and the lowest AICc of that size; on the wide campaign grid it must not
+// interfere (identical to the plain fit).
+TEST(Fit, SelectionFitsTheLargestDeterminedSubset) {
+  std::vector<std::pair<double, double>> grid;
+  for (double phi : {0.1, 0.15, 0.2, 0.3, 0.4}) {
+    for (double re : {0.0, 5.0, 15.0, 25.0}) grid.push_back({phi, re});
+  }
+  const auto points = synthetic("vdh2004", with("vdh2004", kVdhTruth), 0.03, 21, grid);
+  FitOptions off;
+  off.selection = Selection::kOff;
+  off.cv_folds = 0;
+  const FitResult plain = fit_law(points, off);
+  ASSERT_FALSE(plain.undetermined().empty()) << plain.FullReport();
+
+  FitOptions options;
+  options.cv_folds = 0;
+  const FitResult r = fit_law(points, options);
+  const SelectionReport& s = r.selection;
+  ASSERT_TRUE(s.performed);
+  EXPECT_EQ(s.undetermined, plain.undetermined());
+  EXPECT_FALSE(s.inseparable.empty());
+  EXPECT_TRUE(r.undetermined().empty()) << r.FullReport();
+  EXPECT_GE(s.chosen.size(), 2u);
+  EXPECT_LT(s.chosen.size(), 5u);
+  EXPECT_EQ(s.candidates.size(), 31u);  // every non-empty subset of five
+  const SubsetCandidate* chosen = nullptr;
+  for (const SubsetCandidate& c : s.candidates) {
+    if (c.free == s.chosen) chosen = &c;
+  }
+  ASSERT_NE(chosen, nullptr);
+  for (const SubsetCandidate& c : s.candidates) {
+    if (!c.determined) continue;
+    EXPECT_LE(c.free.size(), s.chosen.size());
+    if (c.free.size() == s.chosen.size()) EXPECT_GE(c.aicc, chosen->aicc);
+  }
+  // The chosen parameters are free in the result, the others at their printed values.
+  const auto printed = find_law_form("vdh2004").default_parameters();
+  for (std::size_t k = 0; k < r.names.size(); ++k) {
+    const bool in_chosen =
+        std::find(s.chosen.begin(), s.chosen.end(), r.names[k]) != s.chosen.end();
+    EXPECT_EQ(r.is_free[k], in_chosen) << r.names[k];
+    if (!in_chosen) EXPECT_EQ(r.values[k], printed[k]) << r.names[k];
+  }
+  EXPECT_NE(r.FullReport().find("<- chosen"), std::string::npos);
+  const LawRecord rec = fitted_record(r, options, "quick_like", "id", "hash", points);
+  EXPECT_NE(rec.provenance.fitter_settings.find("\"chosen\""), std::string::npos);
+
+  // Wide data: nothing to select, and the fit is the plain fit exactly.
+  const auto wide = synthetic("vdh2004", with("vdh2004", kVdhTruth), 0.01, 22);
+  const FitResult a = fit_law(wide, options), b = fit_law(wide, off);
+  EXPECT_FALSE(a.selection.performed);
+  EXPECT_EQ(a.values, b.values);
+  EXPECT_EQ(a.ci95_high, b.ci95_high);
+}
+
+// A form with nothing free is bad input, not a crash.
+TEST(Fit, FormWithoutFreeParametersIsAClearError) {
+  const auto points = synthetic("vdh2004", with("vdh2004", kVdhTruth), 0.02, 3);
+  FitOptions options;
+  options.form = "schiller_naumann";
+  try {
+    fit_law(points, options);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("no free parameter"), std::string::npos) << e.what();
+  }
+}
+
+// compare_forms on data made by bvk2007: its own refit fits to the noise level, the published
+// bvk2007 is within the noise too, and every row is there.
+TEST(Fit, CompareFormsRanksTheTrueFormFirst) {
+  const auto points = synthetic("bvk2007", find_law_form("bvk2007").default_parameters(), 0.01, 5,
+                                campaign_grid(6, 6));
+  LawRecord record;
+  record.name = "bvk2007";
+  record.version = 1;
+  record.form = "bvk2007";
+  const LawForm& form = find_law_form("bvk2007");
+  for (std::size_t k = 0; k < form.description.parameters.size(); ++k) {
+    record.parameters.push_back({form.description.parameters[k].name, form.default_parameters()[k],
+                                 form.description.parameters[k].unit});
+  }
+  record.validity = form.description.validity;
+  record.convention = form.convention;
+  const Law law(record, RangePolicy::kExtrapolate);
+  const auto rows = compare_forms(points, {&law}, 5, 1);
+  ASSERT_EQ(rows.size(), 5u);
+  for (const auto& row : rows) EXPECT_TRUE(row.error.empty()) << row.label << ": " << row.error;
+  EXPECT_TRUE(rows[2].refitted);
+  EXPECT_EQ(rows[2].form, "bvk2007");
+  EXPECT_LT(rows[2].rms_rel_err, 0.015);
+  EXPECT_LT(rows[2].cv_rms_rel_err, 0.02);
+  EXPECT_LT(rows[4].rms_rel_err, 0.015);
+  EXPECT_EQ(rows[4].cv_rms_rel_err, rows[4].rms_rel_err);
+  const std::string table = form_comparison_markdown(rows);
+  EXPECT_NE(table.find("bvk2007@1 as published"), std::string::npos) << table;
 }
 
 TEST(Fit, RecordCarriesProvenanceAndEvaluatesTheFit) {
@@ -398,6 +509,7 @@ TEST(Fit, RobustLossDownweightsAnOutlier) {
   points[10].F *= 1.5;  // a 50 sigma outlier
   FitOptions options;
   options.cv_folds = 0;
+  options.selection = Selection::kOff;  // the same free set for both losses
   const FitResult plain = fit_law(points, options);
   options.loss = RobustLoss::kCauchy;
   const FitResult robust = fit_law(points, options);

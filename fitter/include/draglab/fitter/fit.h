@@ -44,6 +44,18 @@ enum class RobustLoss { kNone, kHuber, kCauchy };
 const char* to_string(RobustLoss l);
 RobustLoss robust_loss_from_string(const std::string& s);  ///< "none", "huber", "cauchy"
 
+/// What fit_law does when the data do not determine every requested free parameter (a 95 %
+/// interval wider than the value, or a flat direction of the cost).
+enum class Selection {
+  kOff,  ///< Fit the requested set as it is (a flat direction is an error).
+  /// Fit the largest subset of the requested set whose every 95 % interval is narrower than its
+  /// value, ties broken by the lowest AICc; the others stay at their starting values. Every
+  /// subset is tried (up to 10 requested parameters; beyond, backward elimination).
+  kLargestDetermined,
+};
+const char* to_string(Selection s);
+Selection selection_from_string(const std::string& s);  ///< "off", "auto"
+
 /// How to fit: form, free/fixed parameters, objective, robust loss, and which checks to run.
 struct FitOptions {
   std::string form = "vdh2004";  ///< Law-form key.
@@ -61,8 +73,37 @@ struct FitOptions {
   int cv_folds = 5;               ///< k-fold cross-validation (0 = off; needs points >= 2 folds).
   int bootstrap = 0;              ///< Bootstrap resamples for a covariance check (0 = off).
   unsigned seed = 1;              ///< Seeds the folds, the bootstrap and the global search.
+  Selection selection = Selection::kLargestDetermined;
   bool IsValid(std::string* error) const;
   std::string to_json() const;  ///< Canonical JSON text (stored as the law's fitter settings).
+};
+
+/// One subset of the requested free parameters, fitted by the selection (least squares only).
+struct SubsetCandidate {
+  std::vector<std::string> free;  ///< Canonical names, in the form's order.
+  bool fitted = false;            ///< false: the fit failed (flat direction, too few points).
+  bool determined = false;        ///< Fitted and every 95 % interval narrower than the value.
+  double chi2 = 0.0;
+  /// Akaike's criterion with the small-sample correction, chi2 + 2k + 2k(k+1)/(N-k-1): lower is
+  /// better; differences below 2 are not significant.
+  double aicc = 0.0;
+  double rms_rel_err = 0.0;
+  std::vector<std::string> undetermined;  ///< Free parameters with intervals wider than values.
+  std::string why;                        ///< Why the fit failed, if it did.
+};
+
+/// What the subset selection found and chose (FitOptions::selection).
+struct SelectionReport {
+  /// true when the requested set was not determined and a subset was fitted instead.
+  bool performed = false;
+  std::vector<std::string> requested;     ///< The requested free set (canonical names).
+  std::vector<std::string> undetermined;  ///< Of the requested set, in its own fit.
+  /// The pair the data separate least in the requested fit, e.g. "k0 and c10 (correlation
+  /// -0.998)"; or the flat direction's parameters when that fit had none.
+  std::string inseparable;
+  std::vector<std::string> chosen;
+  /// Every subset tried: determined ones first, then by size (largest first), then AICc.
+  std::vector<SubsetCandidate> candidates;
 };
 
 /// Outcome of fit_law. Parameters are dimensionless (as in the form); errors are relative
@@ -96,13 +137,19 @@ struct FitResult {
   /// What the fitter decided along the way (covariance scaled by chi2/dof, Ceres restarted from
   /// the global optimum, CV skipped, minimax outcome), one sentence each.
   std::vector<std::string> notes;
+  SelectionReport selection;
+  /// Free parameters whose 95 % interval is wider than their value (half-width > |value|).
+  std::vector<std::string> undetermined() const;
+  /// The largest |correlation| between two free parameters (0 with fewer than two), and the pair.
+  double strongest_correlation(std::string* pair) const;
   std::string BriefReport() const;
   std::string FullReport() const;
 };
 
 /// Fits `points` as the options say. Throws Error(kInvalidArgument) for invalid options, an
-/// unknown form or parameter (listing the valid names), non-positive F or sigma, or fewer points
-/// than free parameters + 1; Error(kOutOfValidity) if the optimizer does not converge.
+/// unknown form or parameter (listing the valid names), no free parameter, non-positive F or
+/// sigma, fewer points than free parameters + 1, or (selection on) no determined subset;
+/// Error(kOutOfValidity) if the optimizer does not converge.
 FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options);
 
 /// Index of parameter `name_or_alias` of `form`; throws Error(kInvalidArgument) listing names.
@@ -111,6 +158,34 @@ int parameter_index(const LawForm& form, const std::string& name_or_alias);
 /// Relative errors F(phi_i, Re_i)/F_i - 1 of a law against the points (for comparisons). Uses the
 /// law's range policy: load it with RangePolicy::kExtrapolate to compare outside its box.
 std::vector<double> relative_errors(const Law& law, const std::vector<FitPoint>& points);
+
+/// One row of compare_forms: a form refitted to the points (with the subset selection), or a
+/// stored law evaluated as published. Errors are relative (0.05 = 5 %).
+struct FormComparisonRow {
+  std::string label;  ///< e.g. "Eq. 6 (vdh2004) refit, n = 3" or "bvk2007@1 as published"
+  std::string form;
+  bool refitted = false;
+  std::vector<std::string> free;  ///< The fitted (selected) free parameters; empty as published.
+  double rms_rel_err = 0.0, max_rel_err = 0.0;
+  /// k-fold cross-validation rms of a refit; for a law as published nothing was fitted to these
+  /// points, so its prediction error is its rms error itself.
+  double cv_rms_rel_err = -1.0;
+  double aicc = 0.0;  ///< Refits only (0 as published).
+  std::string error;  ///< Why a refit failed (then the numbers are not meaningful).
+};
+
+/// The comparison of part of the seed's Section 3 on one dataset: Eq. 6 refitted with n = 3 and
+/// with n free, bvk2007 and tang2015 refitted (each with FitOptions' defaults and the subset
+/// selection), then each law of `published` as published (evaluated outside its box too: load
+/// them with RangePolicy::kExtrapolate). A refit that fails is a row with `error` set.
+std::vector<FormComparisonRow> compare_forms(const std::vector<FitPoint>& points,
+                                             const std::vector<const Law*>& published, int cv_folds,
+                                             unsigned seed);
+/// The rows as a Markdown table (law, fitted parameters, rms, max, CV rms, AICc).
+std::string form_comparison_markdown(const std::vector<FormComparisonRow>& rows);
+/// The rows as JSON text: an array of {label, form, refitted, free, rms_rel_err, max_rel_err,
+/// cv_rms_rel_err (null if none), aicc (null as published), error}.
+std::string form_comparison_json_text(const std::vector<FormComparisonRow>& rows);
 
 /// A draft record of the fitted law: form, fitted values, covariance, the form's convention and
 /// validity box narrowed to the data's (phi, Re) range, provenance kind "fitted" with the given
