@@ -390,9 +390,10 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
     };
     const std::vector<std::string> weak = fit.undetermined();
     if (fit.selection.performed) {
-      out << "  Subset selection: these data do not determine " << join(fit.selection.undetermined)
-          << " of " << join(fit.selection.requested)
-          << " (least separable: " << fit.selection.inseparable << ");\n  fitted the largest "
+      out << "  Subset selection: fitting all of " << join(fit.selection.requested) << " leaves "
+          << join(fit.selection.undetermined)
+          << " with 95 % intervals wider than their values\n  (least separable: "
+          << fit.selection.inseparable << "); fitted the largest "
           << "determined subset " << join(fit.selection.chosen)
           << ", the others fixed at their printed values (draglab fit prints the candidates).\n";
     }

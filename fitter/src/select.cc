@@ -209,12 +209,13 @@ FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options
       fixed.push_back(name);
   }
   result.notes.push_back(fmt::format(
-      "Subset selection: the data do not determine {} of the requested {} ({}); fitted the "
-      "largest determined subset {} (AICc {:.4g}, lowest of its size), with {} fixed at their "
-      "starting values.",
-      report.undetermined.empty() ? std::string("all") : join(report.undetermined),
-      join(report.requested), report.inseparable.empty() ? "flat direction" : report.inseparable,
-      join(report.chosen), best.aicc, join(fixed)));
+      "Subset selection: fitting all of {} leaves {} with 95 % intervals wider than their "
+      "values (least separable: {}); fitted the largest determined subset {} (AICc {:.4g}, "
+      "lowest of its size), with {} fixed at their starting values.",
+      join(report.requested),
+      report.undetermined.empty() ? std::string("a flat direction") : join(report.undetermined),
+      report.inseparable.empty() ? "-" : report.inseparable, join(report.chosen), best.aicc,
+      join(fixed)));
   result.selection = report;
   return result;
 }
