@@ -17,6 +17,7 @@
 #include "cli/cli_context.h"
 #include "cli/file_util.h"
 #include "cli/progress.h"
+#include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
@@ -402,7 +403,29 @@ void run_dataset_show(const CliContext& ctx, const std::string& id) {
 void run_dataset_export(const CliContext& ctx, const std::string& id, const std::string& out) {
   std::unique_ptr<Database> db = ctx.open_database(true);
   const Dataset d = load_dataset(*db, id);
-  write_dataset_csv(d, out.empty() ? "/dev/stdout" : out);
+  // Provenance travels with the file: how it was built, from which campaign spec, by which code.
+  std::vector<std::string> provenance = {
+      fmt::format("built {} by draglab {}; method {}", d.created_at, d.code_version, d.method),
+      fmt::format("exported by draglab {}: draglab dataset export {}", kDragDbVersion, d.id)};
+  if (d.campaign_id != 0) {
+    try {
+      const campaign::CampaignStatus c =
+          campaign::campaign_status(*db, std::to_string(d.campaign_id));
+      provenance.push_back(fmt::format(
+          "campaign {} (id {}), spec hash {}, created {}: {} of {} units done, {} failed, {:.0f} "
+          "core-seconds of LBM",
+          c.name, c.id, c.spec_hash, c.created_at, c.units_done, c.units_total, c.units_failed,
+          c.wall_s));
+    } catch (const Error& e) {
+      provenance.push_back(
+          fmt::format("campaign {}: not in this database ({})", d.campaign_id, e.what()));
+    }
+  }
+  if (out.empty()) {
+    std::cout << dataset_csv_text(d, provenance);
+    return;
+  }
+  write_dataset_csv(d, out, provenance);
   if (!out.empty())
     ctx.info(fmt::format("wrote dataset {} ({} points) to {}", d.id, d.points.size(), out));
 }

@@ -125,6 +125,20 @@ assert sum(1 for l in laws if l["name"] == "eq6_tiny") == 1
 # coefficients as printed) becomes the scene's baseline with a U_mf tolerance of 0, so the
 # re-run's eq6_tiny@1, whose U_mf differs, has moved.
 dataset_id="$("$py" -c 'import json,sys; print(json.load(open(sys.argv[1]))["dataset"])' "$work/first.json")"
+
+# Export to stdout (a pipe, not a file to rename over) and to a file carry the provenance header;
+# re-importing either into a fresh database reproduces the dataset id.
+check "dataset export to stdout" 0 "$draglab" --db "$db" dataset export "$dataset_id"
+cp "$work/out" "$work/exported.csv"
+check "dataset export --out" 0 "$draglab" --db "$db" dataset export "$dataset_id" --out "$work/file.csv"
+ok "stdout and file exports agree" cmp -s "$work/exported.csv" "$work/file.csv"
+ok "the export names the campaign spec hash" grep -q "^# campaign tiny (id 1), spec hash [0-9a-f]\{64\}" "$work/exported.csv"
+ok "the export names the code version" grep -q "^# built .* by draglab " "$work/exported.csv"
+check "dataset import into a fresh database" 0 "$draglab" --db "$work/fresh.db" dataset import "$work/exported.csv" --json
+pycheck "re-import reproduces the dataset id" "
+import json, sys
+assert json.load(open(sys.argv[1] + '/out'))['id'] == '$dataset_id'
+"
 check "refit eq6_tiny@2" 0 "$draglab" --db "$db" -q fit --dataset "$dataset_id" --free k0 --cv 0 --no-global \
   --publish eq6_tiny
 check "publish eq6_tiny@2" 0 "$draglab" --db "$db" -q law publish eq6_tiny@2

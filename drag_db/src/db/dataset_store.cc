@@ -324,11 +324,15 @@ Dataset read_dataset_csv(const std::string& path) {
   return dataset;
 }
 
-void write_dataset_csv(const Dataset& dataset, const std::string& path) {
+std::string dataset_csv_text(const Dataset& dataset, const std::vector<std::string>& provenance) {
   std::ostringstream out;
   out << "# draglab dataset " << dataset.id << " (" << dataset.name << "), hash " << dataset.hash
       << "\n# canonical drag-only F = F_d/(3 pi mu d eps u); Re = rho eps d u/mu (superficial); "
          "uncertainties absolute, 1 sigma\n";
+  for (const std::string& line : provenance) {
+    std::istringstream lines(line);
+    for (std::string part; std::getline(lines, part);) out << "# " << part << "\n";
+  }
   out << "phi,re_target,re,F,F_standard_error,F_discretisation_error,F_uncertainty,realizations,"
          "resolutions,F_at_resolution,order,extrapolation,wall_s\n";
   auto joined = [](const std::vector<double>& v) {
@@ -343,6 +347,12 @@ void write_dataset_csv(const Dataset& dataset, const std::string& path) {
         << joined(p.F_at_resolution) << ',' << exact(p.order) << ',' << p.extrapolation << ','
         << exact(p.wall_s) << '\n';
   }
+  return out.str();
+}
+
+void write_dataset_csv(const Dataset& dataset, const std::string& path,
+                       const std::vector<std::string>& provenance) {
+  const std::string text = dataset_csv_text(dataset, provenance);
   // Write to a temporary name and rename, so a reader never sees half a file.
   const std::string temporary = path + ".tmp";
   {
@@ -351,7 +361,7 @@ void write_dataset_csv(const Dataset& dataset, const std::string& path) {
       throw Error(ErrorCode::kInvalidArgument,
                   "cannot write '" + path + "': " + std::strerror(errno));
     }
-    file << out.str();
+    file << text;
     if (!file.flush()) {
       throw Error(ErrorCode::kDatabase, "writing '" + path + "' failed: " + std::strerror(errno));
     }

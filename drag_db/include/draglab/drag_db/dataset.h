@@ -22,11 +22,11 @@ class Database;
 
 /// One (phi, Re) point. Absolute uncertainties (same units as F), 1 sigma.
 struct DatasetPoint {
-  double phi = 0.0;        ///< Solids fraction (exact, of the packings).
-  double re_target = 0.0;  ///< Requested Re (0 = Stokes flow).
-  double re = 0.0;         ///< Mean achieved Re = U d / nu (superficial), 0 for Stokes runs.
-  double F = 0.0;          ///< Canonical drag-only F, resolution-extrapolated mean.
-  double F_standard_error = 0.0;        ///< Over realizations (0 if only one).
+  double phi = 0.0;               ///< Solids fraction (exact, of the packings).
+  double re_target = 0.0;         ///< Requested Re (0 = Stokes flow).
+  double re = 0.0;                ///< Mean achieved Re = U d / nu (superficial), 0 for Stokes runs.
+  double F = 0.0;                 ///< Canonical drag-only F, resolution-extrapolated mean.
+  double F_standard_error = 0.0;  ///< Over realizations (0 if only one).
   double F_discretisation_error = 0.0;  ///< Resolution-extrapolation (or engine) estimate.
   double F_uncertainty = 0.0;           ///< sqrt(standard_error^2 + discretisation_error^2).
   int realizations = 0;                 ///< Converged realizations that entered the mean.
@@ -38,8 +38,8 @@ struct DatasetPoint {
 };
 
 struct Dataset {
-  std::string id;    ///< First 12 hex digits of `hash`.
-  std::string hash;  ///< SHA-256 over the canonical JSON of the points (dataset_hash).
+  std::string id;                ///< First 12 hex digits of `hash`.
+  std::string hash;              ///< SHA-256 over the canonical JSON of the points (dataset_hash).
   std::int64_t campaign_id = 0;  ///< 0 for imported data.
   std::string name;              ///< Campaign name or the imported file's stem.
   std::string method;            ///< How it was built: JSON text (extrapolation, options).
@@ -69,7 +69,13 @@ std::vector<Dataset> list_datasets(const Database& db);
 /// naming the line and column for malformed input (non-numeric, phi outside (0, 0.74], Re < 0,
 /// F <= 0, uncertainty <= 0).
 Dataset read_dataset_csv(const std::string& path);
-/// Writes every field of the points (resolutions joined with ';').
-void write_dataset_csv(const Dataset& dataset, const std::string& path);
+/// The CSV text of every field of the points (resolutions joined with ';'), after a header of
+/// '#' lines: id, hash and conventions, then each `provenance` line (multi-line entries split).
+std::string dataset_csv_text(const Dataset& dataset,
+                             const std::vector<std::string>& provenance = {});
+/// dataset_csv_text written to a regular file `path` through a temporary name and a rename (a
+/// reader never sees half a file; not for devices or pipes: print dataset_csv_text instead).
+void write_dataset_csv(const Dataset& dataset, const std::string& path,
+                       const std::vector<std::string>& provenance = {});
 
 }  // namespace draglab
