@@ -64,10 +64,11 @@ std::string FitResult::FullReport() const {
       return text;
     };
     out += fmt::format(
-        "Subset selection: requested {} not determined ({} not; least separable: {}); the "
-        "largest determined subset is fitted (ties: lowest AICc). Candidates ({} fitted):\n",
+        "Subset selection: fitting all of {} leaves {} with 95 % intervals wider than their "
+        "values (least separable: {}); the largest determined subset is fitted (ties: lowest "
+        "AICc). Candidates ({} fitted):\n",
         join(selection.requested),
-        selection.undetermined.empty() ? std::string("flat direction")
+        selection.undetermined.empty() ? std::string("a flat direction")
                                        : join(selection.undetermined),
         selection.inseparable, selection.candidates.size());
     out += fmt::format("  {:<28} {:>3} {:>12} {:>12} {:>9}  {}\n", "free", "k", "chi2", "AICc",
