@@ -13,6 +13,7 @@
 
 #include "cli/cli_context.h"
 #include "cli/progress.h"
+#include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
@@ -170,10 +171,6 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
 
 void run_run(const CliContext& ctx, const SceneArgs& args) {
   const Scene scene = consumers::load_scene(args.scene_path);
-  if (scene.solver != "dpm")
-    throw Error(ErrorCode::kInvalidArgument,
-                "scene.solver: `scene run` supports \"dpm\" only (this release), got \"" +
-                    scene.solver + "\"");
   if (args.duration_s < 0.0) throw UsageError("--duration must be >= 0 (0: the scene's)");
   const std::string ref = args.laws.empty() ? scene.laws.front() : args.laws;
   if (ref.find(',') != std::string::npos)
@@ -183,12 +180,11 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
   std::shared_ptr<const Law> law =
       db->load(ref, range_policy_from_string(scene.range_policy), &warning);
   if (!warning.empty()) ctx.warn(warning);
-  consumers::DpmOptions options;
+  consumers::BedRunOptions options;
   options.duration_s = args.duration_s;
-  consumers::DpmSimulation sim(scene, law, options);
   ProgressLine progress(!ctx.quiet);
-  const consumers::DpmResult r =
-      sim.Run([&](double f, const std::string& stage) { progress.update(f, stage); });
+  const consumers::BedResult r = consumers::run_bed_model(
+      scene, law, options, [&](double f, const std::string& stage) { progress.update(f, stage); });
   progress.finish();
   // Consumer results are provenance like laws and datasets: scene text, law content, code
   // version and metrics, stored (immutable) unless asked not to.
@@ -201,63 +197,34 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
     stored.law_name = law->record().name;
     stored.law_version = law->record().version;
     stored.law_content_hash = law->record().content_hash;
-    stored.metrics = consumers::consumer_metrics_of(r);
-    stored.result_json = consumers::dpm_result_json(r);
+    stored.metrics = r.metrics;
+    stored.result_json = r.result_json;
     result_id = store_consumer_result(*db, stored).id;
   }
-  if (r.void_fraction_clamps > 0)
-    ctx.warn(fmt::format("{} cell void fractions were raised to the minimum (dense packing)",
-                         r.void_fraction_clamps));
+  const nlohmann::json full = nlohmann::json::parse(r.result_json);
+  const std::int64_t clamps = full.value("void_fraction_clamps", std::int64_t{0});
+  if (clamps > 0)
+    ctx.warn(
+        fmt::format("{} cell void fractions were raised to the minimum (dense packing)", clamps));
   if (ctx.json) {
-    nlohmann::json series = nlohmann::json::array();
-    for (const auto& smp : r.series) {
-      series.push_back({{"t_s", smp.t_s},
-                        {"bubble_diameter_m", smp.bubble_diameter_m},
-                        {"bubble_centroid_m", smp.bubble_centroid_m},
-                        {"bed_height_m", smp.bed_height_m},
-                        {"pressure_drop_pa", smp.pressure_drop_pa}});
-    }
+    // The model's full result, with what this command adds.
+    nlohmann::json out = full;
     const double cell_size_m = std::max(scene.geometry.width_m / scene.grid.cells_x,
                                         scene.geometry.height_m / scene.grid.cells_y);
-    ctx.print_json(
-        {{"scene", r.scene},
-         {"scene_hash", r.scene_hash},
-         {"result_id", result_id > 0 ? nlohmann::json(result_id) : nlohmann::json(nullptr)},
-         {"output_files", r.output_files},
-         {"law", r.law},
-         {"umf_m_s", r.umf_m_s},
-         {"background_m_s", r.background_m_s},
-         {"background", r.background_mode},
-         {"eps_mf", r.eps_mf},
-         {"eps_packing", r.eps_packing},
-         {"umf_packing_m_s", r.umf_packing_m_s},
-         {"bubble_diameter_m",
-          r.bubble_at_t_ref ? nlohmann::json(r.bubble_diameter_m) : nlohmann::json(nullptr)},
-         {"t_ref_s", r.t_ref_s},
-         {"series", series},
-         {"particles", r.particles},
-         {"settled_bed_height_m", r.settled_bed_height_m},
-         {"gas_dt_s", r.gas_dt_s},
-         {"dem_dt_s", r.dem_dt_s},
-         {"gas_steps", r.gas_steps},
-         {"dem_steps", r.dem_steps},
-         {"wall_s", r.wall_s},
-         {"threads", r.threads},
-         {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
-         {"momentum_mismatch", r.momentum_mismatch},
-         {"void_fraction_clamps", r.void_fraction_clamps},
-         {"drag_out_of_range", r.law_out_of_range},
-         // One run: the bound of the bubble boundary on the grid, one gas cell (the larger
-         // side). The packing-realization spread adds in quadrature; `draglab sensitivity`
-         // measures it (0-0.5 mm on the quick scene, 5 mm cells: the cell dominates).
-         {"numerical_uncertainty",
-          r.bubble_at_t_ref ? nlohmann::json(cell_size_m) : nlohmann::json(nullptr)},
-         {"numerical_uncertainty_method",
-          "one gas cell on the bubble boundary (the larger cell side); the packing-realization "
-          "spread is not included: draglab sensitivity adds it in quadrature"}});
+    out["result_id"] = result_id > 0 ? nlohmann::json(result_id) : nlohmann::json(nullptr);
+    out["model"] = r.model;
+    // One run: the bound of the bubble boundary on the grid, one gas cell (the larger side). The
+    // packing-realization spread adds in quadrature; `draglab sensitivity` measures it (0-0.5 mm
+    // on the quick scene, 5 mm cells: the cell dominates).
+    out["numerical_uncertainty"] =
+        r.metrics.bubble_present ? nlohmann::json(cell_size_m) : nlohmann::json(nullptr);
+    out["numerical_uncertainty_method"] =
+        "one gas cell on the bubble boundary (the larger cell side); the packing-realization "
+        "spread is not included: draglab sensitivity adds it in quadrature";
+    ctx.print_json(out);
     return;
   }
-  std::cout << r.BriefReport() << "\n";
+  std::cout << r.brief << "\n";
   std::cout << fmt::format("{:>9} {:>10} {:>11} {:>10} {:>10}\n", "t-jet s", "D m", "centroid m",
                            "bed m", "dp Pa");
   for (const auto& smp : r.series) {

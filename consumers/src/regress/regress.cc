@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "draglab/consumers/bed_model.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
 #include "scene/scene_util.h"
@@ -40,33 +41,27 @@ std::optional<ConsumerResult> stored_result(const Database& db, const std::strin
   return found.back();
 }
 
-// One DPM run of `scene` with `record`, as a result ready to store. Throws draglab::Error when the
-// run fails (the caller reports it and stores nothing).
+// One run of `scene` with `record` by the scene's bed model, as a result ready to store. Throws
+// draglab::Error when the run fails (the caller reports it and stores nothing).
 ConsumerResult run_scene(const Database& db, const Scene& scene, const LawRecord& record,
                          const DpmOptions& dpm, std::vector<std::string>* warnings,
                          const DpmProgress& progress) {
-  if (scene.solver != "dpm") {
-    throw Error(ErrorCode::kInvalidArgument,
-                "scene.solver: regression checks run \"dpm\" scenes only (this release), got \"" +
-                    scene.solver + "\"");
-  }
   std::string warning;
   std::shared_ptr<const Law> law =
       db.load(record.reference(), range_policy_from_string(scene.range_policy), &warning);
   if (!warning.empty() && warnings) warnings->push_back(warning);
-  // U_mf and the time steps first: a law whose validity box excludes the bed fails here, in
-  // microseconds, rather than after the settling.
-  derive_scene(scene, *law);
-  DpmSimulation simulation(scene, law, dpm);
-  const DpmResult r = simulation.Run(progress);
+  BedRunOptions options;
+  options.duration_s = dpm.duration_s;
+  options.output_directory = dpm.output_directory;
+  const BedResult r = run_bed_model(scene, law, options, progress);
   ConsumerResult result;
   result.scene_name = scene.name;
   result.scene_hash = scene.hash();
   result.law_name = law->record().name;
   result.law_version = law->record().version;
   result.law_content_hash = law->record().content_hash;
-  result.metrics = consumer_metrics_of(r);
-  result.result_json = dpm_result_json(r);
+  result.metrics = r.metrics;
+  result.result_json = r.result_json;
   return result;
 }
 
@@ -167,7 +162,10 @@ std::string dpm_result_json(const DpmResult& r) {
                       {"momentum_mismatch", r.momentum_mismatch},
                       {"max_action_reaction_mismatch_n", r.max_action_reaction_mismatch_n},
                       {"void_fraction_clamps", r.void_fraction_clamps},
-                      {"drag_out_of_range", r.law_out_of_range}};
+                      {"drag_out_of_range", r.law_out_of_range},
+                      {"eps_packing", r.eps_packing},
+                      {"umf_packing_m_s", r.umf_packing_m_s},
+                      {"output_files", r.output_files}};
   if (r.has_snapshot) {
     const BubbleMetrics& b = r.snapshot.bubble;
     j["snapshot"] = {{"t_s", r.snapshot.t_s},

@@ -15,6 +15,7 @@
 
 #include <toml++/toml.h>
 
+#include "draglab/consumers/bed_model.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 #include "scene/scene_util.h"
@@ -293,8 +294,14 @@ bool Scene::IsValid(std::string* error) const {
                   "[scene] name '" + name + "' may contain only letters, digits, '_', '-' and '.'");
     }
   }
-  if (solver != "dpm") {
-    return fail(error, "[scene] solver = '" + solver + "' is not one of dpm (tfm, dbm: later)");
+  {
+    const std::vector<std::string> models = bed_model_keys();
+    if (std::find(models.begin(), models.end(), solver) == models.end()) {
+      std::string known;
+      for (const std::string& k : models) known += (known.empty() ? "" : ", ") + k;
+      return fail(
+          error, "[scene] solver = '" + solver + "' is not a registered bed model (" + known + ")");
+    }
   }
   // Geometry: a laboratory pseudo-2D bed, millimetres to metres.
   if (!in_range(geometry.width_m, 0.0, 10.0, true, false, "[geometry] width_m", "m", error) ||

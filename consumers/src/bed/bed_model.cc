@@ -1,0 +1,90 @@
+// The bed-model registry and dispatch by the scene's solver.
+#include "draglab/consumers/bed_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+
+#include "bed/builtin_models.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+struct Registry {
+  std::mutex mutex;
+  std::map<std::string, std::unique_ptr<BedModel>> models;
+};
+
+void add(Registry& r, std::unique_ptr<BedModel> model) {
+  if (!model || model->key().empty()) {
+    throw Error(ErrorCode::kInvalidArgument, "bed model: a model needs a non-empty key");
+  }
+  const std::string key = model->key();
+  if (!r.models.emplace(key, std::move(model)).second) {
+    throw Error(ErrorCode::kInvalidArgument, "bed model '" + key + "' is already registered");
+  }
+}
+
+Registry& registry() {
+  static Registry* r = [] {
+    auto* made = new Registry;
+    add(*made, internal::make_dpm_bed_model());
+    return made;
+  }();
+  return *r;
+}
+
+std::string joined_keys(const Registry& r) {
+  std::string out;
+  for (const auto& [key, model] : r.models) out += (out.empty() ? "" : ", ") + key;
+  return out;
+}
+
+}  // namespace
+
+bool BedRunOptions::IsValid(std::string* error) const {
+  if (!std::isfinite(duration_s) || duration_s < 0.0) {
+    if (error) *error = "duration_s must be finite and >= 0 (0: the scene's duration)";
+    return false;
+  }
+  return true;
+}
+
+void register_bed_model(std::unique_ptr<BedModel> model) {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  add(r, std::move(model));
+}
+
+std::vector<std::string> bed_model_keys() {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  std::vector<std::string> keys;
+  for (const auto& [key, model] : r.models) keys.push_back(key);
+  return keys;
+}
+
+const BedModel& find_bed_model(const std::string& key) {
+  Registry& r = registry();
+  std::lock_guard<std::mutex> lock(r.mutex);
+  const auto it = r.models.find(key);
+  if (it == r.models.end()) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "[scene] solver = '" + key +
+                    "' is not a registered bed model (registered: " + joined_keys(r) + ")");
+  }
+  return *it->second;
+}
+
+BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
+                        const BedRunOptions& options, const BedProgress& progress) {
+  std::string why;
+  if (!options.IsValid(&why)) throw Error(ErrorCode::kInvalidArgument, "bed run options: " + why);
+  return find_bed_model(scene.solver).Run(scene, std::move(law), options, progress);
+}
+
+}  // namespace consumers
+}  // namespace draglab
