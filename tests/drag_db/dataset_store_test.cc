@@ -180,12 +180,25 @@ TEST(DatasetStore, CsvRoundTripAndMalformedFiles) {
     const char* text;
     const char* expect;
   };
-  for (const Case& c : {Case{"phi,re,F\n0.3,0,5\n", "F_uncertainty"},
-                        Case{"phi,re,F,F_uncertainty\n0.3,0,abc,0.1\n", "column 'F'"},
-                        Case{"phi,re,F,F_uncertainty\n0.9,0,5,0.1\n", "phi"},
-                        Case{"phi,re,F,F_uncertainty\n0.3,-1,5,0.1\n", "re"},
-                        Case{"phi,re,F,F_uncertainty\n0.3,0,5\n", "columns"},
-                        Case{"phi,re,F,F_uncertainty\n", "no data rows"}}) {
+  for (const Case& c :
+       {Case{"phi,re,F\n0.3,0,5\n", "F_uncertainty"},
+        Case{"phi,re,F,F_uncertainty\n0.3,0,abc,0.1\n", "column 'F'"},
+        Case{"phi,re,F,F_uncertainty\n0.9,0,5,0.1\n", "phi"},
+        Case{"phi,re,F,F_uncertainty\n0.3,-1,5,0.1\n", "re"},
+        Case{"phi,re,F,F_uncertainty\n0.3,0,5\n", "columns"},
+        Case{"phi,re,F,F_uncertainty\n", "no data rows"},
+        // Values an immutable dataset must never store (each once stored wrong).
+        Case{"phi,re,F,F_uncertainty,realizations\n0.3,0,5,0.1,1e20\n", "realizations"},
+        Case{"phi,re,F,F_uncertainty,realizations\n0.3,0,5,0.1,-4\n", "realizations"},
+        Case{"phi,re,F,F_uncertainty,realizations\n0.3,0,5,0.1,2.7\n", "realizations"},
+        Case{"phi,re,F,F_uncertainty,F_standard_error\n0.3,0,5,0.1,-1\n", "F_standard_error"},
+        Case{"phi,re,F,F_uncertainty\n0.3,0,5,0.1\n0.3,0,6,0.1\n", "already given at"},
+        Case{"phi,re,F,F,F_uncertainty\n0.3,0,5,5,0.1\n", "twice"},
+        Case{"phi,re,F,F_uncertainty,resolutions,F_at_resolution\n"
+             "0.3,0,5,0.1,10;20,5\n",
+             "one F per resolution"},
+        Case{"phi,re,F,F_uncertainty\n0.3,0,1e300,0.1\n", "F = "},
+        Case{"phi,re,F,F_uncertainty\n0.3,1e300,5,0.1\n", "re = "}}) {
     try {
       read_dataset_csv(write(c.text));
       FAIL() << "accepted: " << c.text;

@@ -115,6 +115,10 @@ constexpr const char* kSelect =
 
 // Validation shared by storing and CSV import: every number a fit will divide by or take the
 // log of must be finite and in range.
+constexpr double kMaxRe = 1e7;
+constexpr double kMaxF = 1e9;
+constexpr int kMaxRealizations = 100000;
+
 void validate_point(const DatasetPoint& p, const std::string& where) {
   auto fail = [&](const std::string& field, double value, const std::string& range) {
     throw Error(ErrorCode::kInvalidArgument, where + ": " + field + " = " + exact(value) +
@@ -125,9 +129,56 @@ void validate_point(const DatasetPoint& p, const std::string& where) {
   if (!(p.re_target >= 0.0 && std::isfinite(p.re_target))) {
     fail("re_target", p.re_target, "finite, >= 0");
   }
-  if (!(p.F > 0.0 && std::isfinite(p.F))) fail("F", p.F, "finite, > 0");
-  if (!(p.F_uncertainty > 0.0 && std::isfinite(p.F_uncertainty))) {
-    fail("F_uncertainty", p.F_uncertainty, "finite, > 0");
+  // Bounds far outside any drag measurement (F at phi = 0.74, Re = 1e4 is of order 1e4), so that
+  // an exponent typo (1e300) is caught before it is stored forever.
+  if (!(p.re <= kMaxRe)) fail("re", p.re, "[0, 1e7]");
+  if (!(p.re_target <= kMaxRe)) fail("re_target", p.re_target, "[0, 1e7]");
+  if (!(p.F > 0.0 && p.F <= kMaxF)) fail("F", p.F, "(0, 1e9]");
+  if (!(p.F_uncertainty > 0.0 && p.F_uncertainty <= kMaxF)) {
+    fail("F_uncertainty", p.F_uncertainty, "(0, 1e9]");
+  }
+  if (!(p.F_standard_error >= 0.0 && p.F_standard_error <= kMaxF)) {
+    fail("F_standard_error", p.F_standard_error, "[0, 1e9]");
+  }
+  if (!(p.F_discretisation_error >= 0.0 && p.F_discretisation_error <= kMaxF)) {
+    fail("F_discretisation_error", p.F_discretisation_error, "[0, 1e9]");
+  }
+  if (p.realizations < 0 || p.realizations > kMaxRealizations) {
+    fail("realizations", p.realizations, "an integer in [0, 100000] (0 = not stated)");
+  }
+  if (!std::isfinite(p.order)) fail("order", p.order, "finite");
+  if (!(p.wall_s >= 0.0 && std::isfinite(p.wall_s))) fail("wall_s", p.wall_s, "finite, >= 0");
+  if (p.resolutions.size() != p.F_at_resolution.size()) {
+    throw Error(ErrorCode::kInvalidArgument, where + ": " + std::to_string(p.resolutions.size()) +
+                                                 " resolutions but " +
+                                                 std::to_string(p.F_at_resolution.size()) +
+                                                 " F_at_resolution values (one F per resolution)");
+  }
+  for (std::size_t k = 0; k < p.resolutions.size(); ++k) {
+    if (!(p.resolutions[k] > 0.0 && p.resolutions[k] <= 1e5)) {
+      fail("resolutions", p.resolutions[k], "(0, 1e5] lattice units per diameter");
+    }
+    if (!(p.F_at_resolution[k] > 0.0 && p.F_at_resolution[k] <= kMaxF)) {
+      fail("F_at_resolution", p.F_at_resolution[k], "(0, 1e9]");
+    }
+  }
+}
+
+/// One (phi, Re target) appears once per dataset: two rows for the same point (different F or
+/// not) would be fitted as independent measurements.
+void check_unique_points(const std::vector<DatasetPoint>& points,
+                         const std::vector<std::string>& where) {
+  std::map<std::pair<double, double>, std::size_t> seen;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto key = std::make_pair(points[i].phi, points[i].re_target);
+    const auto [it, inserted] = seen.emplace(key, i);
+    if (!inserted) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  where[i] + ": (phi, re_target) = (" + exact(points[i].phi) + ", " +
+                      exact(points[i].re_target) + ") already given at " + where[it->second] +
+                      " (F = " + exact(points[it->second].F) + " there, " + exact(points[i].F) +
+                      " here): one row per point (combine repeated measurements first)");
+    }
   }
 }
 
@@ -142,9 +193,12 @@ Dataset store_dataset(Database& database, Dataset dataset) {
   if (dataset.points.empty()) {
     throw Error(ErrorCode::kInvalidArgument, "dataset '" + dataset.name + "' has no points");
   }
+  std::vector<std::string> where;
   for (std::size_t i = 0; i < dataset.points.size(); ++i) {
-    validate_point(dataset.points[i], "dataset '" + dataset.name + "', point " + std::to_string(i));
+    where.push_back("dataset '" + dataset.name + "', point " + std::to_string(i));
+    validate_point(dataset.points[i], where.back());
   }
+  check_unique_points(dataset.points, where);
   const std::string points_json = canonical_points(dataset.points, true).dump();
   dataset.hash = dataset_hash(dataset.points);
   dataset.id = dataset.hash.substr(0, 12);
@@ -240,6 +294,7 @@ Dataset read_dataset_csv(const std::string& path) {
   int line_number = 0;
   std::vector<std::string> header;
   std::map<std::string, std::size_t> column;
+  std::vector<std::string> row_where;
   Dataset dataset;
   const std::size_t slash = path.find_last_of('/');
   dataset.name = path.substr(slash == std::string::npos ? 0 : slash + 1);
@@ -253,7 +308,12 @@ Dataset read_dataset_csv(const std::string& path) {
     const std::string where = "'" + path + "' line " + std::to_string(line_number);
     if (header.empty()) {
       header = split(line, ',');
-      for (std::size_t c = 0; c < header.size(); ++c) column[header[c]] = c;
+      for (std::size_t c = 0; c < header.size(); ++c) {
+        if (!column.emplace(header[c], c).second) {
+          throw Error(ErrorCode::kInvalidArgument,
+                      where + ": the header names column '" + header[c] + "' twice");
+        }
+      }
       for (const char* required : {"phi", "re", "F", "F_uncertainty"}) {
         if (!column.count(required)) {
           throw Error(ErrorCode::kInvalidArgument,
@@ -306,7 +366,16 @@ Dataset read_dataset_csv(const std::string& path) {
     p.F_uncertainty = number("F_uncertainty", NAN);
     p.F_standard_error = number("F_standard_error", 0.0);
     p.F_discretisation_error = number("F_discretisation_error", 0.0);
-    p.realizations = static_cast<int>(number("realizations", 0.0));
+    {
+      const double realizations = number("realizations", 0.0);
+      if (!(realizations >= 0.0 && realizations <= kMaxRealizations &&
+            realizations == std::floor(realizations))) {
+        throw Error(ErrorCode::kInvalidArgument,
+                    where + ", column 'realizations': " + exact(realizations) +
+                        " is not an integer in [0, 100000] (0 = not stated)");
+      }
+      p.realizations = static_cast<int>(realizations);
+    }
     p.resolutions = list("resolutions");
     p.F_at_resolution = list("F_at_resolution");
     p.order = number("order", 0.0);
@@ -314,10 +383,12 @@ Dataset read_dataset_csv(const std::string& path) {
     p.wall_s = number("wall_s", 0.0);
     validate_point(p, where);
     dataset.points.push_back(p);
+    row_where.push_back(where);
   }
   if (dataset.points.empty()) {
     throw Error(ErrorCode::kInvalidArgument, "dataset file '" + path + "' has no data rows");
   }
+  check_unique_points(dataset.points, row_where);
   dataset.method = nlohmann::json{{"source", "csv"}, {"file", dataset.name}}.dump();
   dataset.hash = dataset_hash(dataset.points);
   dataset.id = dataset.hash.substr(0, 12);
