@@ -19,8 +19,8 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
-#include "draglab/drag_db/error.h"
 #include "drag_db_version.h"
+#include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace cli {
@@ -86,7 +86,14 @@ int main(int argc, char** argv) {
   app.fallthrough();  // global options (--db, --json, --quiet) are accepted after subcommands
   app.add_option("--db", ctx.db_path,
                  "Database file (default: $DRAGLAB_DB, else ./draglab.db; created and seeded "
-                 "with the literature library on first use)");
+                 "with the literature library on first use)")
+      ->check(CLI::Validator(
+          [](std::string& path) -> std::string {
+            return path.empty() ? "empty path (give a database file, or leave --db out "
+                                  "for $DRAGLAB_DB, else ./draglab.db)"
+                                : std::string();
+          },
+          "FILE"));
   app.add_flag("--json", ctx.json, "Machine-readable JSON results on stdout");
   app.add_flag("-q,--quiet", ctx.quiet, "No informational messages on stderr");
   app.require_subcommand(1);

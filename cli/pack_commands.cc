@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 #include <fmt/core.h>
@@ -81,13 +82,11 @@ void print_statistics(const arrays::Packing& p, const arrays::PackingStatistics&
   std::cout << fmt::format("box              {} x {} x {} d_ref\n", format_number(p.box_length[0]),
                            format_number(p.box_length[1]), format_number(p.box_length[2]));
   std::cout << fmt::format("phi              {:.12f} (exact)\n", s.phi);
-  std::cout << fmt::format("min surface gap  {} d_ref{}\n", format_number(s.min_gap),
-                           s.overlapping_pairs ? fmt::format("  ({} OVERLAPPING pairs)",
-                                                             s.overlapping_pairs)
-                                               : "");
+  std::cout << fmt::format(
+      "min surface gap  {} d_ref{}\n", format_number(s.min_gap),
+      s.overlapping_pairs ? fmt::format("  ({} OVERLAPPING pairs)", s.overlapping_pairs) : "");
   std::cout << fmt::format("g(contact)       {}\n", format_number(s.g_contact, 4));
-  std::cout << fmt::format("Q6               {} (random ~0, FCC 0.575)\n",
-                           format_number(s.q6, 4));
+  std::cout << fmt::format("Q6               {} (random ~0, FCC 0.575)\n", format_number(s.q6, 4));
   std::cout << fmt::format("crystal-like     {:.2f} % of spheres, {:.2f} neighbours per sphere\n",
                            100.0 * s.crystalline_fraction, s.mean_neighbours);
 }
@@ -98,7 +97,8 @@ void ensure_writable_parent(const std::string& path) {
   struct stat st {};
   if (::stat(dir.empty() ? "/" : dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) ||
       access(dir.empty() ? "/" : dir.c_str(), W_OK) != 0) {
-    throw UsageError("--out '" + path + "': directory '" + dir + "' does not exist or is not "
+    throw UsageError("--out '" + path + "': directory '" + dir +
+                     "' does not exist or is not "
                      "writable");
   }
 }
@@ -193,7 +193,8 @@ void run_ensemble(const CliContext& ctx, const PackOptions& o) {
   std::cout << fmt::format("{} realizations in {}; g(contact) = {:.4f} +- {:.4f} (standard error)",
                            o.realizations, o.out_dir, mean, sd / std::sqrt(n));
   if (o.dist == "mono" && o.ordered.empty() && o.phi < 0.494) {
-    std::cout << fmt::format("; Carnahan-Starling {:.4f}", arrays::carnahan_starling_contact(o.phi));
+    std::cout << fmt::format("; Carnahan-Starling {:.4f}",
+                             arrays::carnahan_starling_contact(o.phi));
   }
   std::cout << '\n';
 }
@@ -255,8 +256,9 @@ void add_pack_commands(CLI::App& app, CliContext& ctx) {
       "pack", "Generate periodic sphere packings (random or ordered), show their statistics");
   pack->require_subcommand(0, 1);
   auto add_generation_options = [o](CLI::App* cmd) {
-    cmd->add_option("--phi", o->phi, "Solids fraction: random (0, 0.64], ordered up to close "
-                                     "packing");
+    cmd->add_option("--phi", o->phi,
+                    "Solids fraction: random (0, 0.64], ordered up to close "
+                    "packing");
     cmd->add_option("--n", o->n, "Number of spheres (random), >= 1");
     cmd->add_option("--dist", o->dist, "Size distribution: mono, bi or lognormal")
         ->capture_default_str()
@@ -268,7 +270,20 @@ void add_pack_commands(CLI::App& app, CliContext& ctx) {
         ->capture_default_str();
     cmd->add_option("--sigma", o->sigma, "Lognormal standard deviation of ln d, (0, 0.5]")
         ->capture_default_str();
-    cmd->add_option("--seed", o->seed, "Random seed")->capture_default_str();
+    cmd->add_option("--seed", o->seed, "Random seed, an integer in [0, 2^64 - 1]")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+              // CLI11 would wrap -1 and 2^64 silently; a seed is a plain unsigned decimal.
+              errno = 0;
+              char* end = nullptr;
+              if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos ||
+                  (std::strtoull(text.c_str(), &end, 10), errno == ERANGE)) {
+                return "'" + text + "' must be an integer in [0, 18446744073709551615]";
+              }
+              return std::string();
+            },
+            "UINT64"))
+        ->capture_default_str();
     cmd->add_option("--min-gap", o->min_gap, "Minimum surface gap in d_ref, [0, 0.5]")
         ->capture_default_str();
     cmd->add_option("--sweeps", o->sweeps, "Hard-sphere Monte-Carlo equilibration sweeps")
@@ -304,9 +319,8 @@ void add_pack_commands(CLI::App& app, CliContext& ctx) {
   auto* stats = pack->add_subcommand("stats", "phi, minimum gap, g(r) contact value, Q6 of a file");
   stats->add_option("file", *stats_file, "Packing HDF5 file")->required();
   stats->footer("Example:\n  draglab pack stats p.h5 --json");
-  stats->callback([&ctx, stats_file] {
-    ctx.action = [&ctx, stats_file] { run_stats(ctx, *stats_file); };
-  });
+  stats->callback(
+      [&ctx, stats_file] { ctx.action = [&ctx, stats_file] { run_stats(ctx, *stats_file); }; });
 
   auto vox_file = std::make_shared<std::string>();
   auto resolution = std::make_shared<double>(16.0);

@@ -86,6 +86,13 @@ grep -qi "retracted" "$work/err" || { echo "FAIL: no retraction warning"; failur
 echo "this is not a database" >"$work/bad.db"
 check "not a database" 2 "$draglab" --db "$work/bad.db" law list
 grep -q "bad.db" "$work/err" || { echo "FAIL: corrupt db message does not name the file"; failures=$((failures + 1)); }
+check "empty --db" 2 "$draglab" --db '' law list
+grep -q "empty path" "$work/err" || { echo "FAIL empty --db: no 'empty path' in the message"; failures=$((failures + 1)); }
+for seed in -1 18446744073709551616 1.5; do
+  check "pack --seed $seed" 2 "$draglab" pack --phi 0.3 --n 8 --seed "$seed" --out "$work/seed.h5"
+  grep -q -- "--seed" "$work/err" || { echo "FAIL pack --seed $seed: the message does not name --seed"; failures=$((failures + 1)); }
+done
+[ ! -e "$work/seed.h5" ] || { echo "FAIL a refused seed wrote a packing"; failures=$((failures + 1)); }
 check "db check" 0 "$draglab" db check
 
 # Packings: generation, statistics, bad input (exit 2, no file left behind).
