@@ -132,6 +132,10 @@ TEST(SceneParse, EveryBadInputIsNamed) {
   // Times and steps: a DEM step above t_c/20 (t_c = 1.2e-4 s) is refused.
   expect_bad(edit(base, "time", "dem_dt_s", "dem_dt_s = 1e-5"),
              {"[time] dem_dt_s", "stability limit"});
+  expect_bad(edit(base, "time", "gas_dt_s", "gas_dt_s = 1e-30"),
+             {"[time] gas_dt_s", "more than 1e9"});
+  expect_bad(edit(base, "time", "dem_dt_s", "dem_dt_s = 1e-30"),
+             {"[time] dem_dt_s", "more than 1e9"});
   expect_bad(edit(base, "time", "contact_steps", "contact_steps = 10"),
              {"[time] contact_steps", "[20, 1000]"});
   expect_bad(edit(base, "time", "t_ref_s", "t_ref_s = 0.5"), {"[time] t_ref_s", "duration_s"});

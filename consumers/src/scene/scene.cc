@@ -409,6 +409,22 @@ bool Scene::IsValid(std::string* error) const {
                            fmt(jet.start_s) + " s is beyond [time] duration_s = " +
                            fmt(time.duration_s) + " s (t_ref_s <= duration_s - jet.start_s)");
   }
+  // A positive step so small that the run could never finish is a typo, not a choice.
+  constexpr double kMaxSteps = 1e9;
+  if (time.gas_dt_s > 0.0 && time.duration_s / time.gas_dt_s > kMaxSteps) {
+    return fail(error, "[time] gas_dt_s = " + fmt(time.gas_dt_s) + " s would take " +
+                           fmt(time.duration_s / time.gas_dt_s) +
+                           " gas steps for duration_s (more than 1e9): use 0 = auto, or a step "
+                           ">= duration_s / 1e9 = " +
+                           fmt(time.duration_s / kMaxSteps) + " s");
+  }
+  if (time.dem_dt_s > 0.0 && (time.settle_s + time.duration_s) / time.dem_dt_s > kMaxSteps) {
+    return fail(error, "[time] dem_dt_s = " + fmt(time.dem_dt_s) + " s would take " +
+                           fmt((time.settle_s + time.duration_s) / time.dem_dt_s) +
+                           " DEM steps for settle_s + duration_s (more than 1e9): use 0 = auto, "
+                           "or a step >= (settle_s + duration_s) / 1e9 = " +
+                           fmt((time.settle_s + time.duration_s) / kMaxSteps) + " s");
+  }
   if (time.dem_dt_s > 0.0) {
     const double limit = contact_time_s(particles) / 20.0;
     if (time.dem_dt_s > limit) {
