@@ -4,7 +4,9 @@
 // registry giving bit-identical results to a direct DpmSimulation run of the same scene, law and
 // thread count (the family changes no DPM number).
 #include <algorithm>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -22,43 +24,18 @@ namespace draglab {
 namespace consumers {
 namespace {
 
-const char* kTinyScene = R"(
-[scene]
-name = "bed_model_tiny"
-solver = "SOLVER"
-seed = 3
-[geometry]
-width_m = 0.03
-height_m = 0.09
-depth_m = 0.0075
-[particles]
-diameter_m = 2.5e-3
-density_kg_m3 = 2526.0
-bed_height_mf_m = 0.03
-[gas]
-density_kg_m3 = 1.2
-viscosity_pa_s = 1.8e-5
-[jet]
-slot_width_m = 0.0075
-velocity_m_s = 10.0
-start_s = 0.01
-duration_s = 0.03
-[time]
-settle_s = 0.3
-duration_s = 0.06
-t_ref_s = 0.04
-[grid]
-cells_x = 4
-cells_y = 12
-[drag]
-laws = ["ergun@1"]
-eps_mf = 0.42
-)";
-
+/// The tiny DPM bed of the command-line regress tests (tests/cli/data/regress_tiny.toml), with
+/// its solver replaced.
 std::string scene_text(const std::string& solver) {
-  std::string text = kTinyScene;
-  text.replace(text.find("SOLVER"), 6, solver);
-  return text;
+  std::ifstream file(std::string(DRAGLAB_TEST_SCENES_DIR) + "/regress_tiny.toml");
+  std::stringstream text;
+  text << file.rdbuf();
+  std::string out = text.str();
+  const std::string dpm = "solver = \"dpm\"";
+  const std::size_t at = out.find(dpm);
+  EXPECT_NE(at, std::string::npos) << "regress_tiny.toml not found or changed";
+  if (at != std::string::npos) out.replace(at, dpm.size(), "solver = \"" + solver + "\"");
+  return out;
 }
 
 std::shared_ptr<const Law> ergun() {
@@ -132,7 +109,7 @@ TEST(BedModel, ScenesNameRegisteredModelsAndRunsDispatchToThem) {
   options.duration_s = 0.25;
   const BedResult r = run_bed_model(scene, ergun(), options);
   EXPECT_EQ(r.model, "echo_test");
-  EXPECT_EQ(r.scene, "bed_model_tiny");
+  EXPECT_EQ(r.scene, "dpm_tiny_test");
   EXPECT_EQ(r.law, "ergun@1");
   EXPECT_EQ(r.wall_s, 0.25);
   options.duration_s = -1.0;
