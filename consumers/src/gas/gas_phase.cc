@@ -15,9 +15,7 @@
 // projected velocity satisfies the implicit momentum equation and continuity together.
 #include "draglab/consumers/gas_phase.h"
 
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
+#include "draglab/consumers/mac_pressure.h"
 
 #include <algorithm>
 #include <cmath>
@@ -104,17 +102,6 @@ std::string GasDiagnostics::BriefReport() const {
   return buffer;
 }
 
-struct GasPhase::PoissonCache {
-  std::vector<double> coefficients;    // C_f of every face: the matrix is reused when unchanged
-  Eigen::SparseMatrix<double> matrix;  // the full operator (for the residual)
-  Eigen::SparseMatrix<double> solver_matrix;  // pinned copy; CG keeps a reference to it
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
-  bool pinned = false;  // all-Neumann/periodic: p(0,0) fixed to remove the constant null space
-  // LDLT ordering and symbolic analysis done: the pattern never changes, only the values.
-  bool ordered = false;
-};
-
 GasPhase::GasPhase(const GasOptions& options) : opt_(options) {
   std::string why;
   if (!opt_.IsValid(&why)) Bad(why);
@@ -129,7 +116,16 @@ GasPhase::GasPhase(const GasOptions& options) : opt_(options) {
   beta_ = Eigen::ArrayXXd::Zero(opt_.nx, opt_.nz);
   upx_ = beta_;
   upz_ = beta_;
-  cache_ = std::make_unique<PoissonCache>();
+  MacPressureOptions po;
+  po.nx = opt_.nx;
+  po.nz = opt_.nz;
+  po.dx = dx_;
+  po.dz = dz_;
+  po.vertical = opt_.vertical;
+  po.solver = opt_.poisson;
+  po.cg_tolerance = opt_.cg_tolerance;
+  po.cg_max_iterations = opt_.cg_max_iterations;
+  pressure_ = std::make_unique<MacPressureSolver>(po);
 }
 
 GasPhase::~GasPhase() = default;
@@ -182,29 +178,31 @@ void GasPhase::SetUniformVelocity(double u_x, double u_z) {
   w_.setConstant(u_z);
 }
 
-double GasPhase::InflowSuperficialVelocity(int i, double t) const {
-  if (opt_.vertical != VerticalBoundary::kInflowOutlet) return 0.0;
-  const double ramp = opt_.inflow_ramp_s;
+double inflow_superficial_velocity(const GasOptions& o, double dx, int i, double t) {
+  if (o.vertical != VerticalBoundary::kInflowOutlet) return 0.0;
+  const double ramp = o.inflow_ramp_s;
   // Linear ramp 0 -> 1 over [a, a + ramp] (a step at a when ramp = 0).
   auto opened = [ramp](double t_now, double a) {
     if (ramp <= 0.0) return t_now >= a ? 1.0 : 0.0;
     return std::clamp((t_now - a) / ramp, 0.0, 1.0);
   };
-  double velocity = opt_.background_velocity_m_s * opened(t, 0.0);
+  double velocity = o.background_velocity_m_s * opened(t, 0.0);
   const double jet_fraction =
-      opt_.jet_width_m > 0.0
-          ? opened(t, opt_.jet_start_s) - opened(t, opt_.jet_start_s + opt_.jet_duration_s)
-          : 0.0;
+      o.jet_width_m > 0.0 ? opened(t, o.jet_start_s) - opened(t, o.jet_start_s + o.jet_duration_s)
+                          : 0.0;
   if (jet_fraction > 0.0) {
     // The slot is centred; a partly covered face gets the area-weighted mean so the injected
     // volume flow is exactly jet_width * jet_velocity per unit depth on any grid.
-    const double x0 = 0.5 * (opt_.width_m - opt_.jet_width_m);
-    const double x1 = x0 + opt_.jet_width_m;
-    const double overlap = std::max(0.0, std::min(x1, (i + 1) * dx_) - std::max(x0, i * dx_));
-    velocity += jet_fraction * (opt_.jet_velocity_m_s - opt_.background_velocity_m_s) * overlap /
-                dx_;
+    const double x0 = 0.5 * (o.width_m - o.jet_width_m);
+    const double x1 = x0 + o.jet_width_m;
+    const double overlap = std::max(0.0, std::min(x1, (i + 1) * dx) - std::max(x0, i * dx));
+    velocity += jet_fraction * (o.jet_velocity_m_s - o.background_velocity_m_s) * overlap / dx;
   }
   return velocity;
+}
+
+double GasPhase::InflowSuperficialVelocity(int i, double t) const {
+  return inflow_superficial_velocity(opt_, dx_, i, t);
 }
 
 double GasPhase::StableTimeStep(double cfl) const {
@@ -374,10 +372,6 @@ void GasPhase::Step(double dt) {
   }
 
   // ---- pressure equation: -div(C grad p) = -(div(eps u_hat) + d eps/dt), C = dt eps^2 / a ----
-  const int n = nx * nz;
-  auto id = [nx](int i, int j) { return i + nx * j; };
-  std::vector<double> coefficients;
-  coefficients.reserve(static_cast<size_t>((nx + 1) * nz + nx * (nz + 1)));
   Eigen::ArrayXXd c_u = Eigen::ArrayXXd::Zero(nx + 1, nz), c_w = Eigen::ArrayXXd::Zero(nx, nz + 1);
   for (int j = 0; j < nz; ++j) {
     for (int i = 1; i < nx; ++i) {
@@ -393,65 +387,8 @@ void GasPhase::Step(double dt) {
     }
   }
   if (periodic) c_w.col(nz) = c_w.col(0);
-  coefficients.assign(c_u.data(), c_u.data() + c_u.size());
-  coefficients.insert(coefficients.end(), c_w.data(), c_w.data() + c_w.size());
 
-  PoissonCache& cache = *cache_;
-  const bool pinned = periodic;  // no Dirichlet boundary: remove the constant null space
-  if (coefficients != cache.coefficients || cache.matrix.rows() != n) {
-    std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(static_cast<size_t>(5 * n));
-    auto couple = [&](int a, int b, double g) {  // g = C A / h between cells a and b
-      triplets.emplace_back(a, a, g);
-      triplets.emplace_back(b, b, g);
-      triplets.emplace_back(a, b, -g);
-      triplets.emplace_back(b, a, -g);
-    };
-    for (int j = 0; j < nz; ++j) {
-      for (int i = 1; i < nx; ++i) couple(id(i - 1, j), id(i, j), c_u(i, j) * dz_ / dx_);
-    }
-    for (int i = 0; i < nx; ++i) {
-      for (int j = 1; j < nz; ++j) couple(id(i, j - 1), id(i, j), c_w(i, j) * dx_ / dz_);
-      if (periodic) {
-        couple(id(i, nz - 1), id(i, 0), c_w(i, 0) * dx_ / dz_);
-      } else {
-        // Outlet: p = outlet_pressure at the top face, half a cell above the centre.
-        triplets.emplace_back(id(i, nz - 1), id(i, nz - 1), c_w(i, nz) * dx_ / (0.5 * dz_));
-      }
-    }
-    cache.matrix.resize(n, n);
-    cache.matrix.setFromTriplets(triplets.begin(), triplets.end());
-    cache.solver_matrix = cache.matrix;
-    Eigen::SparseMatrix<double>& matrix = cache.solver_matrix;
-    if (pinned) {
-      // Keep the matrix symmetric: zero row and column 0, unit diagonal, rhs 0 there.
-      for (int k = 0; k < matrix.outerSize(); ++k) {
-        for (Eigen::SparseMatrix<double>::InnerIterator it(matrix, k); it; ++it) {
-          if (it.row() == 0 || it.col() == 0) it.valueRef() = (it.row() == it.col()) ? 1.0 : 0.0;
-        }
-      }
-    }
-    if (opt_.poisson == PoissonSolver::kDirectLDLT) {
-      // The sparsity pattern depends only on the grid and the boundaries, not on C: order
-      // (AMD) and analyse it once, then only the numeric factorisation when C changes.
-      if (!cache.ordered) {
-        cache.ldlt.analyzePattern(matrix);
-        cache.ordered = true;
-      }
-      cache.ldlt.factorize(matrix);
-      if (cache.ldlt.info() != Eigen::Success) {
-        throw Error(ErrorCode::kInternal, "gas pressure equation: LDLT factorisation failed");
-      }
-    } else {
-      cache.cg.setTolerance(opt_.cg_tolerance);
-      cache.cg.setMaxIterations(opt_.cg_max_iterations);
-      cache.cg.compute(matrix);
-    }
-    cache.coefficients = std::move(coefficients);
-    cache.pinned = pinned;
-  }
-
-  Eigen::VectorXd rhs(n);
+  Eigen::ArrayXXd continuity(nx, nz);
   const double volume = dx_ * dz_;
   for (int j = 0; j < nz; ++j) {
     for (int i = 0; i < nx; ++i) {
@@ -470,38 +407,16 @@ void GasPhase::Step(double dt) {
       } else {
         out += eps_new(i, j) * w_hat(i, nz) * dx_;
       }
-      double b = -(out + (eps_next_(i, j) - eps_(i, j)) * volume / dt);
-      if (!periodic && j == nz - 1) b += c_w(i, nz) * dx_ / (0.5 * dz_) * opt_.outlet_pressure_pa;
-      rhs(id(i, j)) = b;
+      continuity(i, j) = out + (eps_next_(i, j) - eps_(i, j)) * volume / dt;
     }
   }
-  Eigen::VectorXd full_rhs = rhs;
-  if (pinned) rhs(0) = 0.0;
-  Eigen::VectorXd pressure;
-  int iterations = 0;
-  if (opt_.poisson == PoissonSolver::kDirectLDLT) {
-    pressure = cache.ldlt.solve(rhs);
-  } else {
-    Eigen::VectorXd guess = Eigen::Map<const Eigen::VectorXd>(p_.data(), n);
-    if (pinned) guess.array() -= guess(0);
-    pressure = cache.cg.solveWithGuess(rhs, guess);
-    iterations = static_cast<int>(cache.cg.iterations());
-    if (cache.cg.info() != Eigen::Success) {
-      Bad("gas pressure equation: conjugate gradient did not reach cg_tolerance " +
-          Fmt("%g", opt_.cg_tolerance) + " in cg_max_iterations " +
-          std::to_string(opt_.cg_max_iterations) + " (estimated error " +
-          Fmt("%.3g", cache.cg.error()) +
-          "); remedy: raise cg_max_iterations or use the "
-          "direct LDLT solver");
-    }
+  try {
+    p_ = pressure_->Solve(c_u, c_w, continuity, opt_.outlet_pressure_pa, p_);
+  } catch (const Error& e) {
+    throw Error(e.code(), std::string("gas ") + e.what());
   }
-  // Residual of the full (unpinned) system: also checks that a closed box got a compatible
-  // eps field (d/dt int eps = net inflow).
-  const double b_norm = full_rhs.norm();
-  const double residual = (cache.matrix * pressure - full_rhs).norm();
-  diag_.poisson_residual = b_norm > 0.0 ? residual / b_norm : residual;
-  diag_.poisson_iterations = iterations;
-  p_ = Eigen::Map<const Eigen::ArrayXXd>(pressure.data(), nx, nz);
+  diag_.poisson_residual = pressure_->diagnostics().relative_residual;
+  diag_.poisson_iterations = pressure_->diagnostics().iterations;
   UpdatePressureGradient();
 
   // ---- projection ----
@@ -625,18 +540,24 @@ Eigen::Vector2d GasPhase::PressureGradientAt(double x, double z) const {
           Bilinear(grad_pz_, 0.5 * dx_, 0.5 * dz_, dx_, dz_, x, z)};
 }
 
-double GasPhase::WidthAveragedPressure(double z) const {
-  const int nz = opt_.nz;
-  Eigen::ArrayXd mean = p_.colwise().mean().transpose();
-  const double s = z / dz_ - 0.5;  // position in cell-centre index units
-  if (opt_.vertical == VerticalBoundary::kInflowOutlet && s > nz - 1) {
+double width_averaged_pressure(const Eigen::ArrayXXd& p, double dz, double z, bool outlet,
+                               double outlet_pressure_pa) {
+  const int nz = static_cast<int>(p.cols());
+  Eigen::ArrayXd mean = p.colwise().mean().transpose();
+  const double s = z / dz - 0.5;  // position in cell-centre index units
+  if (outlet && s > nz - 1) {
     const double f = std::min((s - (nz - 1)) / 0.5, 1.0);
-    return (1 - f) * mean(nz - 1) + f * opt_.outlet_pressure_pa;
+    return (1 - f) * mean(nz - 1) + f * outlet_pressure_pa;
   }
   // Linear between centres; below the first centre, extrapolated from the first two.
   const int j = std::clamp(static_cast<int>(std::floor(s)), 0, nz - 2);
   const double f = s - j;
   return (1 - f) * mean(j) + f * mean(j + 1);
+}
+
+double GasPhase::WidthAveragedPressure(double z) const {
+  return width_averaged_pressure(p_, dz_, z, opt_.vertical == VerticalBoundary::kInflowOutlet,
+                                 opt_.outlet_pressure_pa);
 }
 
 double GasPhase::PressureDrop(double z_low, double z_high) const {

@@ -16,6 +16,8 @@
 namespace draglab {
 namespace consumers {
 
+class MacPressureSolver;
+
 /// Boundary condition of the gas tangential velocity at the left/right walls.
 enum class WallSlip { kNoSlip, kFreeSlip };
 
@@ -70,6 +72,18 @@ struct GasOptions {
   /// field and its allowed range.
   bool IsValid(std::string* why = nullptr) const;
 };
+
+/// Superficial inflow velocity [m/s] through the bottom face of column i (cells dx wide) at time
+/// t for the distributor and jet of `options` (the ramps of GasOptions::inflow_ramp_s; a partly
+/// covered face gets the area-weighted mean, so the injected volume is exact on any grid); 0 for
+/// a periodic box. Shared by every bed model on the MAC grid.
+double inflow_superficial_velocity(const GasOptions& options, double dx, int i, double t);
+
+/// Width average of a cell-centred pressure p (nx x nz, cells dz high) at height z [m], linear
+/// between cell centres; above the top centre it goes linearly to outlet_pressure_pa at the top
+/// face when `outlet` (kInflowOutlet), below the first centre it is extrapolated.
+double width_averaged_pressure(const Eigen::ArrayXXd& p, double dz, double z, bool outlet,
+                               double outlet_pressure_pa);
 
 /// Conservation and stability diagnostics of the last step. Flow rates in kg/s for the full
 /// depth.
@@ -167,8 +181,7 @@ class GasPhase {
   Eigen::ArrayXXd grad_px_, grad_pz_;  // cell-centred dp/dx, dp/dz [Pa/m] of p_
   Eigen::ArrayXXd eps_, eps_next_, beta_, upx_, upz_;
   GasDiagnostics diag_;
-  struct PoissonCache;
-  std::unique_ptr<PoissonCache> cache_;
+  std::unique_ptr<MacPressureSolver> pressure_;
 };
 
 }  // namespace consumers

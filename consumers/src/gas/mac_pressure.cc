@@ -1,0 +1,145 @@
+// The pressure equation of the MAC-grid projections (draglab/consumers/mac_pressure.h).
+#include "draglab/consumers/mac_pressure.h"
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+
+struct MacPressureSolver::Cache {
+  std::vector<double> coefficients;    // C_f of every face: the matrix is reused when unchanged
+  Eigen::SparseMatrix<double> matrix;  // the full operator (for the residual)
+  Eigen::SparseMatrix<double> solver_matrix;  // pinned copy; CG keeps a reference to it
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+  // LDLT ordering and symbolic analysis done: the pattern never changes, only the values.
+  bool ordered = false;
+};
+
+MacPressureSolver::MacPressureSolver(const MacPressureOptions& options)
+    : opt_(options), cache_(std::make_unique<Cache>()) {
+  if (opt_.nx < 1 || opt_.nz < 1 || !(opt_.dx > 0.0) || !(opt_.dz > 0.0)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "pressure equation: the grid needs nx, nz >= 1 and dx, dz > 0");
+  }
+}
+
+MacPressureSolver::~MacPressureSolver() = default;
+MacPressureSolver::MacPressureSolver(MacPressureSolver&&) noexcept = default;
+MacPressureSolver& MacPressureSolver::operator=(MacPressureSolver&&) noexcept = default;
+
+Eigen::ArrayXXd MacPressureSolver::Solve(const Eigen::ArrayXXd& c_u, const Eigen::ArrayXXd& c_w,
+                                         const Eigen::ArrayXXd& continuity_residual,
+                                         double outlet_pressure_pa, const Eigen::ArrayXXd& guess) {
+  const int nx = opt_.nx, nz = opt_.nz;
+  const double dx = opt_.dx, dz = opt_.dz;
+  const bool periodic = opt_.vertical == VerticalBoundary::kPeriodic;
+  const int n = nx * nz;
+  auto id = [nx](int i, int j) { return i + nx * j; };
+  std::vector<double> coefficients;
+  coefficients.reserve(static_cast<size_t>(c_u.size() + c_w.size()));
+  coefficients.assign(c_u.data(), c_u.data() + c_u.size());
+  coefficients.insert(coefficients.end(), c_w.data(), c_w.data() + c_w.size());
+
+  Cache& cache = *cache_;
+  const bool pinned = periodic;  // no Dirichlet boundary: remove the constant null space
+  if (coefficients != cache.coefficients || cache.matrix.rows() != n) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(static_cast<size_t>(5 * n));
+    auto couple = [&](int a, int b, double g) {  // g = C A / h between cells a and b
+      triplets.emplace_back(a, a, g);
+      triplets.emplace_back(b, b, g);
+      triplets.emplace_back(a, b, -g);
+      triplets.emplace_back(b, a, -g);
+    };
+    for (int j = 0; j < nz; ++j) {
+      for (int i = 1; i < nx; ++i) couple(id(i - 1, j), id(i, j), c_u(i, j) * dz / dx);
+    }
+    for (int i = 0; i < nx; ++i) {
+      for (int j = 1; j < nz; ++j) couple(id(i, j - 1), id(i, j), c_w(i, j) * dx / dz);
+      if (periodic) {
+        couple(id(i, nz - 1), id(i, 0), c_w(i, 0) * dx / dz);
+      } else {
+        // Outlet: p = outlet_pressure at the top face, half a cell above the centre.
+        triplets.emplace_back(id(i, nz - 1), id(i, nz - 1), c_w(i, nz) * dx / (0.5 * dz));
+      }
+    }
+    cache.matrix.resize(n, n);
+    cache.matrix.setFromTriplets(triplets.begin(), triplets.end());
+    cache.solver_matrix = cache.matrix;
+    Eigen::SparseMatrix<double>& matrix = cache.solver_matrix;
+    if (pinned) {
+      // Keep the matrix symmetric: zero row and column 0, unit diagonal, rhs 0 there.
+      for (int k = 0; k < matrix.outerSize(); ++k) {
+        for (Eigen::SparseMatrix<double>::InnerIterator it(matrix, k); it; ++it) {
+          if (it.row() == 0 || it.col() == 0) it.valueRef() = (it.row() == it.col()) ? 1.0 : 0.0;
+        }
+      }
+    }
+    if (opt_.solver == PoissonSolver::kDirectLDLT) {
+      // The sparsity pattern depends only on the grid and the boundaries, not on C: order
+      // (AMD) and analyse it once, then only the numeric factorisation when C changes.
+      if (!cache.ordered) {
+        cache.ldlt.analyzePattern(matrix);
+        cache.ordered = true;
+      }
+      cache.ldlt.factorize(matrix);
+      if (cache.ldlt.info() != Eigen::Success) {
+        throw Error(ErrorCode::kInternal, "pressure equation: LDLT factorisation failed");
+      }
+    } else {
+      cache.cg.setTolerance(opt_.cg_tolerance);
+      cache.cg.setMaxIterations(opt_.cg_max_iterations);
+      cache.cg.compute(matrix);
+    }
+    cache.coefficients = std::move(coefficients);
+  }
+
+  Eigen::VectorXd rhs(n);
+  for (int j = 0; j < nz; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      double b = -continuity_residual(i, j);
+      if (!periodic && j == nz - 1) b += c_w(i, nz) * dx / (0.5 * dz) * outlet_pressure_pa;
+      rhs(id(i, j)) = b;
+    }
+  }
+  Eigen::VectorXd full_rhs = rhs;
+  if (pinned) rhs(0) = 0.0;
+  Eigen::VectorXd pressure;
+  int iterations = 0;
+  if (opt_.solver == PoissonSolver::kDirectLDLT) {
+    pressure = cache.ldlt.solve(rhs);
+  } else {
+    Eigen::VectorXd start = Eigen::Map<const Eigen::VectorXd>(guess.data(), n);
+    if (pinned) start.array() -= start(0);
+    pressure = cache.cg.solveWithGuess(rhs, start);
+    iterations = static_cast<int>(cache.cg.iterations());
+    if (cache.cg.info() != Eigen::Success) {
+      char buffer[320];
+      std::snprintf(buffer, sizeof buffer,
+                    "pressure equation: conjugate gradient did not reach cg_tolerance %g in "
+                    "cg_max_iterations %d (estimated error %.3g); remedy: raise "
+                    "cg_max_iterations or use the direct LDLT solver",
+                    opt_.cg_tolerance, opt_.cg_max_iterations, cache.cg.error());
+      throw Error(ErrorCode::kInvalidArgument, buffer);
+    }
+  }
+  // Residual of the full (unpinned) system: also checks that a closed box got a compatible
+  // right-hand side (d/dt int eps = net inflow).
+  const double b_norm = full_rhs.norm();
+  const double residual = (cache.matrix * pressure - full_rhs).norm();
+  diag_.relative_residual = b_norm > 0.0 ? residual / b_norm : residual;
+  diag_.iterations = iterations;
+  return Eigen::Map<const Eigen::ArrayXXd>(pressure.data(), nx, nz);
+}
+
+}  // namespace consumers
+}  // namespace draglab
