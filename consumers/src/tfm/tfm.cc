@@ -1,0 +1,863 @@
+// The two-fluid model (draglab/consumers/tfm.h, docs/tfm.md).
+//
+// Why partial elimination: the drag relaxation time of the gas, eps rho_g / beta, is ~1e-4 s in
+// a bed of 2.5 mm glass and ~1e-7 s for 100 um powders; solving the 2 x 2 drag system of a face
+// exactly makes the step independent of it, and the pressure equation then sees the coupled
+// response of both phases (C = eps c_g + phi c_s).
+// Why a mixture pressure equation: both phases are incompressible, so eps + phi = 1 turns the
+// two continuity equations into div(eps u + phi v) = 0 plus the transport of phi; the gas volume
+// follows from the mixture flux, so both phases are conserved exactly.
+// Why the flux limiter: upwind transport keeps phi >= 0 only under a CFL condition and never
+// keeps phi <= packing_limit by itself (only the solids pressure does, and it is explicit here);
+// limiting the solids flux into a full cell, and letting the gas take the limited volume on the
+// same face, bounds phi without breaking either conservation law.
+#include "draglab/consumers/tfm.h"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+#include "draglab/consumers/mac_pressure.h"
+#include "draglab/drag_db/error.h"
+#include "scene/scene_util.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+using scene_util::fmt;
+using Array = Eigen::ArrayXXd;
+
+[[noreturn]] void Bad(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+/// Closure coefficients of every cell (below residual_solids: all zero).
+struct CellClosures {
+  Array pressure, pressure_derivative, kinetic_pressure_per_theta, mu, mu_kinetic, lambda, kappa,
+      dissipation;
+};
+
+}  // namespace
+
+const char* to_string(TfmStepLimit limit) {
+  switch (limit) {
+    case TfmStepLimit::kGasCfl:
+      return "gas CFL";
+    case TfmStepLimit::kSolidsCfl:
+      return "solids CFL";
+    case TfmStepLimit::kPressureWave:
+      return "granular pressure wave";
+    case TfmStepLimit::kSolidsViscosity:
+      return "solids viscosity";
+    case TfmStepLimit::kFixed:
+      return "fixed";
+    case TfmStepLimit::kMaximum:
+      break;
+  }
+  return "dt_max";
+}
+
+bool TfmOptions::IsValid(std::string* error) const {
+  if (!gas.IsValid(error)) return false;
+  if (!(std::isfinite(particle_diameter_m) && particle_diameter_m > 0.0 &&
+        particle_diameter_m < 0.1))
+    return fail(error,
+                "tfm particle_diameter_m = " + fmt(particle_diameter_m) + " is outside (0, 0.1) m");
+  if (!(std::isfinite(particle_density_kg_m3) && particle_density_kg_m3 > gas.rho_g &&
+        particle_density_kg_m3 <= 30000.0))
+    return fail(error, "tfm particle_density_kg_m3 = " + fmt(particle_density_kg_m3) +
+                           " must exceed the gas density " + fmt(gas.rho_g) +
+                           " and be <= 30000 kg/m^3");
+  if (!ktgf.IsValid(error)) return false;
+  if (!(std::isfinite(initial_solids) && initial_solids >= 0.0 &&
+        initial_solids < ktgf.packing_limit))
+    return fail(error, "[tfm] initial solids fraction = " + fmt(initial_solids) +
+                           " must be in [0, packing_limit = " + fmt(ktgf.packing_limit) +
+                           "): the packing limit must exceed the bed's solids fraction");
+  if (!(std::isfinite(initial_bed_height_m) && initial_bed_height_m >= 0.0 &&
+        initial_bed_height_m <= gas.height_m))
+    return fail(error, "tfm initial_bed_height_m = " + fmt(initial_bed_height_m) +
+                           " is outside [0, height = " + fmt(gas.height_m) + "] m");
+  if (!(std::isfinite(initial_theta_m2_s2) && initial_theta_m2_s2 >= 0.0 &&
+        initial_theta_m2_s2 <= 100.0))
+    return fail(error, "[tfm] theta_initial_m2_s2 = " + fmt(initial_theta_m2_s2) +
+                           " is outside [0, 100] m^2/s^2 (a granular temperature is >= 0)");
+  if (!(std::isfinite(residual_solids) && residual_solids > 0.0 && residual_solids <= 1e-2))
+    return fail(error, "[tfm] residual_solids = " + fmt(residual_solids) + " is outside (0, 1e-2]");
+  if (!(std::isfinite(cfl) && cfl > 0.0 && cfl <= 0.5))
+    return fail(error, "[tfm] cfl = " + fmt(cfl) + " is outside (0, 0.5]");
+  if (!(std::isfinite(dt_max_s) && dt_max_s > 0.0 && dt_max_s <= 0.1))
+    return fail(error, "[tfm] dt_max_s = " + fmt(dt_max_s) + " is outside (0, 0.1] s");
+  if (!(std::isfinite(dt_min_s) && dt_min_s > 0.0 && dt_min_s <= dt_max_s))
+    return fail(error, "[tfm] dt_min_s = " + fmt(dt_min_s) +
+                           " is outside (0, dt_max_s = " + fmt(dt_max_s) + "]");
+  if (!(std::isfinite(fixed_dt_s) && fixed_dt_s >= 0.0 && fixed_dt_s <= 0.1))
+    return fail(error, "[tfm] fixed dt = " + fmt(fixed_dt_s) + " is outside [0, 0.1] s");
+  if (gas.vertical != VerticalBoundary::kInflowOutlet)
+    return fail(error, "tfm: only the inflow/outlet vertical boundary is supported");
+  return true;
+}
+
+std::string TfmDiagnostics::BriefReport() const {
+  std::ostringstream s;
+  s.precision(4);
+  s << "TFM t = " << time_s << " s, " << steps << " steps (dt last " << last_dt_s << " s, min "
+    << min_dt_s << " s, limit: " << to_string(last_limit) << "); solids mass change "
+    << (initial_solids_mass_kg > 0.0
+            ? (solids_mass_kg - initial_solids_mass_kg) / initial_solids_mass_kg
+            : 0.0)
+    << " (rel.), gas mass imbalance " << gas_mass_imbalance_kg << " kg of " << gas_mass_in_kg
+    << " kg in; max phi " << max_solids_fraction << ", max theta " << max_theta_m2_s2
+    << " m^2/s^2, flux-limited faces " << flux_limited_faces << ", max wave speed "
+    << max_wave_speed_m_s << " m/s";
+  return s.str();
+}
+
+struct TfmSimulation::Impl {
+  int nx = 0, nz = 0;
+  double dx = 0.0, dz = 0.0, depth = 0.0;
+  double time = 0.0;
+  Array phi, theta, p, beta;
+  Array ug, wg, us, ws;  // faces: x (nx+1) x nz, z nx x (nz+1)
+  std::unique_ptr<MacPressureSolver> pressure;
+  std::unique_ptr<KtgfClosures> ktgf;
+  // Granular energy matrix: its pattern is fixed (every neighbour entered), analysed once.
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> energy_solver;
+  bool energy_ordered = false;
+  TfmDiagnostics diag;
+
+  CellClosures Closures(const TfmOptions& o) const;
+  double StableStep(const CellClosures& c, TfmStepLimit* limit, const TfmOptions& o) const;
+};
+
+TfmSimulation::TfmSimulation(const TfmOptions& options, std::shared_ptr<const Law> law)
+    : opt_(options), law_(std::move(law)), impl_(std::make_unique<Impl>()) {
+  std::string why;
+  if (!opt_.IsValid(&why)) Bad(why);
+  if (!law_) Bad("TfmSimulation: law is null (load it with Database::load)");
+  Impl& m = *impl_;
+  m.nx = opt_.gas.nx;
+  m.nz = opt_.gas.nz;
+  m.dx = opt_.gas.width_m / m.nx;
+  m.dz = opt_.gas.height_m / m.nz;
+  m.depth = opt_.gas.depth_m;
+  if (opt_.ktgf.knudsen_length_m == 0.0) opt_.ktgf.knudsen_length_m = std::min(m.dx, m.dz);
+  m.ktgf = std::make_unique<KtgfClosures>(opt_.ktgf, opt_.particle_diameter_m,
+                                          opt_.particle_density_kg_m3);
+  MacPressureOptions po;
+  po.nx = m.nx;
+  po.nz = m.nz;
+  po.dx = m.dx;
+  po.dz = m.dz;
+  po.vertical = opt_.gas.vertical;
+  po.solver = opt_.gas.poisson;
+  po.cg_tolerance = opt_.gas.cg_tolerance;
+  po.cg_max_iterations = opt_.gas.cg_max_iterations;
+  m.pressure = std::make_unique<MacPressureSolver>(po);
+  m.phi = Array::Zero(m.nx, m.nz);
+  m.theta = Array::Zero(m.nx, m.nz);
+  for (int j = 0; j < m.nz; ++j) {
+    // The cell's covered fraction of the initial bed, so the bed height is exact on any grid.
+    const double covered = std::clamp(opt_.initial_bed_height_m / m.dz - j, 0.0, 1.0);
+    for (int i = 0; i < m.nx; ++i) {
+      m.phi(i, j) = opt_.initial_solids * covered;
+      m.theta(i, j) = m.phi(i, j) >= opt_.residual_solids ? opt_.initial_theta_m2_s2 : 0.0;
+    }
+  }
+  m.p = Array::Constant(m.nx, m.nz, opt_.gas.outlet_pressure_pa);
+  m.beta = Array::Zero(m.nx, m.nz);
+  m.ug = m.us = Array::Zero(m.nx + 1, m.nz);
+  m.wg = m.ws = Array::Zero(m.nx, m.nz + 1);
+  m.diag.initial_solids_mass_kg = m.diag.solids_mass_kg =
+      m.phi.sum() * m.dx * m.dz * m.depth * opt_.particle_density_kg_m3;
+  m.diag.max_solids_fraction = m.phi.maxCoeff();
+}
+
+TfmSimulation::~TfmSimulation() = default;
+
+void TfmSimulation::SetState(const Array& solids_fraction, const Array& theta) {
+  Impl& m = *impl_;
+  if (solids_fraction.rows() != m.nx || solids_fraction.cols() != m.nz || theta.rows() != m.nx ||
+      theta.cols() != m.nz)
+    Bad("TfmSimulation::SetState: fields must be nx x nz = " + std::to_string(m.nx) + " x " +
+        std::to_string(m.nz));
+  for (int j = 0; j < m.nz; ++j)
+    for (int i = 0; i < m.nx; ++i) {
+      const double f = solids_fraction(i, j), t = theta(i, j);
+      if (!(std::isfinite(f) && f >= 0.0 && f <= opt_.ktgf.packing_limit))
+        Bad("TfmSimulation::SetState: phi(" + std::to_string(i) + ", " + std::to_string(j) +
+            ") = " + fmt(f) + " is outside [0, packing_limit = " + fmt(opt_.ktgf.packing_limit) +
+            "]");
+      if (!(std::isfinite(t) && t >= 0.0))
+        Bad("TfmSimulation::SetState: theta(" + std::to_string(i) + ", " + std::to_string(j) +
+            ") = " + fmt(t) + " must be >= 0 (a granular temperature)");
+    }
+  m.phi = solids_fraction;
+  m.theta = theta;
+  m.diag.initial_solids_mass_kg = m.diag.solids_mass_kg =
+      m.phi.sum() * m.dx * m.dz * m.depth * opt_.particle_density_kg_m3;
+  m.diag.max_solids_fraction = m.phi.maxCoeff();
+}
+
+void TfmSimulation::SetUniformVelocity(double gas_x, double gas_z, double solids_x,
+                                       double solids_z) {
+  Impl& m = *impl_;
+  if (!std::isfinite(gas_x) || !std::isfinite(gas_z) || !std::isfinite(solids_x) ||
+      !std::isfinite(solids_z))
+    Bad("TfmSimulation::SetUniformVelocity: velocities must be finite");
+  m.ug.setConstant(gas_x);
+  m.us.setConstant(solids_x);
+  m.wg.setConstant(gas_z);
+  m.ws.setConstant(solids_z);
+  for (Array* a : {&m.ug, &m.us}) {
+    a->row(0).setZero();
+    a->row(m.nx).setZero();
+  }
+  m.ws.col(0).setZero();
+  m.ws.col(m.nz).setZero();
+}
+
+double TfmSimulation::time() const { return impl_->time; }
+double TfmSimulation::dx() const { return impl_->dx; }
+double TfmSimulation::dz() const { return impl_->dz; }
+const Array& TfmSimulation::solids_fraction() const { return impl_->phi; }
+Array TfmSimulation::gas_fraction() const { return 1.0 - impl_->phi; }
+const Array& TfmSimulation::theta() const { return impl_->theta; }
+const Array& TfmSimulation::pressure() const { return impl_->p; }
+const Array& TfmSimulation::gas_u() const { return impl_->ug; }
+const Array& TfmSimulation::gas_w() const { return impl_->wg; }
+const Array& TfmSimulation::solids_u() const { return impl_->us; }
+const Array& TfmSimulation::solids_w() const { return impl_->ws; }
+const Array& TfmSimulation::beta() const { return impl_->beta; }
+const TfmDiagnostics& TfmSimulation::diagnostics() const { return impl_->diag; }
+
+double TfmSimulation::PressureDrop(double z_low, double z_high) const {
+  const Impl& m = *impl_;
+  return width_averaged_pressure(m.p, m.dz, z_low, true, opt_.gas.outlet_pressure_pa) -
+         width_averaged_pressure(m.p, m.dz, z_high, true, opt_.gas.outlet_pressure_pa);
+}
+
+namespace {
+
+/// Strain of the solids velocity at cell (i, j): normal rates, the cell-averaged shear rate
+/// S_xz = (du/dz + dw/dx)/2 from the corners (zero on the free-slip walls), divergence, the
+/// deviatoric D':D' and sqrt(I_2D).
+struct Strain {
+  double div = 0.0, dev2 = 0.0, shear_rate = 0.0;
+};
+
+double CornerShear(const Array& us, const Array& ws, int i, int j, double dx, double dz) {
+  const int nx = static_cast<int>(ws.rows()), nz = static_cast<int>(us.cols());
+  if (i <= 0 || i >= nx || j <= 0 || j >= nz) return 0.0;  // free slip: no wall shear
+  return 0.5 * ((us(i, j) - us(i, j - 1)) / dz + (ws(i, j) - ws(i - 1, j)) / dx);
+}
+
+Strain StrainAt(const Array& us, const Array& ws, int i, int j, double dx, double dz) {
+  Strain s;
+  const double uxx = (us(i + 1, j) - us(i, j)) / dx;
+  const double wzz = (ws(i, j + 1) - ws(i, j)) / dz;
+  const double sxz =
+      0.25 * (CornerShear(us, ws, i, j, dx, dz) + CornerShear(us, ws, i + 1, j, dx, dz) +
+              CornerShear(us, ws, i, j + 1, dx, dz) + CornerShear(us, ws, i + 1, j + 1, dx, dz));
+  s.div = uxx + wzz;
+  const double third = s.div / 3.0;
+  // 3-D deviator of a plane strain (D_yy = 0).
+  s.dev2 = (uxx - third) * (uxx - third) + (wzz - third) * (wzz - third) + third * third +
+           2.0 * sxz * sxz;
+  s.shear_rate = std::sqrt(0.5 * s.dev2);
+  return s;
+}
+
+}  // namespace
+
+CellClosures TfmSimulation::Impl::Closures(const TfmOptions& o) const {
+  CellClosures c;
+  for (Array* a : {&c.pressure, &c.pressure_derivative, &c.kinetic_pressure_per_theta, &c.mu,
+                   &c.mu_kinetic, &c.lambda, &c.kappa, &c.dissipation})
+    *a = Array::Zero(nx, nz);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if (phi(i, j) < o.residual_solids) continue;  // no solids stress in empty cells
+      const Strain st = StrainAt(us, ws, i, j, dx, dz);
+      const KtgfCoefficients k = ktgf->Evaluate(phi(i, j), theta(i, j), st.div, st.shear_rate);
+      c.pressure(i, j) = k.pressure_pa;
+      c.pressure_derivative(i, j) = k.pressure_derivative_pa;
+      c.kinetic_pressure_per_theta(i, j) = k.kinetic_pressure_per_theta;
+      c.mu(i, j) = k.shear_viscosity_pa_s;
+      c.mu_kinetic(i, j) = k.shear_viscosity_pa_s - k.frictional_viscosity_pa_s;
+      c.lambda(i, j) = k.bulk_viscosity_pa_s;
+      c.kappa(i, j) = k.conductivity;
+      c.dissipation(i, j) = k.dissipation_rate_coefficient;
+    }
+  return c;
+}
+
+double TfmSimulation::StableTimeStep(TfmStepLimit* limit) const {
+  return impl_->StableStep(impl_->Closures(opt_), limit, opt_);
+}
+
+double TfmSimulation::Impl::StableStep(const CellClosures& c, TfmStepLimit* limit,
+                                       const TfmOptions& o) const {
+  const double rho_s = o.particle_density_kg_m3;
+  const double inv_h2 = 1.0 / (dx * dx) + 1.0 / (dz * dz);
+  const double h = std::min(dx, dz);
+  double gas_rate = 0.0, solids_rate = 0.0, wave = 0.0, nu = 0.0;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      gas_rate = std::max(gas_rate, 0.5 * (std::abs(ug(i, j)) + std::abs(ug(i + 1, j))) / dx +
+                                        0.5 * (std::abs(wg(i, j)) + std::abs(wg(i, j + 1))) / dz);
+      if (phi(i, j) <= 0.0) continue;
+      // Outflow of a cell over a step must not exceed its content (positivity): sum of the
+      // face speeds, not their mean.
+      solids_rate = std::max(solids_rate, (std::abs(us(i, j)) + std::abs(us(i + 1, j))) / dx +
+                                              (std::abs(ws(i, j)) + std::abs(ws(i, j + 1))) / dz);
+      if (phi(i, j) < o.residual_solids) continue;
+      wave = std::max(wave, std::sqrt(std::max(c.pressure_derivative(i, j), 0.0) / rho_s));
+      nu = std::max(nu, (2.0 * c.mu(i, j) + c.lambda(i, j)) / (phi(i, j) * rho_s));
+    }
+  const double gas_viscous = o.gas.rho_g / (2.0 * o.gas.mu_g * inv_h2);
+  struct Candidate {
+    double dt;
+    TfmStepLimit why;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  const Candidate candidates[] = {
+      {std::min(gas_rate > 0.0 ? o.cfl / gas_rate : inf, gas_viscous), TfmStepLimit::kGasCfl},
+      {solids_rate > 0.0 ? o.cfl / solids_rate : inf, TfmStepLimit::kSolidsCfl},
+      {wave > 0.0 ? o.cfl * h / wave : inf, TfmStepLimit::kPressureWave},
+      {nu > 0.0 ? 0.25 / (nu * inv_h2) : inf, TfmStepLimit::kSolidsViscosity},
+      {o.dt_max_s, TfmStepLimit::kMaximum}};
+  Candidate best = candidates[4];
+  for (const Candidate& k : candidates)
+    if (k.dt < best.dt) best = k;
+  if (limit) *limit = best.why;
+  return best.dt;
+}
+
+double TfmSimulation::Step() { return StepCapped(std::numeric_limits<double>::infinity()); }
+
+void TfmSimulation::AdvanceTo(double t_end) {
+  if (!std::isfinite(t_end)) Bad("TfmSimulation::AdvanceTo: t_end must be finite");
+  while (impl_->time < t_end - 1e-12 * std::max(1.0, t_end)) StepCapped(t_end - impl_->time);
+}
+
+double TfmSimulation::StepCapped(double dt_cap) {
+  Impl& m = *impl_;
+  const TfmOptions& o = opt_;
+  const int nx = m.nx, nz = m.nz;
+  const double dx = m.dx, dz = m.dz, volume = dx * dz;
+  const double rho_g = o.gas.rho_g, mu_g = o.gas.mu_g, rho_s = o.particle_density_kg_m3;
+  const double g_z = o.gas.gravity_z, phi_res = o.residual_solids;
+  const double phi_max = o.ktgf.packing_limit;
+  const bool noslip = o.gas.side_walls == WallSlip::kNoSlip;
+  const std::string at = "TFM stopped at t = " + fmt(m.time) + " s: ";
+
+  // ---- closures and the time step ----
+  const CellClosures c = m.Closures(o);
+  TfmStepLimit why = TfmStepLimit::kMaximum;
+  const double stable = m.StableStep(c, &why, o);
+  double dt = 0.0;
+  if (o.fixed_dt_s > 0.0) {
+    if (o.fixed_dt_s > stable * (1.0 + 1e-9))
+      Bad(at + "the fixed time step " + fmt(o.fixed_dt_s) + " s is above the stability limit " +
+          fmt(stable) + " s set by the " + to_string(why) +
+          "; remedy: lower the step or use 0 (adaptive)");
+    dt = std::min(o.fixed_dt_s, dt_cap);
+    why = TfmStepLimit::kFixed;
+  } else {
+    if (stable < o.dt_min_s)
+      Bad(at + "the " + std::string(to_string(why)) + " limits the step to " + fmt(stable) +
+          " s, below dt_min_s = " + fmt(o.dt_min_s) +
+          " s (max gas-phase or solids speed, granular pressure wave speed or solids "
+          "viscosity has run away); remedy: a coarser grid, a slower jet, or friction with a "
+          "larger friction_delta");
+    dt = std::min(stable, dt_cap);
+  }
+  if (!(dt > 0.0)) Bad(at + "time step " + fmt(dt) + " s must be > 0");
+
+  // ---- cell-centred velocities and the drag coefficient ----
+  const Array& phi = m.phi;
+  Array eps = 1.0 - phi;
+  Array dga = Array::Zero(nx, nz);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if (!o.interphase_drag) continue;
+      const double sx = 0.5 * (m.ug(i, j) + m.ug(i + 1, j) - m.us(i, j) - m.us(i + 1, j));
+      const double sz = 0.5 * (m.wg(i, j) + m.wg(i, j + 1) - m.ws(i, j) - m.ws(i, j + 1));
+      try {
+        dga(i, j) = law_->dga(eps(i, j), mu_g, rho_g, std::hypot(sx, sz), o.particle_diameter_m);
+      } catch (const Error& e) {
+        throw Error(e.code(), at + "drag law in cell (" + std::to_string(i) + ", " +
+                                  std::to_string(j) + ") at eps = " + fmt(eps(i, j)) + ": " +
+                                  e.what());
+      }
+    }
+  // Cells below residual_solids carry virtual particles of that fraction, so their solids
+  // velocity stays a settling velocity instead of free fall; their drag on the gas is
+  // negligible (residual_solids / phi of a real cell).
+  m.beta = dga * phi.max(phi_res);
+  // A face's drag coefficient averages beta / eps, the resistance to the SUPERFICIAL velocity
+  // (continuous across a face where eps jumps, as at the bed surface), times the face's eps:
+  // a face half in the bed then gets the drag of its bed half, not half the bed's beta at the
+  // mean of two very different interstitial velocities.
+  const Array resistance = m.beta / eps;
+
+  // ---- solids stress at cell centres (sigma = -P I + tau) and corners ----
+  Array sxx = Array::Zero(nx, nz), szz = Array::Zero(nx, nz);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if (phi(i, j) < phi_res) continue;
+      const double uxx = (m.us(i + 1, j) - m.us(i, j)) / dx;
+      const double wzz = (m.ws(i, j + 1) - m.ws(i, j)) / dz;
+      const double bulk = (c.lambda(i, j) - 2.0 / 3.0 * c.mu(i, j)) * (uxx + wzz);
+      sxx(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * uxx + bulk;
+      szz(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * wzz + bulk;
+    }
+  Array sxz = Array::Zero(nx + 1, nz + 1);  // corners; zero on the free-slip walls
+  for (int j = 1; j < nz; ++j)
+    for (int i = 1; i < nx; ++i) {
+      const double mu_corner =
+          0.25 * (c.mu(i - 1, j - 1) + c.mu(i, j - 1) + c.mu(i - 1, j) + c.mu(i, j));
+      sxz(i, j) = 2.0 * mu_corner * CornerShear(m.us, m.ws, i, j, dx, dz);
+    }
+
+  // ---- ghost values of the tangential velocities ----
+  auto eg = [&](int i, int j) { return eps(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1)); };
+  auto ug_at = [&](int i, int j) {  // no slip at the bottom plate, zero gradient at the outlet
+    if (j < 0) return -m.ug(i, 0);
+    if (j >= nz) return m.ug(i, nz - 1);
+    return m.ug(i, j);
+  };
+  auto wg_at = [&](int i, int j) {
+    j = std::clamp(j, 0, nz);
+    if (i < 0) return noslip ? -m.wg(0, j) : m.wg(0, j);
+    if (i >= nx) return noslip ? -m.wg(nx - 1, j) : m.wg(nx - 1, j);
+    return m.wg(i, j);
+  };
+  auto us_at = [&](int i, int j) { return m.us(i, std::clamp(j, 0, nz - 1)); };  // free slip
+  auto ws_at = [&](int i, int j) { return m.ws(std::clamp(i, 0, nx - 1), j); };
+  auto upwind = [](double speed, double centre, double behind, double ahead, double h) {
+    return speed > 0.0 ? (centre - behind) / h : (ahead - centre) / h;
+  };
+
+  // Partial elimination of the drag on one face: returns the velocities without the new
+  // pressure gradient and their response to it (u = u_hat - c_g dp/dn, v = v_hat - c_s dp/dn).
+  struct Face {
+    double u_hat = 0.0, v_hat = 0.0, c_g = 0.0, c_s = 0.0, eps = 1.0, phi = 0.0;
+    double phi_flux = 0.0;  // the donor cell's phi: the solids fraction the face transports
+  };
+  auto eliminate = [&](double eps_f, double phi_f, double beta_f, double rhs_g, double rhs_s,
+                       double a_g, double a_s) {
+    Face f;
+    f.eps = eps_f;
+    f.phi = phi_f;
+    if (o.freeze_solids) {
+      f.u_hat = rhs_g / (a_g + beta_f);
+      f.c_g = eps_f / (a_g + beta_f);
+      return f;
+    }
+    const double det = a_g * a_s + beta_f * (a_g + a_s);
+    f.u_hat = ((a_s + beta_f) * rhs_g + beta_f * rhs_s) / det;
+    f.v_hat = (beta_f * rhs_g + (a_g + beta_f) * rhs_s) / det;
+    f.c_g = ((a_s + beta_f) * eps_f + beta_f * phi_f) / det;
+    f.c_s = (beta_f * eps_f + (a_g + beta_f) * phi_f) / det;
+    return f;
+  };
+
+  // The volume fluxes carry the donor cell's fractions (upwind by the predicted solids velocity),
+  // in the pressure equation as in the transport: at the bed surface, particles that would fall
+  // out of an empty cell carry no volume, so the gas is not asked to take their place.
+  auto donor = [](double v, double lower, double upper, double central) {
+    return v > 0.0 ? lower : v < 0.0 ? upper : central;
+  };
+
+  // Constraints on a face's solids (after the elimination, so the projection sees them):
+  //  - between two empty cells there are no solids: they move with the gas, so the neighbours
+  //    of a free surface see neither fictitious free-fall momentum nor slip;
+  //  - solids that would flow into a cell at the packing limit, or out of an empty cell (the
+  //    surface face of a bed at rest), are held (v = 0) as by a wall, the contact force of a
+  //    packed bed or the absence of anything to move; the gas alone answers the pressure.
+  //    Without the first, the projection would push solids volume into the full cell and the
+  //    flux limiter would hand it to the gas, a velocity spike that feeds back; without the
+  //    second, the surface face would carry the virtual particles' momentum into the bed.
+  const double packed = phi_max * (1.0 - 1e-3);
+  auto constrain = [&](Face& f, double lower, double upper, double a_g, double beta_f,
+                       double rhs_g) {
+    if (o.freeze_solids) return;
+    if (std::max(lower, upper) < phi_res) {
+      f.v_hat = f.u_hat;
+      f.c_s = f.c_g;
+      return;
+    }
+    const double donor_phi = f.v_hat > 0.0 ? lower : upper;
+    const double acceptor_phi = f.v_hat > 0.0 ? upper : lower;
+    if (acceptor_phi < packed && donor_phi >= phi_res) return;
+    f.v_hat = 0.0;
+    f.c_s = 0.0;
+    f.u_hat = rhs_g / (a_g + beta_f);
+    f.c_g = f.eps / (a_g + beta_f);
+  };
+
+  // ---- momentum predictors on the x-faces ----
+  std::vector<Face> fx(static_cast<std::size_t>((nx + 1) * nz));
+  auto fx_at = [&](int i, int j) -> Face& {
+    return fx[static_cast<std::size_t>(i + (nx + 1) * j)];
+  };
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i) {
+      const double ef = 0.5 * (eps(i - 1, j) + eps(i, j));
+      const double pf = 1.0 - ef;
+      const double pm = std::max(pf, phi_res);
+      const double bf = ef * 0.5 * (resistance(i - 1, j) + resistance(i, j));
+      // Gas: advective upwind, div(eps mu grad u) (gas_phase.h).
+      const double uc = m.ug(i, j);
+      const double wc = 0.25 * (m.wg(i - 1, j) + m.wg(i, j) + m.wg(i - 1, j + 1) + m.wg(i, j + 1));
+      const double adv_g = uc * upwind(uc, uc, m.ug(i - 1, j), m.ug(i + 1, j), dx) +
+                           wc * upwind(wc, uc, ug_at(i, j - 1), ug_at(i, j + 1), dz);
+      const double e_n = 0.25 * (eg(i - 1, j) + eg(i, j) + eg(i - 1, j + 1) + eg(i, j + 1));
+      const double e_s = 0.25 * (eg(i - 1, j) + eg(i, j) + eg(i - 1, j - 1) + eg(i, j - 1));
+      const double flux_n = j == nz - 1 ? 0.0 : e_n * (ug_at(i, j + 1) - uc) / dz;
+      const double flux_s = e_s * (uc - ug_at(i, j - 1)) / dz;
+      const double visc =
+          mu_g *
+          ((eg(i, j) * (m.ug(i + 1, j) - uc) - eg(i - 1, j) * (uc - m.ug(i - 1, j))) / (dx * dx) +
+           (flux_n - flux_s) / dz);
+      const double a_g = ef * rho_g / dt;
+      const double rhs_g = a_g * uc - ef * rho_g * adv_g + visc + ef * o.gas.body_force_x;
+      // Solids: advective upwind, the stress divergence.
+      const double vc = m.us(i, j);
+      const double wsc = 0.25 * (m.ws(i - 1, j) + m.ws(i, j) + m.ws(i - 1, j + 1) + m.ws(i, j + 1));
+      const double adv_s = vc * upwind(vc, vc, m.us(i - 1, j), m.us(i + 1, j), dx) +
+                           wsc * upwind(wsc, vc, us_at(i, j - 1), us_at(i, j + 1), dz);
+      const double stress = (sxx(i, j) - sxx(i - 1, j)) / dx + (sxz(i, j + 1) - sxz(i, j)) / dz;
+      const double a_s = pm * rho_s / dt;
+      const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress;
+      Face& f = fx_at(i, j);
+      f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
+      f.phi_flux = donor(f.v_hat, phi(i - 1, j), phi(i, j), pf);
+      constrain(f, phi(i - 1, j), phi(i, j), a_g, bf, rhs_g);
+    }
+
+  // ---- momentum predictors on the z-faces (interior and the outlet) ----
+  std::vector<Face> fz(static_cast<std::size_t>(nx * (nz + 1)));
+  auto fz_at = [&](int i, int j) -> Face& { return fz[static_cast<std::size_t>(i + nx * j)]; };
+  for (int j = 1; j <= nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const bool top = j == nz;
+      const double ef = top ? eps(i, nz - 1) : 0.5 * (eps(i, j - 1) + eps(i, j));
+      const double pf = top ? 0.0 : 1.0 - ef;
+      const double pm = std::max(pf, phi_res);
+      const double bf =
+          top ? m.beta(i, nz - 1) : ef * 0.5 * (resistance(i, j - 1) + resistance(i, j));
+      const int jc1 = top ? nz - 1 : j;
+      const double wc = m.wg(i, j);
+      const double uc =
+          0.25 * (m.ug(i, j - 1) + m.ug(i + 1, j - 1) + m.ug(i, jc1) + m.ug(i + 1, jc1));
+      const double w_below = m.wg(i, j - 1), w_above = top ? wc : m.wg(i, j + 1);
+      const double adv_g = wc * upwind(wc, wc, w_below, w_above, dz) +
+                           uc * upwind(uc, wc, wg_at(i - 1, j), wg_at(i + 1, j), dx);
+      const double e_up = eg(i, jc1), e_dn = eg(i, j - 1);
+      const double e_e = 0.25 * (eg(i, j - 1) + eg(i + 1, j - 1) + e_up + eg(i + 1, jc1));
+      const double e_w = 0.25 * (eg(i, j - 1) + eg(i - 1, j - 1) + e_up + eg(i - 1, jc1));
+      const double visc =
+          mu_g * ((e_e * (wg_at(i + 1, j) - wc) - e_w * (wc - wg_at(i - 1, j))) / (dx * dx) +
+                  (e_up * (w_above - wc) - e_dn * (wc - w_below)) / (dz * dz));
+      const double a_g = ef * rho_g / dt;
+      const double rhs_g =
+          a_g * wc - ef * rho_g * adv_g + visc + ef * rho_g * g_z + ef * o.gas.body_force_z;
+      if (top) {  // the outlet: gas only (the solids see a wall)
+        Face f;
+        f.eps = ef;
+        f.phi_flux = 1.0 - ef;  // the mixture flux is the gas's alone: eps u
+        f.u_hat = rhs_g / (a_g + bf);
+        f.c_g = ef / (a_g + bf);
+        fz_at(i, j) = f;
+        continue;
+      }
+      const double vc = m.ws(i, j);
+      const double usc = 0.25 * (m.us(i, j - 1) + m.us(i + 1, j - 1) + m.us(i, j) + m.us(i + 1, j));
+      const double adv_s = vc * upwind(vc, vc, m.ws(i, j - 1), m.ws(i, j + 1), dz) +
+                           usc * upwind(usc, vc, ws_at(i - 1, j), ws_at(i + 1, j), dx);
+      const double stress = (szz(i, j) - szz(i, j - 1)) / dz + (sxz(i + 1, j) - sxz(i, j)) / dx;
+      const double a_s = pm * rho_s / dt;
+      const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress + pm * rho_s * g_z;
+      Face& f = fz_at(i, j);
+      f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
+      f.phi_flux = donor(f.v_hat, phi(i, j - 1), phi(i, j), pf);
+      constrain(f, phi(i, j - 1), phi(i, j), a_g, bf, rhs_g);
+    }
+
+  // ---- mixture pressure equation: div(eps u + phi v) = 0 ----
+  const double t_new = m.time + dt;
+  std::vector<double> w_in(static_cast<std::size_t>(nx));
+  for (int i = 0; i < nx; ++i)
+    w_in[static_cast<std::size_t>(i)] = inflow_superficial_velocity(o.gas, dx, i, t_new);
+  Array c_u = Array::Zero(nx + 1, nz), c_w = Array::Zero(nx, nz + 1);
+  Array flux_x = Array::Zero(nx + 1, nz), flux_z = Array::Zero(nx, nz + 1);  // predicted, m^2/s
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i) {
+      const Face& f = fx_at(i, j);
+      c_u(i, j) = (1.0 - f.phi_flux) * f.c_g + f.phi_flux * f.c_s;
+      flux_x(i, j) = ((1.0 - f.phi_flux) * f.u_hat + f.phi_flux * f.v_hat) * dz;
+    }
+  for (int j = 1; j <= nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Face& f = fz_at(i, j);
+      c_w(i, j) = (1.0 - f.phi_flux) * f.c_g + f.phi_flux * f.c_s;
+      flux_z(i, j) = ((1.0 - f.phi_flux) * f.u_hat + f.phi_flux * f.v_hat) * dx;
+    }
+  for (int i = 0; i < nx; ++i) flux_z(i, 0) = w_in[static_cast<std::size_t>(i)] * dx;
+  Array continuity(nx, nz);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i)
+      continuity(i, j) = flux_x(i + 1, j) - flux_x(i, j) + flux_z(i, j + 1) - flux_z(i, j);
+  try {
+    m.p = m.pressure->Solve(c_u, c_w, continuity, o.gas.outlet_pressure_pa, m.p);
+  } catch (const Error& e) {
+    throw Error(e.code(), at + e.what());
+  }
+
+  // ---- projection ----
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i) {
+      const Face& f = fx_at(i, j);
+      const double grad = (m.p(i, j) - m.p(i - 1, j)) / dx;
+      m.ug(i, j) = f.u_hat - f.c_g * grad;
+      m.us(i, j) = f.v_hat - f.c_s * grad;
+    }
+  for (int j = 1; j <= nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Face& f = fz_at(i, j);
+      const double grad = j == nz ? (o.gas.outlet_pressure_pa - m.p(i, nz - 1)) / (0.5 * dz)
+                                  : (m.p(i, j) - m.p(i, j - 1)) / dz;
+      m.wg(i, j) = f.u_hat - f.c_g * grad;
+      m.ws(i, j) = f.v_hat - f.c_s * grad;
+    }
+  for (int i = 0; i < nx; ++i) {
+    m.wg(i, 0) = w_in[static_cast<std::size_t>(i)] / eps(i, 0);
+    m.ws(i, 0) = 0.0;
+    m.ws(i, nz) = 0.0;
+  }
+  if (!m.ug.allFinite() || !m.wg.allFinite() || !m.us.allFinite() || !m.ws.allFinite() ||
+      !m.p.allFinite())
+    Bad(at + "non-finite velocity or pressure after a step of " + fmt(dt) +
+        " s (limit: " + to_string(why) + "); remedy: lower cfl or dt_max_s");
+
+  // ---- solids fluxes (upwind phi), the mixture flux, and the bounds ----
+  Array fs_x = Array::Zero(nx + 1, nz), fs_z = Array::Zero(nx, nz + 1);
+  Array mix_x = Array::Zero(nx + 1, nz), mix_z = Array::Zero(nx, nz + 1);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i) {
+      const double v = m.us(i, j), pf = fx_at(i, j).phi_flux;
+      fs_x(i, j) = v * pf * dz;
+      mix_x(i, j) = ((1.0 - pf) * m.ug(i, j) + pf * v) * dz;
+    }
+  for (int j = 1; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double v = m.ws(i, j), pf = fz_at(i, j).phi_flux;
+      fs_z(i, j) = v * pf * dx;
+      mix_z(i, j) = ((1.0 - pf) * m.wg(i, j) + pf * v) * dx;
+    }
+  for (int i = 0; i < nx; ++i) {
+    mix_z(i, 0) = w_in[static_cast<std::size_t>(i)] * dx;
+    mix_z(i, nz) = eps(i, nz - 1) * m.wg(i, nz) * dx;
+  }
+  Array limited_x = Array::Zero(nx + 1, nz), limited_z = Array::Zero(nx, nz + 1);
+  // Net solids outflow of cell (i, j) over the step and its parts [m^2 per unit depth].
+  auto outflow = [&](int i, int j) {
+    return dt * (std::max(fs_x(i + 1, j), 0.0) + std::max(-fs_x(i, j), 0.0) +
+                 std::max(fs_z(i, j + 1), 0.0) + std::max(-fs_z(i, j), 0.0));
+  };
+  auto inflow = [&](int i, int j) {
+    return dt * (std::max(-fs_x(i + 1, j), 0.0) + std::max(fs_x(i, j), 0.0) +
+                 std::max(-fs_z(i, j + 1), 0.0) + std::max(fs_z(i, j), 0.0));
+  };
+  // Positivity: a cell cannot give more than it holds.
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double out = outflow(i, j), holds = phi(i, j) * volume;
+      if (out <= holds) continue;
+      const double r = holds / out;
+      if (fs_x(i + 1, j) > 0.0) fs_x(i + 1, j) *= r, limited_x(i + 1, j) = 1.0;
+      if (fs_x(i, j) < 0.0) fs_x(i, j) *= r, limited_x(i, j) = 1.0;
+      if (fs_z(i, j + 1) > 0.0) fs_z(i, j + 1) *= r, limited_z(i, j + 1) = 1.0;
+      if (fs_z(i, j) < 0.0) fs_z(i, j) *= r, limited_z(i, j) = 1.0;
+    }
+  // Packing limit: a full cell takes only what it has room for (each pass only lowers fluxes,
+  // so the passes converge; a donor that keeps more is checked in the next pass).
+  Array phi_new(nx, nz);
+  auto update_phi = [&]() {
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i)
+        phi_new(i, j) = phi(i, j) + (inflow(i, j) - outflow(i, j)) / volume;
+  };
+  update_phi();
+  const double bound_slack = 1e-12;
+  bool over = true;
+  for (int pass = 0; pass < 200 && over; ++pass) {
+    over = false;
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        if (phi_new(i, j) <= phi_max + bound_slack) continue;
+        over = true;
+        const double in = inflow(i, j);
+        const double room = std::max((phi_max - phi(i, j)) * volume + outflow(i, j), 0.0);
+        const double r = in > 0.0 ? std::min(room / in, 1.0) : 0.0;
+        if (fs_x(i + 1, j) < 0.0) fs_x(i + 1, j) *= r, limited_x(i + 1, j) = 1.0;
+        if (fs_x(i, j) > 0.0) fs_x(i, j) *= r, limited_x(i, j) = 1.0;
+        if (fs_z(i, j + 1) < 0.0) fs_z(i, j + 1) *= r, limited_z(i, j + 1) = 1.0;
+        if (fs_z(i, j) > 0.0) fs_z(i, j) *= r, limited_z(i, j) = 1.0;
+      }
+    if (over) update_phi();
+  }
+  const double phi_new_max = phi_new.maxCoeff(), phi_new_min = phi_new.minCoeff();
+  if (!(phi_new_max <= phi_max + 1e-9) || !(phi_new_min >= -1e-12))
+    Bad(at + "the solids fraction left [0, packing_limit = " + fmt(phi_max) + "] (min " +
+        fmt(phi_new_min) + ", max " + fmt(phi_new_max) +
+        ") although the flux limiter ran; remedy: lower cfl");
+  phi_new = phi_new.max(0.0).min(phi_max);
+  // The limited faces: the solids velocity carries the limited flux, the gas the rest of the
+  // unchanged mixture flux.
+  long limited = 0;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i) {
+      if (limited_x(i, j) == 0.0) continue;
+      ++limited;
+      const double up = fx_at(i, j).phi_flux;
+      if (up > 0.0) m.us(i, j) = fs_x(i, j) / (up * dz);
+      m.ug(i, j) = (mix_x(i, j) / dz - up * m.us(i, j)) / (1.0 - up);
+    }
+  for (int j = 1; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if (limited_z(i, j) == 0.0) continue;
+      ++limited;
+      const double up = fz_at(i, j).phi_flux;
+      if (up > 0.0) m.ws(i, j) = fs_z(i, j) / (up * dx);
+      m.wg(i, j) = (mix_z(i, j) / dx - up * m.ws(i, j)) / (1.0 - up);
+    }
+
+  // ---- granular temperature (Eq. 15): transport and production explicit; conduction and
+  // the sinks (dissipation, drag, expansion) implicit, an M-matrix, so theta >= 0 for any step.
+  // Cells below residual_solids hold theta = 0 and no conduction reaches them. ----
+  Array kappa_x = Array::Zero(nx + 1, nz), kappa_z = Array::Zero(nx, nz + 1);
+  auto active = [&](int i, int j) { return phi_new(i, j) >= phi_res && phi(i, j) >= phi_res; };
+  // Harmonic face mean: a dilute cell next to a dense one exchanges at its own, small rate.
+  auto harmonic = [](double a, double b) { return a + b > 0.0 ? 2.0 * a * b / (a + b) : 0.0; };
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i)
+      if (active(i - 1, j) && active(i, j))
+        kappa_x(i, j) = harmonic(c.kappa(i - 1, j), c.kappa(i, j));
+  for (int j = 1; j < nz; ++j)
+    for (int i = 0; i < nx; ++i)
+      if (active(i, j - 1) && active(i, j))
+        kappa_z(i, j) = harmonic(c.kappa(i, j - 1), c.kappa(i, j));
+  const Array& th = m.theta;
+  auto theta_c = [&](int i, int j) {
+    return th(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1));
+  };
+  const int cells = nx * nz;
+  auto id = [nx](int i, int j) { return i + nx * j; };
+  Eigen::VectorXd energy_rhs = Eigen::VectorXd::Zero(cells);
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(5 * cells));
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int k = id(i, j);
+      // Every coupling is entered (zero where inactive) so the pattern never changes.
+      const double gx_e = i + 1 < nx ? kappa_x(i + 1, j) / (dx * dx) : 0.0;
+      const double gx_w = i > 0 ? kappa_x(i, j) / (dx * dx) : 0.0;
+      const double gz_n = j + 1 < nz ? kappa_z(i, j + 1) / (dz * dz) : 0.0;
+      const double gz_s = j > 0 ? kappa_z(i, j) / (dz * dz) : 0.0;
+      if (i + 1 < nx) triplets.emplace_back(k, id(i + 1, j), -gx_e);
+      if (i > 0) triplets.emplace_back(k, id(i - 1, j), -gx_w);
+      if (j + 1 < nz) triplets.emplace_back(k, id(i, j + 1), -gz_n);
+      if (j > 0) triplets.emplace_back(k, id(i, j - 1), -gz_s);
+      if (phi_new(i, j) < phi_res) {
+        triplets.emplace_back(k, k, 1.0);  // theta = 0
+        continue;
+      }
+      // Upwind transport of phi theta with the final solids fluxes (out: own theta, in: the
+      // donor's).
+      auto carried = [&](double flux_out, int ni, int nj) {
+        return flux_out * (flux_out > 0.0 ? th(i, j) : theta_c(ni, nj));
+      };
+      const double adv = carried(fs_x(i + 1, j), i + 1, j) + carried(-fs_x(i, j), i - 1, j) +
+                         carried(fs_z(i, j + 1), i, j + 1) + carried(-fs_z(i, j), i, j - 1);
+      const Strain st = StrainAt(m.us, m.ws, i, j, dx, dz);
+      const double production =
+          2.0 * c.mu_kinetic(i, j) * st.dev2 + c.lambda(i, j) * st.div * st.div;
+      const double expansion = c.kinetic_pressure_per_theta(i, j) * st.div;  // P_s div v / theta
+      const double dissipation = c.dissipation(i, j);
+      energy_rhs(k) = 1.5 * rho_s * (phi(i, j) * th(i, j) - dt * adv / volume) / dt + production +
+                      std::max(-expansion, 0.0) * th(i, j) + std::max(-dissipation, 0.0) * th(i, j);
+      const double diagonal = 1.5 * rho_s * phi_new(i, j) / dt + std::max(dissipation, 0.0) +
+                              std::max(expansion, 0.0) +
+                              (o.interphase_drag ? 3.0 * m.beta(i, j) : 0.0);
+      triplets.emplace_back(k, k, diagonal + gx_e + gx_w + gz_n + gz_s);
+    }
+  Eigen::SparseMatrix<double> energy(cells, cells);
+  energy.setFromTriplets(triplets.begin(), triplets.end());
+  if (!m.energy_ordered) {
+    m.energy_solver.analyzePattern(energy);
+    m.energy_ordered = true;
+  }
+  m.energy_solver.factorize(energy);
+  if (m.energy_solver.info() != Eigen::Success)
+    Bad(at + "the granular temperature equation could not be factorised; remedy: lower cfl");
+  const Eigen::VectorXd theta_vector = m.energy_solver.solve(energy_rhs);
+  Array theta_new = Eigen::Map<const Array>(theta_vector.data(), nx, nz);
+  const double theta_min = theta_new.minCoeff();
+  if (!theta_new.allFinite()) Bad(at + "non-finite granular temperature; remedy: lower cfl");
+  if (theta_min < -1e-9 * std::max(theta_new.maxCoeff(), 1e-12)) {
+    // The explicit parts are non-negative under the CFL limit; a negative value means the
+    // transport outran it.
+    Bad(at + "the granular temperature became negative (" + fmt(theta_min) +
+        " m^2/s^2) with a step of " + fmt(dt) + " s (limit: " + to_string(why) +
+        "); remedy: lower cfl");
+  }
+  theta_new = theta_new.max(0.0);
+
+  // ---- diagnostics ----
+  double gas_in = 0.0, gas_out = 0.0;
+  for (int i = 0; i < nx; ++i) {
+    gas_in += mix_z(i, 0);
+    gas_out += mix_z(i, nz);
+  }
+  const double storage = -(phi_new - phi).sum() * volume / dt;  // d/dt int eps
+  const double mass_scale = rho_g * m.depth * dt;
+  TfmDiagnostics& dg = m.diag;
+  dg.gas_mass_in_kg += mass_scale * gas_in;
+  dg.gas_mass_imbalance_kg += mass_scale * (gas_in - gas_out - storage);
+  m.phi = phi_new;
+  m.theta = theta_new;
+  m.time = t_new;
+  ++dg.steps;
+  dg.time_s = m.time;
+  dg.last_dt_s = dt;
+  dg.min_dt_s = dg.steps == 1 ? dt : std::min(dg.min_dt_s, dt);
+  dg.last_limit = why;
+  ++dg.steps_by_limit[static_cast<int>(why)];
+  dg.solids_mass_kg = m.phi.sum() * volume * m.depth * rho_s;
+  dg.max_solids_fraction = std::max(dg.max_solids_fraction, phi_new_max);
+  dg.max_theta_m2_s2 = std::max(dg.max_theta_m2_s2, theta_new.maxCoeff());
+  dg.flux_limited_faces += limited;
+  dg.max_wave_speed_m_s = std::max(
+      dg.max_wave_speed_m_s, std::sqrt(std::max(c.pressure_derivative.maxCoeff(), 0.0) / rho_s));
+  dg.poisson_residual = m.pressure->diagnostics().relative_residual;
+  return dt;
+}
+
+}  // namespace consumers
+}  // namespace draglab

@@ -1,0 +1,272 @@
+// Two-fluid model validations (consumers/tfm.h, ktgf.h). Each test states its set-up and the
+// independent reference it is checked against; docs/tfm.md has the derivations.
+//
+// Particles: 2.5 mm glass (2526 kg/m^3) in air (1.2 kg/m^3, 1.8e-5 Pa s), the seed's bed
+// material, unless a test says otherwise.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "draglab/consumers/ktgf.h"
+#include "draglab/consumers/scene.h"
+#include "draglab/consumers/tfm.h"
+#include "draglab/drag_db/database.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kD = 2.5e-3, kRhoS = 2526.0, kRhoG = 1.2, kMu = 1.8e-5, kG = 9.81;
+
+/// Largest solids speed on faces between two cells that hold solids (a face next to an empty
+/// cell carries the virtual particles' velocity, which moves no volume).
+double MaxSolidsSpeed(const TfmSimulation& tfm, double min_phi = 1e-3) {
+  const Eigen::ArrayXXd& phi = tfm.solids_fraction();
+  double v = 0.0;
+  for (int j = 0; j < phi.cols(); ++j)
+    for (int i = 0; i < phi.rows(); ++i) {
+      if (i > 0 && std::min(phi(i - 1, j), phi(i, j)) > min_phi)
+        v = std::max(v, std::abs(tfm.solids_u()(i, j)));
+      if (j > 0 && std::min(phi(i, j - 1), phi(i, j)) > min_phi)
+        v = std::max(v, std::abs(tfm.solids_w()(i, j)));
+    }
+  return v;
+}
+
+class TfmTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    path_ = ::testing::TempDir() + "/tfm_test.db";
+    std::remove(path_.c_str());
+    db_ = std::make_unique<Database>(path_);
+  }
+  static void TearDownTestSuite() {
+    db_.reset();
+    std::remove(path_.c_str());
+  }
+  static std::shared_ptr<const Law> law(const std::string& ref) {
+    auto l = db_->load(ref);
+    l->set_range_policy(RangePolicy::kClamp);
+    return l;
+  }
+  /// A column nx x nz of width w and height h, no inflow, gravity on.
+  static TfmOptions column(int nx, int nz, double w, double h) {
+    TfmOptions o;
+    o.gas.nx = nx;
+    o.gas.nz = nz;
+    o.gas.width_m = w;
+    o.gas.height_m = h;
+    o.gas.depth_m = 0.015;
+    o.gas.rho_g = kRhoG;
+    o.gas.mu_g = kMu;
+    o.gas.gravity_z = -kG;
+    o.gas.side_walls = WallSlip::kFreeSlip;
+    o.particle_diameter_m = kD;
+    o.particle_density_kg_m3 = kRhoS;
+    o.initial_bed_height_m = 0.0;
+    return o;
+  }
+  static std::string path_;
+  static std::unique_ptr<Database> db_;
+};
+std::string TfmTest::path_;
+std::unique_ptr<Database> TfmTest::db_;
+
+// Fixed bed: uniform phi = 0.6 held at rest (freeze_solids), superficial inflow U = 0.5 m/s.
+// Reference (seed Eq. 9 at steady uniform flow): -dp/dz = beta U / eps^2 + rho_g g, and with
+// Ergun's beta the drag part is Ergun's packed-bed gradient 150 phi^2 mu U / (eps^3 d^2) +
+// 1.75 phi rho U^2 / (eps^3 d) = 3183.75 Pa/m (consumers.md section 6 quotes 3 184 Pa/m).
+// The law is evaluated through the database (ergun@1), the reference in closed form here.
+// Tolerance 1e-6: the discrete uniform flow is exact; the remainder is the approach to steady
+// state over 0.2 s (the gas relaxes in eps rho_g / beta ~ 1e-4 s).
+TEST_F(TfmTest, FixedBedPressureDropMatchesErgun) {
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.gas.background_velocity_m_s = 0.5;
+  o.initial_solids = 0.6;
+  o.initial_bed_height_m = 0.2;
+  o.freeze_solids = true;
+  TfmSimulation tfm(o, law("ergun@1"));
+  tfm.AdvanceTo(0.2);
+  const double eps = 0.4, phi = 0.6, u = 0.5;
+  const double ergun = 150.0 * phi * phi * kMu * u / (eps * eps * eps * kD * kD) +
+                       1.75 * phi * kRhoG * u * u / (eps * eps * eps * kD);
+  EXPECT_NEAR(ergun, 3183.75, 1e-6 * 3183.75);
+  const double measured = tfm.PressureDrop(0.05, 0.15) / 0.10;
+  EXPECT_NEAR(measured, ergun + kRhoG * kG, 1e-6 * ergun) << tfm.diagnostics().BriefReport();
+}
+
+// A bed of 500 um glass (the Kuipers et al. jet bed's particles) at minimum fluidization:
+// phi = 1 - eps_mf = 0.58 up to 10 cm, the superficial inflow at ergun@1's own U_mf
+// (minimum_fluidization, scene.h), Johnson-Jackson friction from phi = 0.5 (ktgf.h defaults).
+// Without a solids pressure the two-fluid equations are ill-posed and a bed at U_mf breaks up
+// from round-off (docs/tfm.md); the frictional pressure makes it well posed, and a bed above
+// friction_min_solids is pre-stressed, so the bed expands a little at the surface and then
+// rests with the drag carrying most of its weight and the contacts the rest.
+// References: (1) at rest: every solids speed in the bed below 5 % of U_mf after 1 s (a bed that
+// settles or fluidizes moves at O(U_mf) = 0.2 m/s; what remains is the partly filled surface
+// row, too dilute for its drag to carry it and too thin to fall, oscillating by mm/s); (2) the
+// mixture momentum balance: gas pressure drop over the bed plus the contact pressure at the bottom
+// cell equals the buoyant weight plus the gas column, within 1 % (the bottom cell's contact
+// pressure sits half a cell above the plate); (3) the drag law: the gas pressure drop equals the
+// sum over cells of Ergun's closed-form gradient at each cell's own final phi (independent of the
+// database's law code), within the same half row (the surface row's gas is not in the uniform-bed
+// balance the sum assumes); (4) the solids mass is conserved to round-off (1e-12).
+TEST_F(TfmTest, BedAtMinimumFluidizationRestsAndCarriesItsWeight) {
+  const double d = 5e-4, phi0 = 0.58, h = 0.1;
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.particle_diameter_m = d;
+  o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
+  SceneParticles particles;
+  particles.diameter_m = d;
+  particles.density_kg_m3 = kRhoS;
+  SceneGas gas;
+  gas.density_kg_m3 = kRhoG;
+  gas.viscosity_pa_s = kMu;
+  gas.gravity_m_s2 = kG;
+  MinFluidizationOptions mo;
+  mo.eps_mf = 1.0 - phi0;
+  auto ergun = law("ergun@1");
+  const double umf = minimum_fluidization(*ergun, particles, gas, mo).umf_m_s;
+  o.gas.background_velocity_m_s = umf;
+  o.initial_solids = phi0;
+  o.initial_bed_height_m = h;
+  o.initial_theta_m2_s2 = 0.0;
+  TfmSimulation tfm(o, ergun);
+  tfm.SetUniformVelocity(0.0, umf / (1.0 - phi0), 0.0, 0.0);
+  tfm.AdvanceTo(1.0);
+  const TfmDiagnostics& dg = tfm.diagnostics();
+  EXPECT_LT(MaxSolidsSpeed(tfm, 0.1), 0.05 * umf) << dg.BriefReport();
+  // Balances from the bottom cell centre up (the plate is half a cell below it): the bottom
+  // cell counts half.
+  const Eigen::ArrayXXd& phi = tfm.solids_fraction();
+  const double dz = tfm.dz();
+  double weight = 0.0, ergun_drop = 0.0, top = 0.0;
+  for (int j = 0; j < 40; ++j) {
+    const double p = phi.col(j).mean(), e = 1.0 - p, share = j == 0 ? 0.5 * dz : dz;
+    weight += (p * kRhoS + e * kRhoG) * kG * share;
+    // Ergun with the interstitial slip U/eps: -dp/dz = beta U / eps^2 + rho_g g.
+    const double beta = 150.0 * p * p * kMu / (e * d * d) + 1.75 * p * kRhoG * (umf / e) / d;
+    ergun_drop += (beta * umf / (e * e) + kRhoG * kG) * share;
+    if (p > 0.5 * phi0) top = (j + 1) * dz;
+  }
+  const double gas_drop = tfm.PressureDrop(0.5 * dz, 0.2);
+  KtgfOptions contact_model = o.ktgf;
+  contact_model.knudsen_length_m = dz;
+  const double contact =
+      KtgfClosures(contact_model, d, kRhoS).Evaluate(phi.col(0).mean(), 0.0, 0.0, 0.0).pressure_pa;
+  const double half_row = 0.5 * phi0 * kRhoS * kG * dz;
+  EXPECT_NEAR(gas_drop + contact, weight, half_row)
+      << "gas " << gas_drop << " Pa + contacts " << contact << " Pa";
+  EXPECT_NEAR(gas_drop, ergun_drop, half_row);
+  EXPECT_GT(gas_drop, 0.8 * weight) << "the drag carries most of the weight";
+  EXPECT_NEAR(top, h, 2.0 * dz) << "the bed keeps its height";
+  EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
+}
+
+// Sedimentation: phi = 0.3 of 500 um glass fills the lower 12 cm of a closed-bottom column with
+// no inflow; the particles settle, the gas they displace leaves through the top.
+// Without friction (KTGF only: theta decays, the collisional pressure vanishes) nothing but the
+// packing limit stops the particles. References: (1) phi never exceeds the packing limit, at any
+// step (1e-12); (2) the settled bottom cells sit at the limit (1e-6); (3) the settled height is
+// the solids volume over the limit, within two cells (the surface row is partly filled);
+// (4) solids mass conserved to round-off (1e-12) and the gas mass balance to 1e-12 kg.
+TEST_F(TfmTest, SedimentingColumnReachesThePackingLimitWithoutOvershoot) {
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.particle_diameter_m = 5e-4;
+  o.initial_solids = 0.3;
+  o.initial_bed_height_m = 0.12;
+  o.initial_theta_m2_s2 = 1e-4;
+  TfmSimulation tfm(o, law("ergun@1"));
+  double max_phi = 0.0;
+  while (tfm.time() < 1.5) {
+    tfm.Step();
+    max_phi = std::max(max_phi, tfm.solids_fraction().maxCoeff());
+  }
+  const TfmDiagnostics& dg = tfm.diagnostics();
+  const double limit = o.ktgf.packing_limit;
+  EXPECT_LE(max_phi, limit + 1e-12) << dg.BriefReport();
+  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), limit, 1e-3)
+      << dg.BriefReport() << " theta " << tfm.theta()(1, 0);
+  EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
+  double solids_height = 0.0, top = 0.0;
+  for (int j = 0; j < 40; ++j) {
+    solids_height += tfm.solids_fraction().col(j).mean() * tfm.dz();
+    if (tfm.solids_fraction().col(j).mean() > 1e-3) top = (j + 1) * tfm.dz();
+  }
+  EXPECT_NEAR(solids_height, 0.3 * 0.12, 1e-12);
+  EXPECT_NEAR(top, 0.3 * 0.12 / limit, 2.0 * tfm.dz());
+  EXPECT_LT(std::abs(dg.gas_mass_imbalance_kg), 1e-12);
+  EXPECT_GT(dg.flux_limited_faces, 0) << "the limiter, not the solids pressure, stopped them";
+}
+
+// The same column with Johnson-Jackson friction: the frictional pressure, not the limit, now
+// carries the settled bed. Reference: at rest, the contact pressure at the bottom cell carries
+// the buoyant weight of the solids above its centre, so the bottom phi solves
+//   Fr (phi - phi_min)^n / max(phi_max - phi, delta)^p = (rho_s - rho_g) g (V_s/A - phi dz/2),
+// solved here by bisection (V_s/A = 0.036 m of solids); within 1e-3 in phi (the gas drag of
+// the last settling motion). phi stays below the limit at every step.
+TEST_F(TfmTest, SedimentingColumnWithFrictionRestsOnItsContactPressure) {
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.particle_diameter_m = 5e-4;
+  o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
+  o.initial_solids = 0.3;
+  o.initial_bed_height_m = 0.12;
+  o.initial_theta_m2_s2 = 1e-4;
+  TfmSimulation tfm(o, law("ergun@1"));
+  double max_phi = 0.0;
+  while (tfm.time() < 2.0) {
+    tfm.Step();
+    max_phi = std::max(max_phi, tfm.solids_fraction().maxCoeff());
+  }
+  const KtgfOptions& k = o.ktgf;
+  auto residual = [&](double phi) {
+    const double pf = k.friction_fr_pa * std::pow(phi - k.friction_min_solids, k.friction_n) /
+                      std::pow(std::max(k.packing_limit - phi, k.friction_delta), k.friction_p);
+    return pf - (kRhoS - kRhoG) * kG * (0.036 - 0.5 * phi * tfm.dz());
+  };
+  double lo = k.friction_min_solids, hi = k.packing_limit;
+  for (int n = 0; n < 100; ++n) (residual(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+  EXPECT_LT(max_phi, k.packing_limit);
+  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), 0.5 * (lo + hi), 1e-3)
+      << tfm.diagnostics().BriefReport();
+  EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
+}
+
+// Homogeneous cooling (Haff's law): a closed box, no gravity, no gas drag, uniform phi = 0.3
+// and theta0 = 1e-2 m^2/s^2 at rest. Eq. 15 reduces to (3/2) phi rho_s dtheta/dt = -gamma with
+// the Nieuwland dissipation gamma = 3 (1 - e^2) phi^2 rho_s g0 theta (4/d) sqrt(theta/pi), so
+//   theta(t) = theta0 / (1 + t/tau)^2,  1/tau = (4/d) (1 - e^2) phi g0 sqrt(theta0/pi)
+// (Haff 1983). g0 is Ma-Ahmadi's at phi = 0.3 with phi_max = 0.64, written out here.
+// Tolerance: the sink is implicit with sqrt(theta) lagged, a first-order scheme with an error
+// ~ dt/tau; with dt = tau/1000 the error at t = 3 tau is below 0.5 %.
+TEST_F(TfmTest, HomogeneousCoolingFollowsHaffsLaw) {
+  TfmOptions o = column(3, 3, 0.03, 0.03);
+  o.gas.gravity_z = 0.0;
+  o.interphase_drag = false;
+  o.ktgf.restitution = 0.9;
+  const double phi = 0.3, theta0 = 1e-2, e = 0.9;
+  o.initial_solids = phi;
+  o.initial_bed_height_m = 0.03;
+  o.initial_theta_m2_s2 = theta0;
+  const double x = phi / 0.64;
+  const double g0 = (1.0 + 2.5 * phi + 4.5904 * phi * phi + 4.515439 * phi * phi * phi) /
+                    std::pow(1.0 - x * x * x, 0.67802);
+  const double tau = 1.0 / ((4.0 / kD) * (1.0 - e * e) * phi * g0 * std::sqrt(theta0 / kPi));
+  o.fixed_dt_s = tau / 1000.0;
+  TfmSimulation tfm(o, law("ergun@1"));
+  for (double t : {0.5 * tau, tau, 3.0 * tau}) {
+    tfm.AdvanceTo(t);
+    const double expected = theta0 / ((1.0 + t / tau) * (1.0 + t / tau));
+    EXPECT_NEAR(tfm.theta()(1, 1), expected, 5e-3 * expected) << "t = " << t / tau << " tau";
+    EXPECT_NEAR(tfm.theta().maxCoeff(), tfm.theta().minCoeff(), 1e-12 * expected) << "uniform";
+  }
+}
+
+}  // namespace
+}  // namespace consumers
+}  // namespace draglab
