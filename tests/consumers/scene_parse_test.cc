@@ -88,6 +88,39 @@ TEST(SceneParse, FixedBackground) {
   EXPECT_DOUBLE_EQ(s.distributor.velocity_m_s, 1.26);
 }
 
+// The two-fluid scene: its [tfm] table read, its defaults, and every bad [tfm] input named
+// (issue: unknown solver, missing [tfm], restitution outside (0, 1], packing limit not above the
+// bed's solids fraction, negative theta, unknown closure names, [tfm] with another solver).
+TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
+  const std::string base = read("tfm_bubble.toml");
+  const Scene s = parse_scene(base, "tfm_bubble.toml");
+  EXPECT_EQ(s.solver, "tfm");
+  EXPECT_TRUE(s.tfm.present);
+  EXPECT_EQ(s.tfm.closures, "nieuwland");
+  EXPECT_DOUBLE_EQ(s.tfm.packing_limit, 0.64);
+  EXPECT_DOUBLE_EQ(s.tfm.restitution, -1.0) << "from [particles] unless given";
+  EXPECT_DOUBLE_EQ(s.geometry.height_m, 0.60) << "the seed's TFM box is 60 cm high";
+  expect_bad(edit(base, "scene", "solver", "solver = \"lbm\""), {"[scene] solver", "tfm", "dpm"});
+  expect_bad(base.substr(0, base.find("[tfm]")) + base.substr(base.find("[outputs]")),
+             {"[tfm] table is missing"});
+  expect_bad(edit(base, "tfm", "closures", "restitution = 1.5"), {"[tfm] restitution", "(0, 1]"});
+  expect_bad(edit(base, "tfm", "closures", "restitution = 0"), {"[tfm] restitution"});
+  expect_bad(edit(base, "tfm", "packing_limit", "packing_limit = 0.55"),
+             {"[tfm] packing_limit", "0.58"});
+  expect_bad(edit(base, "tfm", "packing_limit", "packing_limit = 0.58"), {"[tfm] packing_limit"});
+  expect_bad(edit(base, "tfm", "theta_initial_m2_s2", "theta_initial_m2_s2 = -1e-3"),
+             {"[tfm] theta_initial_m2_s2", ">= 0"});
+  expect_bad(edit(base, "tfm", "closures", "closures = \"lun\""), {"[tfm] closures", "gidaspow"});
+  expect_bad(edit(base, "tfm", "radial_distribution", "radial_distribution = \"x\""),
+             {"[tfm] radial_distribution", "carnahan_starling"});
+  expect_bad(edit(base, "tfm", "friction", "friction = \"coulomb\""), {"[tfm] friction", "none"});
+  expect_bad(edit(base, "tfm", "cfl", "cfl = 0.9"), {"[tfm] cfl", "0.5"});
+  expect_bad(edit(base, "tfm", "dt_max_s", "dt_max_s = 0"), {"[tfm] dt_max_s"});
+  expect_bad(edit(base, "tfm", "closures", "cloures = \"nieuwland\""), {"unknown key", "cloures"});
+  expect_bad(read("dpm_bubble.toml") + "\n[tfm]\nclosures = \"nieuwland\"\n",
+             {"[tfm] is read only with solver = \"tfm\""});
+}
+
 TEST(SceneParse, EveryBadInputIsNamed) {
   const std::string base = read("dpm_bubble.toml");
   expect_bad(base + "\n[extra]\nx = 1\n", {"unknown section", "extra", "[geometry]"});

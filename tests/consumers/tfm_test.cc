@@ -7,14 +7,19 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
+#include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/ktgf.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/consumers/tfm.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
+
+#include <nlohmann/json.hpp>
 
 namespace draglab {
 namespace consumers {
@@ -265,6 +270,35 @@ TEST_F(TfmTest, HomogeneousCoolingFollowsHaffsLaw) {
     EXPECT_NEAR(tfm.theta()(1, 1), expected, 5e-3 * expected) << "t = " << t / tau << " tau";
     EXPECT_NEAR(tfm.theta().maxCoeff(), tfm.theta().minCoeff(), 1e-12 * expected) << "uniform";
   }
+}
+
+// The tiny two-fluid scene through the bed-model registry (tests/cli/data/tfm_tiny.toml): a
+// jet into a bed at U_mf must make a bubble at t_ref, the bed's solids mass is conserved to
+// round-off and the gas mass balance to 1e-12 (relative), before the jet the gas carries the
+// bed (pressure drop above the first cell centre within 10 % of the weight there: a 6-row bed
+// whose surface row is partly filled and oscillates; a bed resting on the plate or thrown up
+// would be far outside), and the result JSON names the model and the closures.
+TEST_F(TfmTest, TinySceneThroughTheRegistryMakesABubbleAndConservesMass) {
+  std::ifstream file(std::string(DRAGLAB_TEST_SCENES_DIR) + "/tfm_tiny.toml");
+  std::stringstream text;
+  text << file.rdbuf();
+  const Scene scene = parse_scene(text.str(), "tfm_tiny.toml");
+  const BedResult r = run_bed_model(scene, law("ergun@1"));
+  EXPECT_EQ(r.model, "tfm");
+  EXPECT_TRUE(r.metrics.bubble_present) << r.brief;
+  EXPECT_GT(r.metrics.bubble_diameter_m, 0.01) << r.brief;
+  EXPECT_LT(r.max_relative_mass_imbalance, 1e-12);
+  const nlohmann::json j = nlohmann::json::parse(r.result_json);
+  EXPECT_EQ(j.at("solver"), "tfm");
+  EXPECT_EQ(j.at("closures").at("set"), "nieuwland");
+  EXPECT_LT(std::abs(j.at("relative_solids_mass_change").get<double>()), 1e-12);
+  EXPECT_LE(j.at("max_solids_fraction").get<double>(), 0.64 + 1e-12);
+  const double dz = scene.geometry.height_m / scene.grid.cells_y;
+  const double weight =
+      (1.0 - scene.eps_mf) * (kRhoS - kRhoG) * kG * (scene.bed_height_mf_m() - 0.5 * dz);
+  ASSERT_FALSE(r.series.empty());
+  EXPECT_LT(r.series.front().t_s, 0.0) << "a sample before the jet";
+  EXPECT_NEAR(r.series.front().pressure_drop_pa, weight, 0.1 * weight) << r.brief;
 }
 
 }  // namespace

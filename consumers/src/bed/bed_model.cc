@@ -32,6 +32,7 @@ Registry& registry() {
   static Registry* r = [] {
     auto* made = new Registry;
     add(*made, internal::make_dpm_bed_model());
+    add(*made, internal::make_tfm_bed_model());
     return made;
   }();
   return *r;

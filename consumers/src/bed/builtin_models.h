@@ -11,6 +11,7 @@ namespace consumers {
 namespace internal {
 
 std::unique_ptr<BedModel> make_dpm_bed_model();
+std::unique_ptr<BedModel> make_tfm_bed_model();
 
 }  // namespace internal
 }  // namespace consumers

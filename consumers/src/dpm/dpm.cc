@@ -3,6 +3,8 @@
 
 #include "draglab/consumers/dpm_output.h"
 
+#include "bed/bed_sampling.h"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -51,18 +53,6 @@ Tent TentAt(double x, double z, double dx, double dz, int nx, int nz) {
   t.j[0] = std::clamp(j0, 0, nz - 1);
   t.j[1] = std::clamp(j0 + 1, 0, nz - 1);
   return t;
-}
-
-/// The bubble criterion of a scene (bubble.h) with the settled bed height for the expansion.
-BubbleOptions SceneBubbleOptions(const Scene& s, double settled_height_m) {
-  BubbleOptions bo;
-  bo.eps_threshold = s.bubble.eps_threshold;
-  const double dx = s.geometry.width_m / s.grid.cells_x;
-  const double half = std::max(0.5 * s.jet.slot_width_m, 0.5 * dx);
-  bo.jet_x_min_m = s.jet_center_m() - half;
-  bo.jet_x_max_m = s.jet_center_m() + half;
-  bo.bed_height_initial_m = settled_height_m;
-  return bo;
 }
 
 }  // namespace
@@ -300,16 +290,7 @@ void DpmSimulation::Start(Particles settled) {
 }
 
 GridField2D DpmSimulation::VoidFractionField() const {
-  GridField2D f;
-  f.nx = scene_.grid.cells_x;
-  f.ny = scene_.grid.cells_y;
-  f.width_m = scene_.geometry.width_m;
-  f.height_m = scene_.geometry.height_m;
-  f.values.resize(static_cast<std::size_t>(f.nx) * f.ny);
-  for (int j = 0; j < f.ny; ++j)
-    for (int i = 0; i < f.nx; ++i)
-      f.values[static_cast<std::size_t>(j) * f.nx + i] = impl_->eps(i, j);
-  return f;
+  return internal::scene_grid_field(scene_, impl_->eps);
 }
 
 DpmSnapshot DpmSimulation::Snapshot() const {
@@ -327,7 +308,8 @@ DpmSnapshot DpmSimulation::Snapshot() const {
     snap.layer[n] = id < layer_by_id_.size() ? layer_by_id_[id] : 0;
   }
   snap.void_fraction = VoidFractionField();
-  snap.bubble = measure_bubble(snap.void_fraction, SceneBubbleOptions(scene_, settled_height_));
+  snap.bubble =
+      measure_bubble(snap.void_fraction, internal::scene_bubble_options(scene_, settled_height_));
   return snap;
 }
 
@@ -478,7 +460,7 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   const double area = s.geometry.width_m * s.geometry.depth_m;
   const double g = s.gas.gravity_m_s2, rho_g = s.gas.density_kg_m3;
   const double particle_mass = static_cast<double>(result_.particles) * s.particle_mass_kg();
-  const BubbleOptions bo = SceneBubbleOptions(s, settled_height_);
+  const BubbleOptions bo = internal::scene_bubble_options(s, settled_height_);
 
   // Vertical momentum of gas + particles [kg m/s].
   auto total_momentum = [&]() {

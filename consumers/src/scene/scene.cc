@@ -16,6 +16,7 @@
 #include <toml++/toml.h>
 
 #include "draglab/consumers/bed_model.h"
+#include "draglab/consumers/ktgf.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 #include "scene/scene_util.h"
@@ -198,6 +199,25 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                    s.outputs.particles = as_bool(n, f, at);
                  }},
                 num("interval_s", [](S& s) -> double& { return s.outputs.interval_s; })}},
+              {"tfm",
+               {{"closures", [](S& s, const toml::node& n, const std::string& f,
+                                const std::string& at) { s.tfm.closures = as_text(n, f, at); }},
+                {"radial_distribution",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.tfm.radial_distribution = as_text(n, f, at);
+                 }},
+                num("restitution", [](S& s) -> double& { return s.tfm.restitution; }),
+                num("packing_limit", [](S& s) -> double& { return s.tfm.packing_limit; }),
+                {"friction", [](S& s, const toml::node& n, const std::string& f,
+                                const std::string& at) { s.tfm.friction = as_text(n, f, at); }},
+                num("friction_min_solids",
+                    [](S& s) -> double& { return s.tfm.friction_min_solids; }),
+                num("friction_angle_deg", [](S& s) -> double& { return s.tfm.friction_angle_deg; }),
+                num("theta_initial_m2_s2",
+                    [](S& s) -> double& { return s.tfm.theta_initial_m2_s2; }),
+                num("residual_solids", [](S& s) -> double& { return s.tfm.residual_solids; }),
+                num("cfl", [](S& s) -> double& { return s.tfm.cfl; }),
+                num("dt_max_s", [](S& s) -> double& { return s.tfm.dt_max_s; })}},
               {"drag",
                {{"laws",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
@@ -217,6 +237,61 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                  }}}},
           };
   return table;
+}
+
+/// The [tfm] table: required by solver = "tfm", refused by the others; ranges via ktgf.h.
+bool tfm_is_valid(const Scene& s, std::string* error) {
+  const bool tfm = s.solver == "tfm";
+  if (tfm && !s.tfm.present) {
+    return fail(error,
+                "[tfm] table is missing: solver = \"tfm\" needs it (closures, packing_limit, "
+                "friction, ...; docs/scenes.md)");
+  }
+  if (!tfm) {
+    if (s.tfm.present) {
+      return fail(error, "[tfm] is read only with solver = \"tfm\" (this scene's solver is \"" +
+                             s.solver + "\"): remove the table or change the solver");
+    }
+    return true;
+  }
+  KtgfOptions k;
+  if (!parse_closure_set(s.tfm.closures, &k.closures)) {
+    return fail(error,
+                "[tfm] closures = '" + s.tfm.closures + "' is not one of nieuwland, gidaspow");
+  }
+  if (!parse_radial_distribution(s.tfm.radial_distribution, &k.radial)) {
+    return fail(error, "[tfm] radial_distribution = '" + s.tfm.radial_distribution +
+                           "' is not one of ma_ahmadi, carnahan_starling, sinclair_jackson, "
+                           "lun_savage");
+  }
+  if (!parse_friction_model(s.tfm.friction, &k.friction)) {
+    return fail(error, "[tfm] friction = '" + s.tfm.friction +
+                           "' is not one of none, johnson_jackson_schaeffer");
+  }
+  if (s.tfm.restitution != -1.0 &&
+      !in_range(s.tfm.restitution, 0.0, 1.0, true, false, "[tfm] restitution", "", error)) {
+    return false;
+  }
+  k.restitution = s.tfm.restitution == -1.0 ? s.particles.restitution : s.tfm.restitution;
+  k.packing_limit = s.tfm.packing_limit;
+  k.friction_min_solids = s.tfm.friction_min_solids;
+  k.friction_angle_deg = s.tfm.friction_angle_deg;
+  if (!(s.tfm.packing_limit > 1.0 - s.eps_mf)) {
+    return fail(error, "[tfm] packing_limit = " + fmt(s.tfm.packing_limit) +
+                           " must exceed the bed's solids fraction at minimum fluidization 1 - "
+                           "[drag] eps_mf = " +
+                           fmt(1.0 - s.eps_mf));
+  }
+  if (!k.IsValid(error)) return false;
+  if (!in_range(s.tfm.theta_initial_m2_s2, 0.0, 100.0, false, false, "[tfm] theta_initial_m2_s2",
+                "m^2/s^2 (a granular temperature is >= 0)", error) ||
+      !in_range(s.tfm.residual_solids, 0.0, 1e-2, true, false, "[tfm] residual_solids", "",
+                error) ||
+      !in_range(s.tfm.cfl, 0.0, 0.5, true, false, "[tfm] cfl", "", error) ||
+      !in_range(s.tfm.dt_max_s, 0.0, 0.1, true, false, "[tfm] dt_max_s", "s", error)) {
+    return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -258,6 +333,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
     }
     const toml::table* table = section_node.as_table();
     if (!table) bad(where(origin, section_node) + ": '" + section + "' must be a [section]");
+    if (section == "tfm") s.tfm.present = true;
     for (const auto& [key_name, node] : *table) {
       const std::string key(key_name.str());
       const Key* found = nullptr;
@@ -468,6 +544,7 @@ bool Scene::IsValid(std::string* error) const {
       return fail(error, "[drag] laws lists '" + laws[i] + "' twice");
     }
   }
+  if (!tfm_is_valid(*this, error)) return false;
   if (range_policy != "clamp" && range_policy != "extrapolate" && range_policy != "error") {
     return fail(error, "[drag] range_policy = '" + range_policy +
                            "' is not one of clamp, extrapolate, error");

@@ -7,7 +7,7 @@
 // run` and `regress` dispatch through run_bed_model, so a new model (TFM, DBM) plugs in by
 // registering, and scene validation accepts exactly the registered keys.
 //
-// Built in: "dpm" (dpm.h, CFD-DEM). Units SI. Thread-safety: register before running.
+// Built in: "dpm" (dpm.h, CFD-DEM) and "tfm" (tfm.h, two-fluid with KTGF). Units SI. Thread-safety: register before running.
 #pragma once
 
 #include <cstdint>

@@ -119,11 +119,28 @@ struct SceneOutputs {
   double interval_s = 0.0;  ///< Output spacing; 0: only the snapshot at t_ref.
 };
 
+/// [tfm]: closures and numerics of the two-fluid model (read only with solver = "tfm", which
+/// requires the table; tfm.h, ktgf.h, docs/tfm.md). Names as ktgf.h's to_string.
+struct SceneTfm {
+  bool present = false;                ///< The file has a [tfm] table.
+  std::string closures = "nieuwland";  ///< "nieuwland" or "gidaspow".
+  std::string radial_distribution = "ma_ahmadi";
+  double restitution = -1.0;    ///< Particle-particle e, (0, 1]; -1: [particles] restitution.
+  double packing_limit = 0.64;  ///< phi_max, (1 - eps_mf, 0.74].
+  std::string friction = "johnson_jackson_schaeffer";  ///< Or "none".
+  double friction_min_solids = 0.5;   ///< Johnson-Jackson phi_min, (0, packing_limit).
+  double friction_angle_deg = 28.5;   ///< (0, 90).
+  double theta_initial_m2_s2 = 1e-4;  ///< Initial granular temperature of the bed, >= 0.
+  double residual_solids = 1e-4;      ///< (0, 1e-2].
+  double cfl = 0.3;                   ///< (0, 0.5].
+  double dt_max_s = 5e-4;             ///< (0, 0.1].
+};
+
 /// A scene file, parsed. Built by parse_scene / load_scene; IsValid checks every range.
 struct Scene {
   std::string name;
   std::string description;
-  std::string solver = "dpm";  ///< "dpm" (this issue); "tfm", "dbm" later.
+  std::string solver = "dpm";  ///< A registered bed model: "dpm", "tfm" (bed_model.h).
   std::uint64_t seed = 1;      ///< Initial packing realization.
   SceneGeometry geometry;
   SceneParticles particles;
@@ -134,6 +151,7 @@ struct Scene {
   SceneGrid grid;
   SceneBubble bubble;
   SceneOutputs outputs;
+  SceneTfm tfm;
   std::vector<std::string> laws;  ///< "name@version" references, at least one.
   double eps_mf = 0.42;           ///< Gas fraction of the bed at minimum fluidization.
   /// Range policy the solver uses for drag evaluations outside a law's validity box during a

@@ -1,0 +1,248 @@
+// The two-fluid model (tfm.h) as a bed model: the scene's bed, uniform at eps_mf up to its
+// minimum-fluidization height, fluidized at the law's U_mf (or the scene's fixed velocity), one
+// bubble injected by the jet; bubble metrics sampled like every bed model (bed_sampling.h).
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "bed/bed_sampling.h"
+#include "bed/builtin_models.h"
+#include "draglab/consumers/tfm.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+std::string Num(double x) {
+  std::ostringstream s;
+  s.precision(4);
+  s << x;
+  return s.str();
+}
+
+/// The two-fluid model's options for a scene whose background is `background_m_s`.
+TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
+  TfmOptions o;
+  GasOptions& g = o.gas;
+  g.nx = s.grid.cells_x;
+  g.nz = s.grid.cells_y;
+  g.width_m = s.geometry.width_m;
+  g.height_m = s.geometry.height_m;
+  g.depth_m = s.geometry.depth_m;
+  g.rho_g = s.gas.density_kg_m3;
+  g.mu_g = s.gas.viscosity_pa_s;
+  g.gravity_z = -s.gas.gravity_m_s2;
+  g.side_walls = WallSlip::kNoSlip;
+  g.background_velocity_m_s = background_m_s;
+  g.jet_width_m = s.jet.slot_width_m;
+  g.jet_velocity_m_s = s.jet.velocity_m_s;
+  g.jet_start_s = s.jet.start_s;
+  g.jet_duration_s = s.jet.duration_s;
+  g.inflow_ramp_s = s.jet.ramp_s;
+  o.particle_diameter_m = s.particles.diameter_m;
+  o.particle_density_kg_m3 = s.particles.density_kg_m3;
+  KtgfOptions& k = o.ktgf;
+  parse_closure_set(s.tfm.closures, &k.closures);
+  parse_radial_distribution(s.tfm.radial_distribution, &k.radial);
+  parse_friction_model(s.tfm.friction, &k.friction);
+  k.restitution = s.tfm.restitution == -1.0 ? s.particles.restitution : s.tfm.restitution;
+  k.packing_limit = s.tfm.packing_limit;
+  k.friction_min_solids = s.tfm.friction_min_solids;
+  k.friction_angle_deg = s.tfm.friction_angle_deg;
+  o.initial_solids = 1.0 - s.eps_mf;
+  o.initial_bed_height_m = s.bed_height_mf_m();
+  o.initial_theta_m2_s2 = s.tfm.theta_initial_m2_s2;
+  o.residual_solids = s.tfm.residual_solids;
+  o.cfl = s.tfm.cfl;
+  o.dt_max_s = s.tfm.dt_max_s;
+  o.fixed_dt_s = s.time.gas_dt_s;
+  return o;
+}
+
+class TfmBedModel : public BedModel {
+ public:
+  std::string key() const override { return "tfm"; }
+  std::string description() const override {
+    return "two-fluid model with the kinetic theory of granular flow (tfm.h)";
+  }
+  BedResult Run(const Scene& scene, std::shared_ptr<const Law> law, const BedRunOptions& options,
+                const BedProgress& progress) const override {
+    const auto t0 = std::chrono::steady_clock::now();
+    scene.Validate();
+    if (!law) throw Error(ErrorCode::kInvalidArgument, "tfm: law is null");
+    if (std::abs(scene.jet_center_m() - 0.5 * scene.geometry.width_m) >
+        1e-9 * scene.geometry.width_m)
+      throw Error(ErrorCode::kInvalidArgument,
+                  "[jet] center_m: the gas inflow supports only a central slot (width / 2 = " +
+                      Num(0.5 * scene.geometry.width_m) + " m), got " + Num(scene.jet_center_m()));
+    if (scene.outputs.fields || scene.outputs.particles)
+      throw Error(ErrorCode::kInvalidArgument,
+                  "[outputs] fields/particles: the two-fluid model writes no field files yet "
+                  "(set them to false; the bubble series is in the result)");
+    // U_mf first: a law whose validity box excludes the bed fails here, before any step.
+    const SceneDerived derived = derive_scene(scene, *law);
+    // The TFM bed starts uniform at eps_mf, so its packing is the eps_mf state: "umf_packing"
+    // is "umf" here.
+    const double background = derived.background_m_s;
+    TfmSimulation tfm(SceneTfmOptions(scene, background), law);
+    const double duration = options.duration_s > 0.0 ? options.duration_s : scene.time.duration_s;
+    const double interval = scene.bubble.sample_interval_s;
+    const double t_ref_abs = scene.jet.start_s + scene.time.t_ref_s;
+    const BubbleOptions bubble = internal::scene_bubble_options(scene, scene.bed_height_mf_m());
+    const double dz = tfm.dz();
+
+    BedResult out;
+    out.model = key();
+    out.law = law->record().name + "@" + std::to_string(law->record().version);
+    out.scene = scene.name;
+    out.scene_hash = scene.hash();
+    out.eps_mf = scene.eps_mf;
+    out.background_mode = to_string(scene.distributor.mode);
+    ConsumerMetrics& m = out.metrics;
+    m.umf_m_s = derived.umf.umf_m_s;
+    m.background_m_s = background;
+    m.t_ref_s = scene.time.t_ref_s;
+    nlohmann::json series = nlohmann::json::array();
+    double best_gap = 0.5 * interval + 1e-12;
+    BedSample at_ref;
+    bool have_ref = false;
+    BubbleMetrics ref_bubble;
+    const int samples = static_cast<int>(std::floor(duration / interval + 1e-9));
+    try {
+      for (int n = 1; n <= samples; ++n) {
+        const double t = std::min(n * interval, duration);
+        tfm.AdvanceTo(t);
+        const BubbleMetrics b =
+            measure_bubble(internal::scene_grid_field(scene, tfm.gas_fraction()), bubble);
+        BedSample smp;
+        smp.t_s = tfm.time() - scene.jet.start_s;
+        smp.bubble_diameter_m = b.found ? b.diameter_m : 0.0;
+        smp.bubble_centroid_m = b.found ? b.centroid_y_m : 0.0;
+        smp.bed_height_m = b.bed_height_m;
+        smp.pressure_drop_pa = tfm.PressureDrop(0.5 * dz, scene.geometry.height_m);
+        out.series.push_back(smp);
+        m.max_bed_height_m = std::max(m.max_bed_height_m, smp.bed_height_m);
+        const double gap = std::abs(tfm.time() - t_ref_abs);
+        if (gap < best_gap) {
+          best_gap = gap;
+          at_ref = smp;
+          have_ref = true;
+          ref_bubble = b;
+        }
+        series.push_back({{"t_s", smp.t_s},
+                          {"bubble_diameter_m", smp.bubble_diameter_m},
+                          {"bubble_centroid_m", smp.bubble_centroid_m},
+                          {"bed_height_m", smp.bed_height_m},
+                          {"pressure_drop_pa", smp.pressure_drop_pa},
+                          {"dt_s", tfm.diagnostics().last_dt_s}});
+        if (progress) {
+          progress(t / duration, "two-fluid run, dt " + Num(tfm.diagnostics().last_dt_s) + " s (" +
+                                     to_string(tfm.diagnostics().last_limit) + ")");
+        }
+      }
+      if (tfm.time() < duration) tfm.AdvanceTo(duration);
+    } catch (const Error& e) {
+      throw Error(e.code(), "tfm " + scene.name + " with " + out.law + ": " + e.what());
+    }
+    const TfmDiagnostics& dg = tfm.diagnostics();
+    m.bubble_present = have_ref && ref_bubble.found;
+    m.bubble_diameter_m = m.bubble_present ? at_ref.bubble_diameter_m : 0.0;
+    m.bubble_centroid_m = m.bubble_present ? at_ref.bubble_centroid_m : 0.0;
+    out.max_relative_mass_imbalance =
+        dg.gas_mass_in_kg > 0.0 ? std::abs(dg.gas_mass_imbalance_kg) / dg.gas_mass_in_kg : 0.0;
+    out.momentum_mismatch = 0.0;
+    out.law_out_of_range = law->out_of_range_count();
+    out.threads = 1;
+    out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m.wall_s = out.wall_s;
+
+    nlohmann::json limits = nlohmann::json::object();
+    for (int k = 0; k < 6; ++k) {
+      if (dg.steps_by_limit[k] > 0)
+        limits[to_string(static_cast<TfmStepLimit>(k))] = dg.steps_by_limit[k];
+    }
+    const TfmOptions& o = tfm.options();
+    const double solids_change =
+        dg.initial_solids_mass_kg > 0.0
+            ? (dg.solids_mass_kg - dg.initial_solids_mass_kg) / dg.initial_solids_mass_kg
+            : 0.0;
+    nlohmann::json j = {
+        {"solver", "tfm"},
+        {"scene", out.scene},
+        {"scene_hash", out.scene_hash},
+        {"law", out.law},
+        {"umf_m_s", m.umf_m_s},
+        {"background_m_s", background},
+        {"background", out.background_mode},
+        {"eps_mf", scene.eps_mf},
+        {"t_ref_s", m.t_ref_s},
+        {"bubble_at_t_ref", m.bubble_present},
+        {"bubble_diameter_m",
+         m.bubble_present ? nlohmann::json(m.bubble_diameter_m) : nlohmann::json(nullptr)},
+        {"series", series},
+        {"grid", {{"cells_x", o.gas.nx}, {"cells_y", o.gas.nz}}},
+        {"closures",
+         {{"set", to_string(o.ktgf.closures)},
+          {"radial_distribution", to_string(o.ktgf.radial)},
+          {"restitution", o.ktgf.restitution},
+          {"packing_limit", o.ktgf.packing_limit},
+          {"friction", to_string(o.ktgf.friction)},
+          {"friction_min_solids", o.ktgf.friction_min_solids},
+          {"knudsen_length_m", std::min(tfm.dx(), tfm.dz())}}},
+        {"steps", dg.steps},
+        {"dt_min_s", dg.min_dt_s},
+        {"dt_mean_s", dg.steps > 0 ? tfm.time() / static_cast<double>(dg.steps) : 0.0},
+        {"steps_by_limit", limits},
+        {"max_wave_speed_m_s", dg.max_wave_speed_m_s},
+        {"max_solids_fraction", dg.max_solids_fraction},
+        {"max_theta_m2_s2", dg.max_theta_m2_s2},
+        {"flux_limited_faces", dg.flux_limited_faces},
+        {"relative_solids_mass_change", solids_change},
+        {"max_relative_gas_mass_imbalance", out.max_relative_mass_imbalance},
+        {"momentum_mismatch", nullptr},
+        {"drag_out_of_range", out.law_out_of_range},
+        {"threads", out.threads},
+        {"wall_s", out.wall_s},
+        {"output_files", nlohmann::json::array()}};
+    if (have_ref) {
+      j["snapshot"] = {{"t_s", at_ref.t_s},
+                       {"bubble_found", ref_bubble.found},
+                       {"bubble_diameter_m", ref_bubble.diameter_m},
+                       {"bubble_centroid_x_m", ref_bubble.centroid_x_m},
+                       {"bubble_centroid_y_m", ref_bubble.centroid_y_m},
+                       {"bubble_top_m", ref_bubble.top_m},
+                       {"bubble_bottom_m", ref_bubble.bottom_m},
+                       {"bubble_erupting", ref_bubble.touches_surface},
+                       {"bed_height_m", ref_bubble.bed_height_m}};
+    }
+    out.result_json = j.dump();
+    std::ostringstream brief;
+    brief << "TFM " << scene.name << " with " << out.law << ": U_mf = " << Num(m.umf_m_s)
+          << " m/s, background = " << Num(background) << " m/s (" << out.background_mode
+          << "), eps_mf = " << scene.eps_mf << "; " << o.gas.nx << " x " << o.gas.nz << " cells, "
+          << dg.steps << " steps (dt min " << Num(dg.min_dt_s) << " s, mean "
+          << Num(dg.steps > 0 ? tfm.time() / dg.steps : 0.0) << " s); wall " << Num(out.wall_s)
+          << " s\n  bubble D at t_ref = " << Num(scene.time.t_ref_s)
+          << " s: " << (m.bubble_present ? Num(m.bubble_diameter_m) + " m" : std::string("none"))
+          << "\n  solids mass change " << Num(solids_change) << " (rel.), gas mass imbalance "
+          << Num(out.max_relative_mass_imbalance) << " (rel.), max phi "
+          << Num(dg.max_solids_fraction) << ", flux-limited faces " << dg.flux_limited_faces
+          << ", drag out of range " << out.law_out_of_range;
+    out.brief = brief.str();
+    return out;
+  }
+};
+
+}  // namespace
+
+namespace internal {
+std::unique_ptr<BedModel> make_tfm_bed_model() { return std::make_unique<TfmBedModel>(); }
+}  // namespace internal
+
+}  // namespace consumers
+}  // namespace draglab
