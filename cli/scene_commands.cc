@@ -130,29 +130,46 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
   }
   const auto& first = derived.front();
   if (ctx.json) {
-    ctx.print_json({{"scene", scene.name},
-                    {"scene_hash", scene.hash()},
-                    {"valid", true},
-                    {"particle_count", first.particle_count},
-                    {"bed_height_mf_m", first.bed_height_mf_m},
-                    {"archimedes", first.archimedes},
-                    {"particle_response_s", first.particle_response_s},
-                    {"contact_time_s", first.contact_time_s},
-                    {"recommended_dem_dt_s", first.recommended_dem_dt_s},
-                    {"jet_area_rate_m2_s", first.jet_area_rate_m2_s},
-                    {"background", consumers::to_string(scene.distributor.mode)},
-                    {"laws", per_law}});
+    nlohmann::json out = {{"scene", scene.name},
+                          {"scene_hash", scene.hash()},
+                          {"valid", true},
+                          {"solver", scene.solver},
+                          {"particle_count", first.particle_count},
+                          {"bed_height_mf_m", first.bed_height_mf_m},
+                          {"archimedes", first.archimedes},
+                          {"particle_response_s", first.particle_response_s},
+                          {"jet_area_rate_m2_s", first.jet_area_rate_m2_s},
+                          {"background", consumers::to_string(scene.distributor.mode)},
+                          {"laws", per_law}};
+    if (scene.solver == "dpm") {  // the contact model matters to the DEM only
+      out["contact_time_s"] = first.contact_time_s;
+      out["recommended_dem_dt_s"] = first.recommended_dem_dt_s;
+    }
+    ctx.print_json(out);
     return;
   }
-  std::cout << fmt::format("scene {} ({}): valid\n", scene.name, scene.origin);
+  std::cout << fmt::format("scene {} ({}): valid, solver {} ({})\n", scene.name, scene.origin,
+                           scene.solver, consumers::find_bed_model(scene.solver).description());
   std::cout << fmt::format(
-      "  particles: {} of d = {} m (H_mf = {} m at eps_mf = {}); Ar = {}\n"
-      "  contact time t_c = {} s -> DEM step {} s (t_c/{}); Stokes response {} s\n"
-      "  jet q = {} m^2/s through {} m at {} m/s; background: {}\n",
+      "  particles: {} of d = {} m (H_mf = {} m at eps_mf = {}); Ar = {}; Stokes response {} s\n",
       first.particle_count, format_number(scene.particles.diameter_m),
       format_number(first.bed_height_mf_m, 4), scene.eps_mf, format_number(first.archimedes, 4),
-      format_number(first.contact_time_s, 3), format_number(first.recommended_dem_dt_s, 3),
-      scene.time.contact_steps, format_number(first.particle_response_s, 3),
+      format_number(first.particle_response_s, 3));
+  if (scene.solver == "dpm") {
+    std::cout << fmt::format("  contact time t_c = {} s -> DEM step {} s (t_c/{})\n",
+                             format_number(first.contact_time_s, 3),
+                             format_number(first.recommended_dem_dt_s, 3),
+                             scene.time.contact_steps);
+  } else if (scene.solver == "tfm") {
+    std::cout << fmt::format(
+        "  two-fluid: {} closures, g0 {}, e = {}, packing limit {}, friction {}; adaptive step "
+        "(CFL {}, at most {} s)\n",
+        scene.tfm.closures, scene.tfm.radial_distribution,
+        scene.tfm.restitution == -1.0 ? scene.particles.restitution : scene.tfm.restitution,
+        scene.tfm.packing_limit, scene.tfm.friction, scene.tfm.cfl, scene.tfm.dt_max_s);
+  }
+  std::cout << fmt::format(
+      "  jet q = {} m^2/s through {} m at {} m/s; background: {}\n",
       format_number(first.jet_area_rate_m2_s, 3), format_number(scene.jet.slot_width_m),
       format_number(scene.jet.velocity_m_s), consumers::to_string(scene.distributor.mode));
   std::cout << fmt::format("{:<20} {:>8} {:>7} {:>10} {:>6} {:>10} {:>10} {:>10} {:>8}\n", "law",
@@ -273,7 +290,8 @@ void add_scene_commands(CLI::App& app, CliContext& ctx) {
   auto run_args = std::make_shared<SceneArgs>();
   auto* run = scene->add_subcommand(
       "run",
-      "Run a DPM scene (CFD-DEM, docs/dpm.md) with one law: settle, fluidize, inject the jet's "
+      "Run a scene with its bed model and one law (dpm: CFD-DEM, docs/dpm.md, settles the "
+      "packing first; tfm: two-fluid with KTGF, docs/tfm.md): fluidize, inject the jet's "
       "bubble; prints U_mf, the background velocity used, the bubble diameter at t_ref and the "
       "time series (progress with ETA on stderr)");
   run->add_option("SCENE", run_args->scene_path, "Scene file (TOML)")->required();

@@ -52,6 +52,7 @@ struct SensitivityArgs {
   double duration_s = 0.0;
   std::string out_dir;
   bool no_figure = false;
+  std::string beside;  // --beside OTHER/sensitivity.json: fig5.png, OTHER's panels above these
   bool work_precision = false;
   std::string law;            // --work-precision --law
   std::string grids;          // --grids 8x24,12x36
@@ -88,7 +89,7 @@ void write_json_file(const std::string& path, const nlohmann::json& j) {
 
 /// Runs the figure script on `bundle`; it writes `figure` into out_dir.
 void render(const CliContext& ctx, const std::string& bundle, const std::string& out_dir,
-            const std::string& figure) {
+            const std::string& figure, const std::string& beside = "") {
   const std::string python = python_interpreter();
   const std::string probe = shell_quote(python) + " -c 'import matplotlib' >/dev/null 2>&1";
   if (std::system(probe.c_str()) != 0) {
@@ -100,6 +101,7 @@ void render(const CliContext& ctx, const std::string& bundle, const std::string&
   std::remove(figure.c_str());  // so a stale figure is never taken for a new one
   const std::string command = shell_quote(python) + " " + shell_quote(find_script(kFigureScript)) +
                               " " + shell_quote(bundle) + " " + shell_quote(out_dir) +
+                              (beside.empty() ? "" : " --beside " + shell_quote(beside)) +
                               (ctx.quiet ? " --quiet" : "") + " 1>&2";
   const int status = std::system(command.c_str());
   if (status != 0 || !file_exists(figure)) {
@@ -315,6 +317,14 @@ void print_work_precision_table(const consumers::WorkPrecisionResult& w) {
 }
 
 void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args) {
+  if (!args.beside.empty()) {
+    if (args.work_precision)
+      throw UsageError("--beside is for the law study, not --work-precision");
+    if (args.no_figure) throw UsageError("--beside draws a figure: drop --no-figure");
+    if (!file_exists(args.beside))
+      throw UsageError("--beside: '" + args.beside +
+                       "' does not exist (give another study's sensitivity.json)");
+  }
   // Flags of the other mode are a usage error, not silently ignored.
   if (args.work_precision) {
     if (!args.laws.empty())
@@ -451,17 +461,26 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   const std::string bundle = out_dir + "/sensitivity.json";
   const std::string figure = out_dir + "/fig4.png";
   write_json_file(bundle, summary_json(scene, s, /*with_snapshots=*/true));
-  if (!args.no_figure) render(ctx, bundle, out_dir, figure);
+  const std::string fig5 = out_dir + "/fig5.png";
+  if (!args.no_figure) {
+    render(ctx, bundle, out_dir, figure, args.beside);
+    if (!args.beside.empty() && !file_exists(fig5))
+      throw std::runtime_error("the figure script wrote no " + fig5 + " (--beside " + args.beside +
+                               ")");
+  }
+  const bool with_fig5 = !args.no_figure && !args.beside.empty();
   if (ctx.json) {
     nlohmann::json j = summary_json(scene, s, /*with_snapshots=*/false);
     j["out_dir"] = out_dir;
     j["data"] = bundle;
     j["figure"] = args.no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
+    j["figure_beside"] = with_fig5 ? nlohmann::json(fig5) : nlohmann::json(nullptr);
     ctx.print_json(j);
     return;
   }
   print_sensitivity_table(s);
-  std::cout << "  data: " << bundle << (args.no_figure ? "" : "\n  figure: " + figure) << "\n";
+  std::cout << "  data: " << bundle << (args.no_figure ? "" : "\n  figure: " + figure)
+            << (with_fig5 ? "\n  figure: " + fig5 : "") << "\n";
 }
 
 }  // namespace
@@ -470,10 +489,12 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
   auto args = std::make_shared<SensitivityArgs>();
   auto* cmd = app.add_subcommand(
       "sensitivity",
-      "Run a DPM scene per drag law: bubble diameter at t_ref with its numerical uncertainty "
-      "(two packing realizations or two grids), the seed's Fig. 4 (bubble snapshot per law, "
-      "particles coloured by initial layer) as DIR/fig4.png; or, with --work-precision, the "
-      "bubble diameter against grid size and DEM step with run times");
+      "Run a scene per drag law with its bed model: bubble diameter at t_ref with its numerical "
+      "uncertainty (DPM: two packing realizations or two grids; TFM: two grids), the seed's "
+      "Fig. 4 (bubble snapshot per law: particles coloured by initial layer, or the TFM's solids "
+      "fraction in grey) as DIR/fig4.png, D(t) as DIR/bubble_series.png, with --beside the "
+      "seed's Fig. 5 (another study's panels above these) as DIR/fig5.png; or, with "
+      "--work-precision, the bubble diameter against grid size (and DEM step) with run times");
   cmd->add_option("SCENE", args->scene_path, "Scene file (TOML, docs/scenes.md)")->required();
   cmd->add_option("--laws", args->laws, "Laws NAME@V,... (default: the scene's [drag] laws)");
   cmd->add_option("--uncertainty", args->uncertainty,
@@ -488,6 +509,9 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
   cmd->add_flag("--no-figure", args->no_figure,
                 "Write the JSON data only (draw later with /usr/bin/python3 "
                 "scripts/draglab_fig4.py DATA.json DIR)");
+  cmd->add_option("--beside", args->beside,
+                  "Another study's sensitivity.json (e.g. the DPM's): also draw DIR/fig5.png, its "
+                  "panels above this study's, per shared law");
   cmd->add_flag("--work-precision", args->work_precision,
                 "Work-precision study of one law (--law) over --grids x --contact-steps");
   cmd->add_option("--law", args->law, "--work-precision: the law NAME@V");
@@ -500,6 +524,8 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
       "Examples:\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --uncertainty grids --json\n"
+      "  draglab sensitivity data/scenes/tfm_bubble.toml --laws gidaspow@1,hill_koch_ladd@1 "
+      "--beside out/dpm_bubble_sensitivity/sensitivity.json\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --work-precision --law ergun@1 "
       "--grids 8x24,12x36 --contact-steps 20,40\n"
       "Writes DIR/sensitivity.json + DIR/fig4.png, or DIR/work_precision.json + "

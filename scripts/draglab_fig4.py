@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Draw the figures of `draglab sensitivity` from its JSON data.
 
-Usage: /usr/bin/python3 draglab_fig4.py DATA.json OUT_DIR [--quiet]
+Usage: /usr/bin/python3 draglab_fig4.py DATA.json OUT_DIR [--beside OTHER.json] [--quiet]
 
 DATA.json is either
   - sensitivity.json (format "draglab_sensitivity" version 1): writes OUT_DIR/fig4.png, the seed
@@ -11,6 +11,12 @@ DATA.json is either
     mixing shows), the eps = threshold contour of the bubble over them, and the title
     "law@v  D = x.x +- y.y cm"; and OUT_DIR/bubble_series.png, D and the bubble's centroid
     height against time per law and run, t_ref marked;
+    A continuum model's snapshot (the two-fluid model: no particles) is drawn as the solids
+    fraction 1 - eps in grey scale (white empty, black at the packing limit), as the seed's
+    Fig. 5. With --beside OTHER.json (another sensitivity.json, typically the DPM's of the same
+    laws) it also writes OUT_DIR/fig5.png, the seed's Fig. 5: OTHER's panels above DATA's, every
+    panel as solids fraction in grey scale, matched by law, each titled with its model, time and
+    D +- uncertainty;
   - work_precision.json (format "draglab_work_precision" version 1): writes
     OUT_DIR/work_precision.png, the bubble diameter and its error against wall time.
 Both are described in docs/scenes.md ("Sensitivity and work-precision"). This script only
@@ -103,6 +109,43 @@ def bubble_only_field(field, bubble, threshold):
     return out
 
 
+def solids_grid(field):
+    """Cell faces [cm] and the solids fraction 1 - eps (row j from the bottom) of a snapshot."""
+    nx, ny = field["nx"], field["ny"]
+    phi = 1.0 - np.array(field["values"], dtype=float).reshape(ny, nx)
+    xf = np.linspace(0.0, field["width_m"], nx + 1) * 100
+    yf = np.linspace(0.0, field["height_m"], ny + 1) * 100
+    return xf, yf, phi
+
+
+def draw_solids(ax, snap, threshold):
+    """Grey-scale solids fraction of a snapshot with the bubble's threshold contour."""
+    field = snap["void_fraction"]
+    xf, yf, phi = solids_grid(field)
+    ax.pcolormesh(xf, yf, phi, cmap="Greys", vmin=0.0, vmax=0.64, shading="flat")
+    eps = bubble_only_field(field, snap.get("bubble"), threshold)
+    nx, ny = field["nx"], field["ny"]
+    if nx >= 2 and ny >= 2 and eps.max() > threshold:
+        xc = (np.arange(nx) + 0.5) * field["width_m"] / nx * 100
+        yc = (np.arange(ny) + 0.5) * field["height_m"] / ny * 100
+        ax.contour(xc, yc, eps, levels=[threshold], colors=CONTOUR_COLOUR, linewidths=1.5)
+
+
+def shown_height(laws, width, height):
+    """The bed, not the freeboard: up to the highest particle top or the bed surface, + 15 %
+    of the width."""
+    top = 0.0
+    for law in laws:
+        snap = law.get("snapshot")
+        if not snap:
+            continue
+        if snap["y"]:
+            top = max(top, max(y + 0.5 * d for y, d in zip(snap["y"], snap["diameter"])))
+        elif snap.get("bubble"):
+            top = max(top, snap["bubble"].get("bed_height_m", 0.0))
+    return min(height, top + 0.15 * width) if top > 0 else height
+
+
 def draw_fig4(data, out_dir, quiet):
     laws = data["laws"]
     if not laws:
@@ -110,13 +153,8 @@ def draw_fig4(data, out_dir, quiet):
     width = data["geometry"]["width_m"]
     height = data["geometry"]["height_m"]
     threshold = data["eps_threshold"]
-    # Show the bed, not the freeboard: up to the highest particle top (+ 15 % of the width).
-    top = 0.0
-    for law in laws:
-        snap = law.get("snapshot")
-        if snap and snap["y"]:
-            top = max(top, max(y + 0.5 * d for y, d in zip(snap["y"], snap["diameter"])))
-    shown = min(height, top + 0.15 * width) if top > 0 else height
+    shown = shown_height(laws, width, height)
+    continuum = any(law.get("snapshot") and not law["snapshot"]["x"] for law in laws)
     panel_w = 2.6
     panel_h = min(8.0, max(2.0, panel_w * shown / width))
     fig_w = max(6.0, panel_w * len(laws) + 0.6)
@@ -139,6 +177,9 @@ def draw_fig4(data, out_dir, quiet):
             ax.text(0.5, 0.5, "no snapshot\n(run ended before t_ref)", transform=ax.transAxes,
                     ha="center", va="center")
             continue
+        if not snap["x"]:
+            draw_solids(ax, snap, threshold)
+            continue
         xy = np.column_stack([np.array(snap["x"]) * 100, np.array(snap["y"]) * 100])
         diam = np.array(snap["diameter"]) * 100
         colours = [LAYER_COLOURS[layer % 2] for layer in snap["layer"]]
@@ -159,9 +200,12 @@ def draw_fig4(data, out_dir, quiet):
             if eps.max() > threshold:
                 ax.contour(xc, yc, eps, levels=[threshold], colors=CONTOUR_COLOUR, linewidths=1.8)
     axes[0][0].set_ylabel("y [cm]")
-    caption = ("%s: bubble %.3g s after injection; particles coloured by initial layer; red: "
+    caption = ("%s: bubble %.3g s after injection; %s; red: "
                "\u03b5 = %.2f contour of the bubble; \u00b1 from %s (sensitivity.json)" % (
-                   data["scene"], data["t_ref_s"], threshold, data["uncertainty"]["method"]))
+                   data["scene"], data["t_ref_s"],
+                   "solids fraction in grey (black: 0.64)" if continuum
+                   else "particles coloured by initial layer", threshold,
+                   data["uncertainty"]["method"]))
     fig.suptitle(textwrap.fill(caption, width=int(16 * fig_w)), fontsize=9)
     save_figure(fig, out_dir, "fig4.png", quiet)
 
@@ -198,6 +242,49 @@ def draw_bubble_series(data, out_dir, quiet):
     fig.suptitle("%s: the bubble against time (dashed: t_ref = %g s)" % (
         data["scene"], data["t_ref_s"]), fontsize=10)
     save_figure(fig, out_dir, "bubble_series.png", quiet)
+
+
+def draw_fig5(above, below, out_dir, quiet):
+    """OUT_DIR/fig5.png: the seed's Fig. 5, one column per law present in both data sets,
+    `above`'s snapshot over `below`'s, each as solids fraction in grey scale with the bubble
+    contour, titled with the scene, the time after injection and D +- uncertainty."""
+    laws_above = {law["law"]: law for law in above["laws"]}
+    names = [law["law"] for law in below["laws"] if law["law"] in laws_above]
+    if not names:
+        raise SystemExit("error: --beside: the two data sets share no law")
+    width = below["geometry"]["width_m"]
+    rows = (above, below)
+    shown = max(shown_height(d["laws"], width, d["geometry"]["height_m"]) for d in rows)
+    panel_w = 2.4
+    panel_h = min(6.0, max(2.0, panel_w * shown / width))
+    fig, axes = plt.subplots(2, len(names), figsize=(max(6.0, panel_w * len(names) + 0.6),
+                                                     2 * panel_h + 1.6), squeeze=False)
+    for r, data in enumerate(rows):
+        by_law = {law["law"]: law for law in data["laws"]}
+        for c, name in enumerate(names):
+            ax, law = axes[r][c], by_law[name]
+            snap = law.get("snapshot")
+            ax.set_xlim(0, 100 * width)
+            ax.set_ylim(0, 100 * shown)
+            ax.set_aspect("equal")
+            t = snap["t_s"] if snap else data["t_ref_s"]
+            ax.set_title("%s %s\nt = %.2f s  D = %.1f \u00b1 %.1f cm" % (
+                data["scene"], name, t, 100 * law["d_estimate_m"], 100 * law["uncertainty_m"]),
+                fontsize=8)
+            if snap:
+                draw_solids(ax, snap, data["eps_threshold"])
+            else:
+                ax.text(0.5, 0.5, "no snapshot", transform=ax.transAxes, ha="center")
+        axes[r][0].set_ylabel("y [cm]")
+    if abs(above["t_ref_s"] - below["t_ref_s"]) > 1e-9:
+        note = " (NOT the same time after injection: %g s above, %g s below)" % (
+            above["t_ref_s"], below["t_ref_s"])
+    else:
+        note = ""
+    fig.suptitle(textwrap.fill("Bubble per law, %s above %s: solids fraction in grey (black: "
+                               "0.64), red: bubble contour%s" % (above["scene"], below["scene"],
+                                                                 note), width=110), fontsize=9)
+    save_figure(fig, out_dir, "fig5.png", quiet)
 
 
 def draw_work_precision(data, out_dir, quiet):
@@ -240,23 +327,43 @@ def draw_work_precision(data, out_dir, quiet):
     save_figure(fig, out_dir, "work_precision.png", quiet)
 
 
-def main(argv):
-    args = [a for a in argv[1:] if a != "--quiet"]
-    quiet = "--quiet" in argv[1:]
-    if len(args) != 2:
-        sys.stderr.write(__doc__)
-        return 2
-    with open(args[0]) as f:
+def load(path):
+    with open(path) as f:
         data = json.load(f)
     kind = data.get("format")
     if data.get("version") != 1 or kind not in ("draglab_sensitivity", "draglab_work_precision"):
         sys.stderr.write("error: %s is not draglab sensitivity data (format %r, version %r)\n" % (
-            args[0], kind, data.get("version")))
+            path, kind, data.get("version")))
+        sys.exit(2)
+    return data
+
+
+def main(argv):
+    args = [a for a in argv[1:] if a != "--quiet"]
+    quiet = "--quiet" in argv[1:]
+    beside = None
+    if "--beside" in args:
+        k = args.index("--beside")
+        if k + 1 >= len(args):
+            sys.stderr.write(__doc__)
+            return 2
+        beside = args[k + 1]
+        del args[k:k + 2]
+    if len(args) != 2:
+        sys.stderr.write(__doc__)
         return 2
+    data = load(args[0])
+    kind = data["format"]
     os.makedirs(args[1], exist_ok=True)
     if kind == "draglab_sensitivity":
         draw_fig4(data, args[1], quiet)
         draw_bubble_series(data, args[1], quiet)
+        if beside:
+            other = load(beside)
+            if other["format"] != "draglab_sensitivity":
+                sys.stderr.write("error: --beside %s is not sensitivity data\n" % beside)
+                return 2
+            draw_fig5(other, data, args[1], quiet)
     else:
         draw_work_precision(data, args[1], quiet)
     return 0

@@ -45,6 +45,14 @@ class DpmBedModel : public BedModel {
     out.wall_s = r.wall_s;
     out.threads = r.threads;
     out.output_files = r.output_files;
+    out.steps = r.gas_steps;
+    out.mean_dt_s = r.gas_dt_s;
+    out.has_snapshot = r.has_snapshot;
+    if (r.has_snapshot) {
+      out.snapshot_t_s = r.snapshot.t_s;
+      out.snapshot_void_fraction = r.snapshot.void_fraction;
+      out.snapshot_bubble = r.snapshot.bubble;
+    }
     out.result_json = dpm_result_json(r);
     out.brief = r.BriefReport();
     return out;

@@ -133,6 +133,7 @@ class TfmBedModel : public BedModel {
           at_ref = smp;
           have_ref = true;
           ref_bubble = b;
+          out.snapshot_void_fraction = internal::scene_grid_field(scene, tfm.gas_fraction());
         }
         series.push_back({{"t_s", smp.t_s},
                           {"bubble_diameter_m", smp.bubble_diameter_m},
@@ -158,6 +159,11 @@ class TfmBedModel : public BedModel {
     out.momentum_mismatch = 0.0;
     out.law_out_of_range = law->out_of_range_count();
     out.threads = 1;
+    out.steps = dg.steps;
+    out.mean_dt_s = dg.steps > 0 ? tfm.time() / static_cast<double>(dg.steps) : 0.0;
+    out.has_snapshot = have_ref;
+    out.snapshot_t_s = at_ref.t_s;
+    out.snapshot_bubble = ref_bubble;
     out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     m.wall_s = out.wall_s;
 

@@ -2,6 +2,8 @@
 // (draglab/consumers/sensitivity.h, docs/scenes.md "Sensitivity and work-precision").
 #include "draglab/consumers/sensitivity.h"
 
+#include "draglab/consumers/bed_model.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -104,6 +106,44 @@ SensitivityRun MakeRun(const DpmResult& r, const Scene& s) {
   run.void_fraction_clamps = r.void_fraction_clamps;
   run.drag_out_of_range = r.law_out_of_range;
   return run;
+}
+
+/// A run of a bed model other than the DPM (no packing: seed 0, no DEM steps).
+SensitivityRun MakeBedRun(const BedResult& r, const Scene& s) {
+  SensitivityRun run;
+  run.cells_x = s.grid.cells_x;
+  run.cells_y = s.grid.cells_y;
+  run.cell_size_m = CellSize(s);
+  run.bubble_found = r.metrics.bubble_present;
+  run.reached_t_ref = r.has_snapshot;
+  run.bubble_diameter_m = r.metrics.bubble_present ? r.metrics.bubble_diameter_m : 0.0;
+  run.background_m_s = r.metrics.background_m_s;
+  run.wall_s = r.wall_s;
+  run.gas_steps = r.steps;
+  run.gas_dt_s = r.mean_dt_s;
+  for (const BedSample& b : r.series) {
+    DpmSample d;
+    d.t_s = b.t_s;
+    d.bubble_diameter_m = b.bubble_diameter_m;
+    d.bubble_centroid_m = b.bubble_centroid_m;
+    d.bed_height_m = b.bed_height_m;
+    d.pressure_drop_pa = b.pressure_drop_pa;
+    run.series.push_back(d);
+  }
+  run.momentum_mismatch = r.momentum_mismatch;
+  run.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
+  run.drag_out_of_range = r.law_out_of_range;
+  return run;
+}
+
+/// The snapshot of a bed-model run for the figures: the gas fraction and its bubble, no
+/// particles (the figure draws the solids fraction as a grey scale then).
+DpmSnapshot BedSnapshot(const BedResult& r) {
+  DpmSnapshot snap;
+  snap.t_s = r.snapshot_t_s;
+  snap.void_fraction = r.snapshot_void_fraction;
+  snap.bubble = r.snapshot_bubble;
+  return snap;
 }
 
 /// Settles one packing of `scene` (its seed) with the DPM's own settling; the law is needed by
@@ -347,16 +387,17 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
                                    const SensitivityProgress& progress) {
   const auto t0 = Clock::now();
   scene.Validate();
-  if (scene.solver != "dpm")
-    Fail("scene.solver: sensitivity runs \"dpm\" scenes only, got \"" + scene.solver + "\"");
   std::string why;
   if (!options.IsValid(&why)) Fail(why);
   if (!load_law) Fail("run_sensitivity: no law loader given");
   const std::vector<std::string> laws = options.laws.empty() ? scene.laws : options.laws;
+  // A continuum model has no packing realizations: its uncertainty comes from two grids.
+  const bool particles = scene.solver == "dpm";
+  const UncertaintyMethod method = particles ? options.uncertainty : UncertaintyMethod::kGrids;
 
   // Grids and seeds of the study.
   std::vector<Scene> grid_scenes = {scene};
-  if (options.uncertainty == UncertaintyMethod::kGrids) {
+  if (method == UncertaintyMethod::kGrids) {
     GridSize fine{static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_x)),
                   static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_y))};
     grid_scenes.push_back(SceneOnGrid(scene, fine, 0,
@@ -368,8 +409,7 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
            " has no smaller cells than the scene's; raise grid_refinement");
   }
   std::vector<std::uint64_t> seeds;
-  const int n_seeds =
-      options.uncertainty == UncertaintyMethod::kRealizations ? options.realizations : 1;
+  const int n_seeds = method == UncertaintyMethod::kRealizations ? options.realizations : 1;
   for (int k = 0; k < n_seeds; ++k) seeds.push_back(scene.seed + static_cast<std::uint64_t>(k));
 
   // Fail fast: every law loads and has a U_mf and stable steps on every grid.
@@ -381,11 +421,11 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   SensitivitySummary summary;
   summary.scene = scene.name;
   summary.scene_hash = scene.hash();
-  summary.method = options.uncertainty;
+  summary.method = method;
   summary.t_ref_s = scene.time.t_ref_s;
   summary.eps_threshold = scene.bubble.eps_threshold;
   for (const Scene& gs : grid_scenes) summary.grids.push_back({gs.grid.cells_x, gs.grid.cells_y});
-  if (options.uncertainty == UncertaintyMethod::kRealizations) {
+  if (method == UncertaintyMethod::kRealizations) {
     summary.method_description =
         std::to_string(n_seeds) + " packing realizations (seeds " + std::to_string(seeds.front()) +
         ".." + std::to_string(seeds.back()) +
@@ -395,8 +435,9 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   } else {
     const double r = CellSize(grid_scenes[0]) / CellSize(grid_scenes[1]);
     summary.method_description =
-        "one packing (seed " + std::to_string(scene.seed) + ") on the grids " +
-        GridText(scene.grid.cells_x, scene.grid.cells_y) + " and " +
+        (particles ? "one packing (seed " + std::to_string(scene.seed) + ")"
+                   : "the " + scene.solver + " model (deterministic: no packing realizations)") +
+        " on the grids " + GridText(scene.grid.cells_x, scene.grid.cells_y) + " and " +
         GridText(grid_scenes[1].grid.cells_x, grid_scenes[1].grid.cells_y) + " (r = " + Num(r) +
         "); D = the finer grid's; uncertainty = sqrt(E^2 + h^2) with E = |D_fine - D_coarse|/(r - "
         "1) the Richardson error of the finer value for first-order convergence and h = max(dx, "
@@ -406,9 +447,31 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
 
   summary.laws.resize(laws.size());
   for (std::size_t i = 0; i < laws.size(); ++i) summary.laws[i].law = laws[i];
-  StudyProgress study(progress,
-                      static_cast<int>(seeds.size() * (1 + grid_scenes.size() * laws.size())));
-  for (std::size_t k = 0; k < seeds.size(); ++k) {
+  StudyProgress study(
+      progress, static_cast<int>(particles ? seeds.size() * (1 + grid_scenes.size() * laws.size())
+                                           : grid_scenes.size() * laws.size()));
+  if (!particles) {
+    BedRunOptions run_options;
+    run_options.duration_s = options.dpm.duration_s;
+    for (const Scene& run_scene : grid_scenes) {
+      const std::string tag = GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
+      for (std::size_t i = 0; i < laws.size(); ++i) {
+        const BedResult r = run_bed_model(run_scene, Load(load_law, laws[i]), run_options,
+                                          study.Unit(laws[i] + " " + tag));
+        SensitivityLawResult& lr = summary.laws[i];
+        lr.runs.push_back(MakeBedRun(r, run_scene));
+        lr.wall_s += r.wall_s;
+        if (lr.runs.size() == 1) {
+          lr.umf_m_s = r.metrics.umf_m_s;
+          lr.background_m_s = r.metrics.background_m_s;
+          lr.background_mode = r.background_mode;
+          lr.has_snapshot = r.has_snapshot;
+          if (r.has_snapshot) lr.snapshot = BedSnapshot(r);
+        }
+      }
+    }
+  }
+  for (std::size_t k = 0; particles && k < seeds.size(); ++k) {
     Scene seeded = scene;
     seeded.seed = seeds[k];
     SensitivityPacking packing_info;
@@ -447,7 +510,7 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
       d.push_back(run.bubble_diameter_m);
       lr.bubbles_found += run.bubble_found ? 1 : 0;
     }
-    if (options.uncertainty == UncertaintyMethod::kRealizations) {
+    if (method == UncertaintyMethod::kRealizations) {
       lr.diameter = realization_uncertainty(d, lr.runs.front().cell_size_m);
     } else {
       lr.diameter = grid_uncertainty(d[0], lr.runs[0].cell_size_m, d[1], lr.runs[1].cell_size_m);
@@ -498,11 +561,15 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
                                        const SensitivityProgress& progress) {
   const auto t0 = Clock::now();
   scene.Validate();
-  if (scene.solver != "dpm")
-    Fail("scene.solver: work-precision runs \"dpm\" scenes only, got \"" + scene.solver + "\"");
   std::string why;
   if (!options.IsValid(&why)) Fail(why);
   if (!load_law) Fail("run_work_precision: no law loader given");
+  const bool particles = scene.solver == "dpm";
+  if (!particles && !options.contact_steps.empty())
+    Fail(
+        "WorkPrecisionOptions.contact_steps: DEM contact steps apply to the dpm model only (this "
+        "scene's solver is \"" +
+        scene.solver + "\"): sweep grids alone");
   const std::vector<GridSize> grids =
       options.grids.empty() ? std::vector<GridSize>{{scene.grid.cells_x, scene.grid.cells_y}}
                             : options.grids;
@@ -530,14 +597,41 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   result.law = options.law;
   result.seed = scene.seed;
   result.t_ref_s = scene.time.t_ref_s;
-  StudyProgress study(progress, 1 + static_cast<int>(configs.size()));
-  SensitivityPacking packing_info;
-  // One packing, settled with the scene's own DEM settings, for every configuration.
-  const Particles packing =
-      SettlePacking(scene, Load(load_law, options.law), options.dpm,
-                    study.Unit("settle packing seed " + std::to_string(scene.seed)), &packing_info);
-  result.settle_wall_s = packing_info.settle_wall_s;
+  StudyProgress study(progress, (particles ? 1 : 0) + static_cast<int>(configs.size()));
+  Particles packing;
+  if (particles) {
+    SensitivityPacking packing_info;
+    // One packing, settled with the scene's own DEM settings, for every configuration.
+    packing = SettlePacking(scene, Load(load_law, options.law), options.dpm,
+                            study.Unit("settle packing seed " + std::to_string(scene.seed)),
+                            &packing_info);
+    result.settle_wall_s = packing_info.settle_wall_s;
+  } else {
+    result.seed = 0;
+  }
   for (const Scene& c : configs) {
+    if (!particles) {
+      BedRunOptions run_options;
+      run_options.duration_s = options.dpm.duration_s;
+      const std::string tag = GridText(c.grid.cells_x, c.grid.cells_y);
+      const BedResult r = run_bed_model(c, Load(load_law, options.law), run_options,
+                                        study.Unit(options.law + " " + tag));
+      WorkPrecisionRow row;
+      row.cells_x = c.grid.cells_x;
+      row.cells_y = c.grid.cells_y;
+      row.contact_steps = c.time.contact_steps;
+      row.cell_size_m = CellSize(c);
+      row.bubble_found = r.metrics.bubble_present;
+      row.reached_t_ref = r.has_snapshot;
+      row.bubble_diameter_m = r.metrics.bubble_present ? r.metrics.bubble_diameter_m : 0.0;
+      row.wall_s = r.wall_s;
+      row.gas_steps = r.steps;
+      row.gas_dt_s = r.mean_dt_s;
+      result.rows.push_back(row);
+      result.umf_m_s = r.metrics.umf_m_s;
+      result.background_m_s = r.metrics.background_m_s;
+      continue;
+    }
     const std::string tag =
         GridText(c.grid.cells_x, c.grid.cells_y) + "_cs" + std::to_string(c.time.contact_steps);
     DpmSimulation sim(c, Load(load_law, options.law), RunOptions(options.dpm, c, options.law, tag));

@@ -7,7 +7,8 @@
 // run` and `regress` dispatch through run_bed_model, so a new model (TFM, DBM) plugs in by
 // registering, and scene validation accepts exactly the registered keys.
 //
-// Built in: "dpm" (dpm.h, CFD-DEM) and "tfm" (tfm.h, two-fluid with KTGF). Units SI. Thread-safety: register before running.
+// Built in: "dpm" (dpm.h, CFD-DEM) and "tfm" (tfm.h, two-fluid with KTGF). Units SI. Thread-safety:
+// register before running.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "draglab/consumers/bubble.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/law.h"
@@ -54,6 +56,14 @@ struct BedResult {
   double wall_s = 0.0;
   int threads = 1;
   std::vector<std::string> output_files;
+  long steps = 0;          ///< Gas (DPM) or coupled (TFM) time steps.
+  double mean_dt_s = 0.0;  ///< Simulated time / steps.
+  /// The state at the sample nearest to t_ref (false: the run ended before it): the gas
+  /// fraction on the scene's grid and the bubble measured in it, for figures.
+  bool has_snapshot = false;
+  double snapshot_t_s = 0.0;  ///< After the jet start.
+  GridField2D snapshot_void_fraction;
+  BubbleMetrics snapshot_bubble;
   std::string result_json;  ///< The model's full result (a JSON object with "solver": key).
   std::string brief;        ///< One-line report.
 };
