@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# End-to-end test of the two-fluid model through the command line (docs/tfm.md): the tiny TFM
+# scene tests/cli/data/tfm_tiny.toml (6 x 20 cells, well under a second per run) through
+# `scene check`, `scene run` (stored result, JSON naming the model and its conservation),
+# `regress register|run` (exactly as on DPM scenes: the baseline is reused, a new law version is
+# compared), `sensitivity` (two grids, the figures) and the bad input of the [tfm] table, each
+# exiting 2 with the field named and nothing stored.
+set -u
+draglab="$1"
+src="$(cd "$(dirname "$0")/../.." && pwd)"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+db="$work/tfm.db"
+scene="$src/tests/cli/data/tfm_tiny.toml"
+. "$(dirname "$0")/harness.sh"
+
+results() {
+  "$py" -c '
+import sqlite3, sys
+c = sqlite3.connect("file:" + sys.argv[1] + "?mode=ro", uri=True)
+print(c.execute("SELECT count(*) FROM consumer_results").fetchone()[0])
+' "$db"
+}
+
+check "scene check" 0 "$draglab" --db "$db" scene check "$scene"
+ok "check names the two-fluid model" grep -q "solver tfm" "$work/out"
+check "scene run" 0 "$draglab" --db "$db" scene run "$scene" --json
+pycheck "run result: model, bubble, conservation" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/out"))
+assert r["model"] == "tfm" and r["solver"] == "tfm", r["model"]
+assert r["bubble_at_t_ref"] and r["bubble_diameter_m"] > 0.01, r["bubble_diameter_m"]
+assert abs(r["relative_solids_mass_change"]) < 1e-12, r["relative_solids_mass_change"]
+assert r["max_relative_gas_mass_imbalance"] < 1e-12
+assert r["max_solids_fraction"] <= r["closures"]["packing_limit"] + 1e-12
+assert r["steps"] > 0 and r["dt_min_s"] > 0 and r["steps_by_limit"]
+assert r["result_id"] is not None
+'
+
+# Bad input: exit 2 naming the field, nothing stored.
+before="$(results)"
+sed 's/^solver = "tfm"/solver = "tfmx"/' "$scene" >"$work/bad_solver.toml"
+check "unknown solver" 2 "$draglab" --db "$db" scene run "$work/bad_solver.toml"
+ok "unknown solver named" grep -q "tfmx" "$work/err"
+awk '/^\[tfm\]/{skip=1; next} /^\[/{skip=0} !skip' "$scene" >"$work/no_tfm.toml"
+check "missing [tfm]" 2 "$draglab" --db "$db" scene run "$work/no_tfm.toml"
+ok "missing [tfm] named" grep -q "\[tfm\] table is missing" "$work/err"
+sed 's/^closures = "nieuwland"/closures = "nieuwland"\nrestitution = 1.2/' "$scene" >"$work/bad_e.toml"
+check "restitution out of range" 2 "$draglab" --db "$db" scene run "$work/bad_e.toml"
+ok "restitution named" grep -q "\[tfm\] restitution" "$work/err"
+sed 's/^packing_limit = 0.64/packing_limit = 0.57/' "$scene" >"$work/bad_packing.toml"
+check "packing limit below the bed" 2 "$draglab" --db "$db" scene run "$work/bad_packing.toml"
+ok "packing limit named" grep -q "\[tfm\] packing_limit" "$work/err"
+sed 's/^closures = "nieuwland"/closures = "nieuwland"\ntheta_initial_m2_s2 = -0.1/' "$scene" >"$work/bad_theta.toml"
+check "negative theta" 2 "$draglab" --db "$db" scene run "$work/bad_theta.toml"
+ok "theta named" grep -q "\[tfm\] theta_initial_m2_s2" "$work/err"
+sed 's/^t_ref_s = 0.05/t_ref_s = 0.05\ngas_dt_s = 0.002/' "$scene" >"$work/bad_dt.toml"
+check "time step above the stability limit" 2 "$draglab" --db "$db" scene run "$work/bad_dt.toml"
+ok "time step named" grep -q "gas_dt_s" "$work/err"
+ok "nothing stored by bad input" [ "$(results)" = "$before" ]
+
+# regress on a TFM scene, exactly as on a DPM scene.
+check "regress register" 0 "$draglab" --db "$db" regress register "$scene" --law ergun@1 --json
+check "regress run" 0 "$draglab" --db "$db" regress --law ergun@1 --json
+pycheck "regress: ergun@1 ok on the tfm scene, its stored result reused" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/out"))
+e = [x for x in r["entries"] if x["law"] == "ergun@1"]
+assert e and e[0]["outcome"] == "ok" and not e[0]["ran"], r
+assert r["runs"] == 0, r["runs"]
+'
+
+# sensitivity: two grids (a continuum model has no packing realizations), figures.
+check "sensitivity" 0 "$draglab" --db "$db" sensitivity "$scene" --laws ergun@1,vdh2004@1 --out "$work/sens" --json
+pycheck "sensitivity: two grids per law" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/out"))
+assert r["uncertainty"]["method"] == "grids", r["uncertainty"]
+for law in r["laws"]:
+    assert len(law["runs"]) == 2 and law["uncertainty_m"] > 0, law
+'
+if "$py" -c 'import matplotlib' 2>/dev/null; then
+  ok "fig4.png written" [ -s "$work/sens/fig4.png" ]
+  ok "bubble_series.png written" [ -s "$work/sens/bubble_series.png" ]
+  check "sensitivity --beside" 0 "$draglab" --db "$db" sensitivity "$scene" --laws ergun@1 --out "$work/sens2" --beside "$work/sens/sensitivity.json"
+  ok "fig5.png written" [ -s "$work/sens2/fig5.png" ]
+fi
+check "--beside a missing file" 2 "$draglab" --db "$db" sensitivity "$scene" --beside "$work/none.json"
+check "work-precision contact steps on a tfm scene" 2 "$draglab" --db "$db" sensitivity "$scene" --work-precision --law ergun@1 --grids 6x20,9x30 --contact-steps 20,40
+check "work-precision" 0 "$draglab" --db "$db" sensitivity "$scene" --work-precision --law ergun@1 --grids 6x20,9x30 --out "$work/wp" --json
+pycheck "work-precision rows" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/out"))
+assert len(r["rows"]) == 2 and all(x["wall_s"] >= 0 and x["gas_steps"] > 0 for x in r["rows"]), r
+'
+finish cli.tfm
