@@ -8,6 +8,28 @@ namespace draglab {
 namespace consumers {
 namespace internal {
 
+GasOptions scene_gas_options(const Scene& s, double background_m_s, bool with_jet) {
+  GasOptions g;
+  g.nx = s.grid.cells_x;
+  g.nz = s.grid.cells_y;
+  g.width_m = s.geometry.width_m;
+  g.height_m = s.geometry.height_m;
+  g.depth_m = s.geometry.depth_m;
+  g.rho_g = s.gas.density_kg_m3;
+  g.mu_g = s.gas.viscosity_pa_s;
+  g.gravity_z = -s.gas.gravity_m_s2;
+  g.side_walls = WallSlip::kNoSlip;
+  g.background_velocity_m_s = background_m_s;
+  if (with_jet) {
+    g.jet_width_m = s.jet.slot_width_m;
+    g.jet_velocity_m_s = s.jet.velocity_m_s;
+    g.jet_start_s = s.jet.start_s;
+    g.jet_duration_s = s.jet.duration_s;
+  }
+  g.inflow_ramp_s = s.jet.ramp_s;
+  return g;
+}
+
 BubbleOptions scene_bubble_options(const Scene& s, double initial_bed_height_m) {
   BubbleOptions bo;
   bo.eps_threshold = s.bubble.eps_threshold;

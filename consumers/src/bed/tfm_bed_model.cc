@@ -28,22 +28,7 @@ std::string Num(double x) {
 /// The two-fluid model's options for a scene whose background is `background_m_s`.
 TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   TfmOptions o;
-  GasOptions& g = o.gas;
-  g.nx = s.grid.cells_x;
-  g.nz = s.grid.cells_y;
-  g.width_m = s.geometry.width_m;
-  g.height_m = s.geometry.height_m;
-  g.depth_m = s.geometry.depth_m;
-  g.rho_g = s.gas.density_kg_m3;
-  g.mu_g = s.gas.viscosity_pa_s;
-  g.gravity_z = -s.gas.gravity_m_s2;
-  g.side_walls = WallSlip::kNoSlip;
-  g.background_velocity_m_s = background_m_s;
-  g.jet_width_m = s.jet.slot_width_m;
-  g.jet_velocity_m_s = s.jet.velocity_m_s;
-  g.jet_start_s = s.jet.start_s;
-  g.jet_duration_s = s.jet.duration_s;
-  g.inflow_ramp_s = s.jet.ramp_s;
+  o.gas = internal::scene_gas_options(s, background_m_s, /*with_jet=*/true);
   o.particle_diameter_m = s.particles.diameter_m;
   o.particle_density_kg_m3 = s.particles.density_kg_m3;
   KtgfOptions& k = o.ktgf;

@@ -240,24 +240,7 @@ void DpmSimulation::Start(Particles settled) {
                                  : derived.background_m_s;
     result_.background_mode = to_string(s.distributor.mode);
   }
-  GasOptions g;
-  g.nx = s.grid.cells_x;
-  g.nz = s.grid.cells_y;
-  g.width_m = s.geometry.width_m;
-  g.height_m = s.geometry.height_m;
-  g.depth_m = s.geometry.depth_m;
-  g.rho_g = s.gas.density_kg_m3;
-  g.mu_g = s.gas.viscosity_pa_s;
-  g.gravity_z = -s.gas.gravity_m_s2;
-  g.side_walls = WallSlip::kNoSlip;
-  g.background_velocity_m_s = result_.background_m_s;
-  if (opt_.jet) {
-    g.jet_width_m = s.jet.slot_width_m;
-    g.jet_velocity_m_s = s.jet.velocity_m_s;
-    g.jet_start_s = s.jet.start_s;
-    g.jet_duration_s = s.jet.duration_s;
-  }
-  g.inflow_ramp_s = s.jet.ramp_s;
+  const GasOptions g = internal::scene_gas_options(s, result_.background_m_s, opt_.jet);
   impl_->gas = std::make_unique<GasPhase>(g);
   gas_dt_ = opt_.gas_dt_s > 0.0     ? opt_.gas_dt_s
             : s.time.gas_dt_s > 0.0 ? s.time.gas_dt_s
