@@ -37,6 +37,31 @@ assert r["steps"] > 0 and r["dt_min_s"] > 0 and r["steps_by_limit"]
 assert r["result_id"] is not None
 '
 
+# Field files (HDF5 + XDMF) every 20 ms: the two phases' fields, eps + phi = 1, one group per
+# output time; particles are refused (a continuum has none).
+sed "s|^range_policy = \"clamp\"|range_policy = \"clamp\"\n\n[outputs]\nfields = true\ninterval_s = 0.02\ndirectory = \"$work/fields\"|" "$scene" >"$work/fields.toml"
+check "scene run with fields" 0 "$draglab" --db "$db" scene run "$work/fields.toml" --no-store --json
+pycheck "field files" '
+import glob, json, sys
+import h5py, numpy as np
+work = sys.argv[1]
+r = json.load(open(work + "/out"))
+assert any(f.endswith(".h5") for f in r["output_files"]) and any(f.endswith(".xmf") for f in r["output_files"]), r["output_files"]
+with h5py.File(glob.glob(work + "/fields/*.h5")[0], "r") as f:
+    groups = sorted(k for k in f.keys() if k.startswith("t"))
+    assert len(groups) == 4, groups
+    g = f[groups[-1]]
+    for name in ("eps", "phi", "p", "u_x", "u_z", "v_x", "v_z", "theta", "beta"):
+        assert g[name].shape == (1, 20, 6), (name, g[name].shape)
+    assert np.allclose(g["eps"][...] + g["phi"][...], 1.0, atol=1e-15)
+    assert (g["theta"][...] >= 0).all()
+xmf = open(glob.glob(work + "/fields/*.xmf")[0]).read()
+assert xmf.count("Name=\"theta\"") == 4, xmf.count("theta")
+'
+sed 's/^range_policy = "clamp"/range_policy = "clamp"\n\n[outputs]\nparticles = true/' "$scene" >"$work/particles.toml"
+check "particles output refused" 2 "$draglab" --db "$db" scene run "$work/particles.toml" --no-store
+ok "particles output named" grep -q "\[outputs\] particles" "$work/err"
+
 # Bad input: exit 2 naming the field, nothing stored.
 before="$(results)"
 sed 's/^solver = "tfm"/solver = "tfmx"/' "$scene" >"$work/bad_solver.toml"

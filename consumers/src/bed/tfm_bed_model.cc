@@ -3,14 +3,18 @@
 // bubble injected by the jet; bubble metrics sampled like every bed model (bed_sampling.h).
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
+#include "draglab/consumers/dpm_output.h"
 #include "draglab/consumers/tfm.h"
 #include "draglab/drag_db/error.h"
 
@@ -49,6 +53,36 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   return o;
 }
 
+/// The two-fluid model's cell fields for the output files (dpm_output.h layout).
+CellFields TfmCellFields(const TfmSimulation& tfm) {
+  const TfmOptions& o = tfm.options();
+  CellFields c;
+  c.nx = o.gas.nx;
+  c.nz = o.gas.nz;
+  c.dx = tfm.dx();
+  c.dz = tfm.dz();
+  c.depth = o.gas.depth_m;
+  Eigen::ArrayXXd ux(c.nx, c.nz), uz(c.nx, c.nz), vx(c.nx, c.nz), vz(c.nx, c.nz);
+  for (int j = 0; j < c.nz; ++j) {
+    for (int i = 0; i < c.nx; ++i) {
+      ux(i, j) = 0.5 * (tfm.gas_u()(i, j) + tfm.gas_u()(i + 1, j));
+      uz(i, j) = 0.5 * (tfm.gas_w()(i, j) + tfm.gas_w()(i, j + 1));
+      vx(i, j) = 0.5 * (tfm.solids_u()(i, j) + tfm.solids_u()(i + 1, j));
+      vz(i, j) = 0.5 * (tfm.solids_w()(i, j) + tfm.solids_w()(i, j + 1));
+    }
+  }
+  c.arrays = {{"eps", tfm.gas_fraction()},
+              {"phi", tfm.solids_fraction()},
+              {"p", tfm.pressure()},
+              {"u_x", ux},
+              {"u_z", uz},
+              {"v_x", vx},
+              {"v_z", vz},
+              {"theta", tfm.theta()},
+              {"beta", tfm.beta()}};
+  return c;
+}
+
 class TfmBedModel : public BedModel {
  public:
   std::string key() const override { return "tfm"; }
@@ -65,10 +99,10 @@ class TfmBedModel : public BedModel {
       throw Error(ErrorCode::kInvalidArgument,
                   "[jet] center_m: the gas inflow supports only a central slot (width / 2 = " +
                       Num(0.5 * scene.geometry.width_m) + " m), got " + Num(scene.jet_center_m()));
-    if (scene.outputs.fields || scene.outputs.particles)
+    if (scene.outputs.particles)
       throw Error(ErrorCode::kInvalidArgument,
-                  "[outputs] fields/particles: the two-fluid model writes no field files yet "
-                  "(set them to false; the bubble series is in the result)");
+                  "[outputs] particles = true: the two-fluid model has no particles (its solids "
+                  "fraction, velocities and theta are cell fields: [outputs] fields = true)");
     // U_mf first: a law whose validity box excludes the bed fails here, before any step.
     const SceneDerived derived = derive_scene(scene, *law);
     // The TFM bed starts uniform at eps_mf, so its packing is the eps_mf state: "umf_packing"
@@ -98,10 +132,32 @@ class TfmBedModel : public BedModel {
     bool have_ref = false;
     BubbleMetrics ref_bubble;
     const int samples = static_cast<int>(std::floor(duration / interval + 1e-9));
+    // Where the run stops: every sample, and every field output (each outputs.interval_s, or
+    // once at t_ref when it is 0), in time order.
+    std::unique_ptr<DpmOutputWriter> writer;
+    std::vector<std::pair<double, bool>> stops;  // (time, is a field output)
+    for (int n = 1; n <= samples; ++n) stops.push_back({std::min(n * interval, duration), false});
+    if (scene.outputs.fields) {
+      const std::string dir = !options.output_directory.empty()  ? options.output_directory
+                              : !scene.outputs.directory.empty() ? scene.outputs.directory
+                                                                 : "out/" + scene.name;
+      writer = std::make_unique<DpmOutputWriter>(scene, out.law, dir, true, false);
+      if (scene.outputs.interval_s > 0.0) {
+        for (int k = 1; k * scene.outputs.interval_s <= duration * (1.0 + 1e-12); ++k)
+          stops.push_back({k * scene.outputs.interval_s, true});
+      } else if (t_ref_abs <= duration) {
+        stops.push_back({t_ref_abs, true});
+      }
+    }
+    std::stable_sort(stops.begin(), stops.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
     try {
-      for (int n = 1; n <= samples; ++n) {
-        const double t = std::min(n * interval, duration);
+      for (const auto& [t, is_output] : stops) {
         tfm.AdvanceTo(t);
+        if (is_output) {
+          writer->WriteFields(tfm.time(), TfmCellFields(tfm));
+          continue;
+        }
         const BubbleMetrics b =
             measure_bubble(internal::scene_grid_field(scene, tfm.gas_fraction()), bubble);
         BedSample smp;
@@ -132,6 +188,10 @@ class TfmBedModel : public BedModel {
         }
       }
       if (tfm.time() < duration) tfm.AdvanceTo(duration);
+      if (writer) {
+        writer->Finish();
+        out.output_files = writer->files();
+      }
     } catch (const Error& e) {
       throw Error(e.code(), "tfm " + scene.name + " with " + out.law + ": " + e.what());
     }
@@ -199,7 +259,7 @@ class TfmBedModel : public BedModel {
         {"drag_out_of_range", out.law_out_of_range},
         {"threads", out.threads},
         {"wall_s", out.wall_s},
-        {"output_files", nlohmann::json::array()}};
+        {"output_files", out.output_files}};
     if (have_ref) {
       j["snapshot"] = {{"t_s", at_ref.t_s},
                        {"bubble_found", ref_bubble.found},

@@ -136,6 +136,7 @@ struct OutputTime {
   bool fields = false;
   int nx = 0, nz = 0;                      // gas cells (width, height)
   double dx = 0.0, dz = 0.0, depth = 0.0;  // gas cell size [m]
+  std::vector<std::string> field_names;    // the cell fields of this time, in file order
   bool particles = false;
   std::size_t particle_count = 0;
 };
@@ -168,7 +169,7 @@ std::string GasGrid(const OutputTime& o, const std::string& h5_name) {
     << "Format=\"XML\">" << Number(o.depth) << " " << Number(o.dz) << " " << Number(o.dx)
     << "</DataItem>\n"
     << "     </Geometry>\n";
-  for (const char* name : {"eps", "p", "u_x", "u_z", "beta"}) {
+  for (const std::string& name : o.field_names) {
     x << "     <Attribute Name=\"" << name << "\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
       << HdfItem(cells, "Float", 8, h5_name, "/" + o.group + "/" + name, in)
       << "     </Attribute>\n";
@@ -248,8 +249,11 @@ struct DpmOutputWriter::Impl {
   bool h5_created = false, xmf_written = false, index_current = true;
   std::vector<OutputTime> outputs;
 
-  void WriteGroup(hid_t file, const OutputTime& o, double t_s, const GasPhase& gas,
-                  const Particles& p, const std::vector<int>& layers);
+  void WriteGroup(hid_t file, const OutputTime& o, double t_s, const CellFields* cells,
+                  const Particles* p, const std::vector<int>* layers);
+  /// The checks, the file handling and the bookkeeping of one output time.
+  void Append(double t_s, const CellFields* cells, const Particles* particles,
+              const std::vector<int>* layer_by_id);
 };
 
 DpmOutputWriter::DpmOutputWriter(const Scene& scene, const std::string& law,
@@ -288,38 +292,26 @@ DpmOutputWriter::~DpmOutputWriter() {
 }
 
 void DpmOutputWriter::Impl::WriteGroup(hid_t file, const OutputTime& o, double t_s,
-                                       const GasPhase& gas, const Particles& p,
-                                       const std::vector<int>& layers) {
+                                       const CellFields* cells, const Particles* particles,
+                                       const std::vector<int>* layer_by_id) {
   Handle group(H5Gcreate2(file, o.group.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
   if (!group.ok()) Fail(h5_path, "cannot create group /" + o.group);
   const hid_t g = group.get();
   WriteAttribute(g, "time_s", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, &t_s, h5_path);
   if (o.fields) {
-    const int nx = o.nx, nz = o.nz;
     // Eigen arrays are column-major with index (i, j): i (x) fastest, exactly the C order of
     // shape (1, nz, nx), so cell-centred arrays are written as they are.
-    const std::vector<hsize_t> dims{1, static_cast<hsize_t>(nz), static_cast<hsize_t>(nx)};
-    const Eigen::ArrayXXd& u = gas.u();
-    const Eigen::ArrayXXd& w = gas.w();
-    Eigen::ArrayXXd ux(nx, nz), uz(nx, nz);
-    for (int j = 0; j < nz; ++j) {
-      for (int i = 0; i < nx; ++i) {
-        ux(i, j) = 0.5 * (u(i, j) + u(i + 1, j));
-        uz(i, j) = 0.5 * (w(i, j) + w(i, j + 1));
-      }
-    }
-    const std::pair<const char*, const double*> arrays[] = {{"eps", gas.eps().data()},
-                                                            {"p", gas.p().data()},
-                                                            {"u_x", ux.data()},
-                                                            {"u_z", uz.data()},
-                                                            {"beta", gas.beta().data()}};
-    for (const auto& a : arrays) {
-      WriteDataset(g, a.first, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, a.second, h5_path, o.group);
+    const std::vector<hsize_t> dims{1, static_cast<hsize_t>(o.nz), static_cast<hsize_t>(o.nx)};
+    for (const auto& [name, values] : cells->arrays) {
+      WriteDataset(g, name.c_str(), dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, values.data(), h5_path,
+                   o.group);
     }
     const double cell[3] = {o.dx, o.dz, o.depth};
     WriteAttribute(g, "cell_size_m", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {3}, cell, h5_path);
   }
   if (o.particles) {
+    const Particles& p = *particles;
+    const std::vector<int>& layers = *layer_by_id;
     const std::size_t n = o.particle_count;
     std::vector<double> position(3 * n), velocity(3 * n);
     std::vector<std::int64_t> id(n);
@@ -346,10 +338,52 @@ void DpmOutputWriter::Impl::WriteGroup(hid_t file, const OutputTime& o, double t
   }
 }
 
+CellFields gas_cell_fields(const GasPhase& gas) {
+  CellFields c;
+  c.nx = gas.options().nx;
+  c.nz = gas.options().nz;
+  c.dx = gas.dx();
+  c.dz = gas.dz();
+  c.depth = gas.options().depth_m;
+  const Eigen::ArrayXXd& u = gas.u();
+  const Eigen::ArrayXXd& w = gas.w();
+  Eigen::ArrayXXd ux(c.nx, c.nz), uz(c.nx, c.nz);
+  for (int j = 0; j < c.nz; ++j) {
+    for (int i = 0; i < c.nx; ++i) {
+      ux(i, j) = 0.5 * (u(i, j) + u(i + 1, j));
+      uz(i, j) = 0.5 * (w(i, j) + w(i, j + 1));
+    }
+  }
+  c.arrays = {{"eps", gas.eps()}, {"p", gas.p()}, {"u_x", ux}, {"u_z", uz}, {"beta", gas.beta()}};
+  return c;
+}
+
 void DpmOutputWriter::Write(double t_s, const GasPhase& gas, const Particles& particles,
                             const std::vector<int>& layer_by_id) {
   Impl& m = *impl_;
   if (!m.fields && !m.particles) return;
+  const CellFields cells = m.fields ? gas_cell_fields(gas) : CellFields();
+  m.Append(t_s, m.fields ? &cells : nullptr, m.particles ? &particles : nullptr, &layer_by_id);
+}
+
+void DpmOutputWriter::WriteFields(double t_s, const CellFields& cells) {
+  Impl& m = *impl_;
+  if (!m.fields) return;
+  if (m.particles) Fail(m.h5_path, "this writer was made for particles too: use Write()");
+  if (cells.nx < 1 || cells.nz < 1 || cells.arrays.empty())
+    Fail(m.h5_path, "cell fields need a grid (nx, nz >= 1) and at least one array");
+  for (const auto& [name, values] : cells.arrays) {
+    if (name.empty() || values.rows() != cells.nx || values.cols() != cells.nz)
+      Fail(m.h5_path, "cell field '" + name + "' must be named and nx x nz = " +
+                          std::to_string(cells.nx) + " x " + std::to_string(cells.nz));
+  }
+  m.Append(t_s, &cells, nullptr, nullptr);
+}
+
+void DpmOutputWriter::Impl::Append(double t_s, const CellFields* cells,
+                                   const Particles* particles_in,
+                                   const std::vector<int>* layers_in) {
+  Impl& m = *this;
   if (!std::isfinite(t_s)) Fail(m.h5_path, "output time t_s must be finite");
   if (!m.outputs.empty() && !(t_s > m.outputs.back().t_s)) {
     Fail(m.h5_path, "output time t_s = " + Number(t_s) + " s must be after the previous one (" +
@@ -360,17 +394,19 @@ void DpmOutputWriter::Write(double t_s, const GasPhase& gas, const Particles& pa
   std::snprintf(group, sizeof group, "t%06zu", m.outputs.size());
   o.group = group;
   o.t_s = t_s;
-  o.fields = m.fields;
+  o.fields = cells != nullptr;
   if (o.fields) {
-    o.nx = gas.options().nx;
-    o.nz = gas.options().nz;
-    o.dx = gas.dx();
-    o.dz = gas.dz();
-    o.depth = gas.options().depth_m;
+    o.nx = cells->nx;
+    o.nz = cells->nz;
+    o.dx = cells->dx;
+    o.dz = cells->dz;
+    o.depth = cells->depth;
+    for (const auto& a : cells->arrays) o.field_names.push_back(a.first);
   }
-  o.particles = m.particles;
+  o.particles = particles_in != nullptr;
   if (o.particles) {
-    const Particles& p = particles;
+    const Particles& p = *particles_in;
+    const std::vector<int>& layer_by_id = *layers_in;
     const std::size_t n = p.size();
     if (p.y.size() != n || p.z.size() != n || p.vx.size() != n || p.vy.size() != n ||
         p.vz.size() != n || p.diameter.size() != n || p.id.size() != n) {
@@ -412,14 +448,16 @@ void DpmOutputWriter::Write(double t_s, const GasPhase& gas, const Particles& pa
       WriteString(f, "draglab_version", kDragDbVersion, m.h5_path);
       WriteString(f, "layout",
                   "one group per output time /t000000, /t000001, ... (attribute time_s [s] since "
-                  "the background flow started). Gas (cell centres, shape (1, nz, nx), C order, "
-                  "x fastest; cell (i, j) centre at ((i + 1/2) dx, (j + 1/2) dz), dx dz depth in "
-                  "attribute cell_size_m): eps, p [Pa], u_x u_z [m/s] interstitial, beta "
-                  "[kg m^-3 s^-1]. Particles (N rows): position, velocity (N, 3) [m, m/s] in "
-                  "(x width, y height, z depth), diameter [m], id, layer (initial, 0 = bottom).",
+                  "the background flow started). Cell fields (cell centres, shape (1, nz, nx), C "
+                  "order, x fastest; cell (i, j) centre at ((i + 1/2) dx, (j + 1/2) dz), dx dz "
+                  "depth in attribute cell_size_m): DPM eps, p [Pa], u_x u_z [m/s] interstitial, "
+                  "beta [kg m^-3 s^-1]; TFM eps, phi, p [Pa], u_x u_z v_x v_z [m/s] interstitial "
+                  "gas and solids, theta [m^2/s^2], beta. Particles (N rows): position, velocity "
+                  "(N, 3) [m, m/s] in (x width, y height, z depth), diameter [m], id, layer "
+                  "(initial, 0 = bottom).",
                   m.h5_path);
     }
-    m.WriteGroup(file.get(), o, t_s, gas, particles, layer_by_id);
+    m.WriteGroup(file.get(), o, t_s, cells, particles_in, layers_in);
     if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) Fail(m.h5_path, "cannot flush the file");
   } catch (...) {
     // Drop the unfinished group so the file holds only complete output times; the index never
