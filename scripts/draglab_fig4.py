@@ -292,8 +292,11 @@ def draw_work_precision(data, out_dir, quiet):
     if not rows:
         raise SystemExit("error: the data hold no configurations")
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
+    # A continuum model (no DEM steps) has no contact steps to show.
+    dem = any(r.get("dem_steps", 1) > 0 for r in rows)
     for r in rows:
-        label = "%dx%d/%d" % (r["cells_x"], r["cells_y"], r["contact_steps"])
+        label = ("%dx%d/%d" % (r["cells_x"], r["cells_y"], r["contact_steps"]) if dem
+                 else "%dx%d" % (r["cells_x"], r["cells_y"]))
         wall = max(r["wall_s"], 1e-3)
         d_cm = 100 * r["bubble_diameter_m"]
         left.errorbar([wall], [d_cm], yerr=[100 * r["cell_size_m"]], fmt="o", capsize=3,
@@ -322,8 +325,8 @@ def draw_work_precision(data, out_dir, quiet):
     right.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
     right.yaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
     right.tick_params(axis="y", which="minor", labelsize=7)
-    fig.suptitle("work-precision of %s on %s (grid/contact steps per point)" % (
-        data["law"], data["scene"]), fontsize=10)
+    fig.suptitle("work-precision of %s on %s (%s per point)" % (
+        data["law"], data["scene"], "grid/contact steps" if dem else "grid"), fontsize=10)
     save_figure(fig, out_dir, "work_precision.png", quiet)
 
 
