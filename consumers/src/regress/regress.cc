@@ -44,15 +44,12 @@ std::optional<ConsumerResult> stored_result(const Database& db, const std::strin
 // One run of `scene` with `record` by the scene's bed model, as a result ready to store. Throws
 // draglab::Error when the run fails (the caller reports it and stores nothing).
 ConsumerResult run_scene(const Database& db, const Scene& scene, const LawRecord& record,
-                         const DpmOptions& dpm, std::vector<std::string>* warnings,
-                         const DpmProgress& progress) {
+                         const BedRunOptions& options, std::vector<std::string>* warnings,
+                         const BedProgress& progress) {
   std::string warning;
   std::shared_ptr<const Law> law =
       db.load(record.reference(), range_policy_from_string(scene.range_policy), &warning);
   if (!warning.empty() && warnings) warnings->push_back(warning);
-  BedRunOptions options;
-  options.duration_s = dpm.duration_s;
-  options.output_directory = dpm.output_directory;
   const BedResult r = run_bed_model(scene, law, options, progress);
   ConsumerResult result;
   result.scene_name = scene.name;
@@ -320,7 +317,7 @@ bool RegressOptions::IsValid(std::string* error) const {
       return fail(error, "scene_hashes: '" + hash + "' is not a scene hash (64 hex digits)");
     }
   }
-  return dpm.IsValid(error);
+  return run.IsValid(error);
 }
 
 RegressionTolerances baseline_tolerances(const Scene& scene, const RegressOptions& options) {
@@ -426,14 +423,14 @@ RegressSummary run_regression(Database& db, const RegressOptions& options,
     if (!result) {
       const int this_run = run_index++;
       const auto run_start = std::chrono::steady_clock::now();
-      DpmProgress on_progress;
+      BedProgress on_progress;
       if (progress) {
         on_progress = [&](double fraction, const std::string& stage) {
           progress(this_run, runs, fraction, e.scene_name + " " + e.law + ": " + stage);
         };
       }
       try {
-        result = run_scene(db, *p.scene, p.record, options.dpm, &e.warnings, on_progress);
+        result = run_scene(db, *p.scene, p.record, options.run, &e.warnings, on_progress);
       } catch (const Error& error) {
         e.outcome = error.code() == ErrorCode::kOutOfValidity ? RegressOutcome::kOutsideValidity
                                                               : RegressOutcome::kFailed;
@@ -518,14 +515,14 @@ RegressSummary register_regression_baseline(Database& db, const Scene& scene,
   e.tolerances = tolerances;
   std::optional<ConsumerResult> result = stored_result(db, hash, record);
   if (!result) {
-    DpmProgress on_progress;
+    BedProgress on_progress;
     if (progress) {
       on_progress = [&](double fraction, const std::string& stage) {
         progress(0, 1, fraction, scene.name + " " + e.law + ": " + stage);
       };
     }
     const auto run_start = std::chrono::steady_clock::now();
-    result = run_scene(db, scene, record, options.dpm, &e.warnings, on_progress);  // throws
+    result = run_scene(db, scene, record, options.run, &e.warnings, on_progress);  // throws
     e.ran = true;
     e.wall_s = seconds_since(run_start);
     summary.runs = 1;

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/consumer_results.h"
@@ -119,7 +120,7 @@ struct RegressOptions {
   double tol_umf_rel = -1.0;
   /// register_regression_baseline: replace an active baseline (kept as superseded).
   bool replace_baseline = false;
-  DpmOptions dpm;  ///< Run controls (defaults: the scene as registered).
+  BedRunOptions run;  ///< Run controls of every model (defaults: the scene as registered).
   /// On failure *error names the field and its allowed range.
   bool IsValid(std::string* error) const;
 };

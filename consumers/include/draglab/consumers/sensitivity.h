@@ -1,7 +1,9 @@
-// draglab/consumers/sensitivity.h: how much a DPM bubble depends on the drag law, each law's
-// bubble diameter with its numerical uncertainty (the seed's Fig. 4 study), and the
+// draglab/consumers/sensitivity.h: how much a bed model's bubble depends on the drag law, each
+// law's bubble diameter with its numerical uncertainty (the seed's Fig. 4 and 5 studies), and the
 // work-precision study of one law (bubble diameter against grid size and DEM step, with run
-// times).
+// times). The DPM (dpm.h) is described below; any other registered model (bed_model.h, e.g. the
+// two-fluid model) runs through run_bed_model, deterministic, so its uncertainty always comes
+// from two grids and its work-precision sweeps grids only.
 //
 // run_sensitivity runs one scene (scene.h, docs/scenes.md) per law with the coupled DPM (dpm.h)
 // and reports the bubble diameter D at t_ref with an uncertainty from one of two sources:
@@ -74,7 +76,8 @@ struct SensitivityOptions {
   int realizations = 2;
   /// kGrids: the finer grid has round(factor x cells) cells each way; (1, 4].
   double grid_refinement = 1.5;
-  /// Run controls for every run (duration, settling); jet must stay on (the bubble needs it).
+  /// Run controls (duration, settling); jet must stay on (the bubble needs it). A scene of
+  /// another bed model (tfm) takes its duration_s only.
   DpmOptions dpm;
   bool IsValid(std::string* error) const;
 };
@@ -179,7 +182,7 @@ struct WorkPrecisionOptions {
   std::string law;                 ///< One "name@version"; required.
   std::vector<GridSize> grids;     ///< Empty: the scene's grid. No duplicates.
   std::vector<int> contact_steps;  ///< DEM steps per contact time, [20, 1000]; empty: scene's.
-  DpmOptions dpm;                  ///< Run controls (jet on).
+  DpmOptions dpm;                  ///< Run controls (jet on); other models: duration_s only.
   bool IsValid(std::string* error) const;
 };
 
