@@ -213,7 +213,7 @@ class TfmBedModel : public BedModel {
     m.wall_s = out.wall_s;
 
     nlohmann::json limits = nlohmann::json::object();
-    for (int k = 0; k < 6; ++k) {
+    for (int k = 0; k < 7; ++k) {
       if (dg.steps_by_limit[k] > 0)
         limits[to_string(static_cast<TfmStepLimit>(k))] = dg.steps_by_limit[k];
     }
@@ -244,7 +244,7 @@ class TfmBedModel : public BedModel {
           {"packing_limit", o.ktgf.packing_limit},
           {"friction", to_string(o.ktgf.friction)},
           {"friction_min_solids", o.ktgf.friction_min_solids},
-          {"knudsen_length_m", std::min(tfm.dx(), tfm.dz())}}},
+          {"knudsen_length_m", o.ktgf.knudsen_length_m}}},
         {"steps", dg.steps},
         {"dt_min_s", dg.min_dt_s},
         {"dt_mean_s", dg.steps > 0 ? tfm.time() / static_cast<double>(dg.steps) : 0.0},
@@ -253,6 +253,8 @@ class TfmBedModel : public BedModel {
         {"max_solids_fraction", dg.max_solids_fraction},
         {"max_theta_m2_s2", dg.max_theta_m2_s2},
         {"flux_limited_faces", dg.flux_limited_faces},
+        {"positivity_limited_cells", dg.positivity_limited_cells},
+        {"packing_limited_cells", dg.packing_limited_cells},
         {"relative_solids_mass_change", solids_change},
         {"max_relative_gas_mass_imbalance", out.max_relative_mass_imbalance},
         {"momentum_mismatch", nullptr},

@@ -43,6 +43,17 @@ Eigen::ArrayXXd MacPressureSolver::Solve(const Eigen::ArrayXXd& c_u, const Eigen
   const double dx = opt_.dx, dz = opt_.dz;
   const bool periodic = opt_.vertical == VerticalBoundary::kPeriodic;
   const int n = nx * nz;
+  auto shape = [](const Eigen::ArrayXXd& a, int rows, int cols, const char* name) {
+    if (a.rows() != rows || a.cols() != cols)
+      throw Error(ErrorCode::kInvalidArgument,
+                  std::string("pressure equation: ") + name + " has " + std::to_string(a.rows()) +
+                      " x " + std::to_string(a.cols()) + " entries, expected " +
+                      std::to_string(rows) + " x " + std::to_string(cols));
+  };
+  shape(c_u, nx + 1, nz, "c_u");
+  shape(c_w, nx, nz + 1, "c_w");
+  shape(continuity_residual, nx, nz, "continuity_residual");
+  shape(guess, nx, nz, "guess");
   auto id = [nx](int i, int j) { return i + nx * j; };
   std::vector<double> coefficients;
   coefficients.reserve(static_cast<size_t>(c_u.size() + c_w.size()));

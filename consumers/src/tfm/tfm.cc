@@ -63,6 +63,8 @@ const char* to_string(TfmStepLimit limit) {
       return "solids viscosity";
     case TfmStepLimit::kFixed:
       return "fixed";
+    case TfmStepLimit::kLanding:
+      return "landing on an output time";
     case TfmStepLimit::kMaximum:
       break;
   }
@@ -103,8 +105,15 @@ bool TfmOptions::IsValid(std::string* error) const {
   if (!(std::isfinite(dt_min_s) && dt_min_s > 0.0 && dt_min_s <= dt_max_s))
     return fail(error, "[tfm] dt_min_s = " + fmt(dt_min_s) +
                            " is outside (0, dt_max_s = " + fmt(dt_max_s) + "]");
-  if (!(std::isfinite(fixed_dt_s) && fixed_dt_s >= 0.0 && fixed_dt_s <= 0.1))
-    return fail(error, "[tfm] fixed dt = " + fmt(fixed_dt_s) + " is outside [0, 0.1] s");
+  if (!(std::isfinite(fixed_dt_s) && fixed_dt_s >= 0.0 && fixed_dt_s <= dt_max_s))
+    return fail(error,
+                "[time] gas_dt_s = " + fmt(fixed_dt_s) +
+                    " s (the two-fluid model's fixed step) is outside [0, [tfm] dt_max_s = " +
+                    fmt(dt_max_s) + " s]");
+  if (!(initial_solids <= ktgf.packing_limit * (1.0 - 1e-2)))
+    return fail(error, "[tfm] the bed's solids fraction " + fmt(initial_solids) +
+                           " is within 1 % of packing_limit = " + fmt(ktgf.packing_limit) +
+                           ": such a bed cannot move (raise packing_limit or eps_mf)");
   if (gas.vertical != VerticalBoundary::kInflowOutlet)
     return fail(error, "tfm: only the inflow/outlet vertical boundary is supported");
   return true;
@@ -153,6 +162,7 @@ TfmSimulation::TfmSimulation(const TfmOptions& options, std::shared_ptr<const La
   m.dx = opt_.gas.width_m / m.nx;
   m.dz = opt_.gas.height_m / m.nz;
   m.depth = opt_.gas.depth_m;
+  // 0 in the options means "the cell size" here (ktgf.h's 0 = off is for direct use).
   if (opt_.ktgf.knudsen_length_m == 0.0) opt_.ktgf.knudsen_length_m = std::min(m.dx, m.dz);
   m.ktgf = std::make_unique<KtgfClosures>(opt_.ktgf, opt_.particle_diameter_m,
                                           opt_.particle_density_kg_m3);
@@ -386,6 +396,9 @@ double TfmSimulation::StepCapped(double dt_cap) {
     dt = std::min(stable, dt_cap);
   }
   if (!(dt > 0.0)) Bad(at + "time step " + fmt(dt) + " s must be > 0");
+  // A step shortened to land on an output time says nothing about stability.
+  const bool landing = dt < (o.fixed_dt_s > 0.0 ? o.fixed_dt_s : stable);
+  if (landing) why = TfmStepLimit::kLanding;
 
   // ---- cell-centred velocities and the drag coefficient ----
   const Array& phi = m.phi;
@@ -493,16 +506,20 @@ double TfmSimulation::StepCapped(double dt_cap) {
   //    flux limiter would hand it to the gas, a velocity spike that feeds back; without the
   //    second, the surface face would carry the virtual particles' momentum into the bed.
   const double packed = phi_max * (1.0 - 1e-3);
-  auto constrain = [&](Face& f, double lower, double upper, double a_g, double beta_f,
-                       double rhs_g) {
+  // The direction of a face's solids: the prediction with the previous step's pressure gradient
+  // (v_hat alone lacks the whole pressure gradient, so in a dense bed it points down with
+  // gravity even where the gas lifts the solids).
+  auto constrain = [&](Face& f, double lower, double upper, double a_g, double beta_f, double rhs_g,
+                       double old_gradient) {
     if (o.freeze_solids) return;
     if (std::max(lower, upper) < phi_res) {
       f.v_hat = f.u_hat;
       f.c_s = f.c_g;
       return;
     }
-    const double donor_phi = f.v_hat > 0.0 ? lower : upper;
-    const double acceptor_phi = f.v_hat > 0.0 ? upper : lower;
+    const double v = f.v_hat - f.c_s * old_gradient;
+    const double donor_phi = v > 0.0 ? lower : upper;
+    const double acceptor_phi = v > 0.0 ? upper : lower;
     if (acceptor_phi < packed && donor_phi >= phi_res) return;
     f.v_hat = 0.0;
     f.c_s = 0.0;
@@ -546,8 +563,9 @@ double TfmSimulation::StepCapped(double dt_cap) {
       const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress;
       Face& f = fx_at(i, j);
       f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
-      f.phi_flux = donor(f.v_hat, phi(i - 1, j), phi(i, j), pf);
-      constrain(f, phi(i - 1, j), phi(i, j), a_g, bf, rhs_g);
+      const double old_gradient = (m.p(i, j) - m.p(i - 1, j)) / dx;
+      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, phi(i - 1, j), phi(i, j), pf);
+      constrain(f, phi(i - 1, j), phi(i, j), a_g, bf, rhs_g, old_gradient);
     }
 
   // ---- momentum predictors on the z-faces (interior and the outlet) ----
@@ -595,8 +613,9 @@ double TfmSimulation::StepCapped(double dt_cap) {
       const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress + pm * rho_s * g_z;
       Face& f = fz_at(i, j);
       f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
-      f.phi_flux = donor(f.v_hat, phi(i, j - 1), phi(i, j), pf);
-      constrain(f, phi(i, j - 1), phi(i, j), a_g, bf, rhs_g);
+      const double old_gradient = (m.p(i, j) - m.p(i, j - 1)) / dz;
+      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, phi(i, j - 1), phi(i, j), pf);
+      constrain(f, phi(i, j - 1), phi(i, j), a_g, bf, rhs_g, old_gradient);
     }
 
   // ---- mixture pressure equation: div(eps u + phi v) = 0 ----
@@ -685,11 +704,13 @@ double TfmSimulation::StepCapped(double dt_cap) {
                  std::max(-fs_z(i, j + 1), 0.0) + std::max(fs_z(i, j), 0.0));
   };
   // Positivity: a cell cannot give more than it holds.
+  long positivity_limited = 0, packing_limited = 0;
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
       const double out = outflow(i, j), holds = phi(i, j) * volume;
       if (out <= holds) continue;
       const double r = holds / out;
+      ++positivity_limited;
       if (fs_x(i + 1, j) > 0.0) fs_x(i + 1, j) *= r, limited_x(i + 1, j) = 1.0;
       if (fs_x(i, j) < 0.0) fs_x(i, j) *= r, limited_x(i, j) = 1.0;
       if (fs_z(i, j + 1) > 0.0) fs_z(i, j + 1) *= r, limited_z(i, j + 1) = 1.0;
@@ -712,6 +733,7 @@ double TfmSimulation::StepCapped(double dt_cap) {
       for (int i = 0; i < nx; ++i) {
         if (phi_new(i, j) <= phi_max + bound_slack) continue;
         over = true;
+        ++packing_limited;
         const double in = inflow(i, j);
         const double room = std::max((phi_max - phi(i, j)) * volume + outflow(i, j), 0.0);
         const double r = in > 0.0 ? std::min(room / in, 1.0) : 0.0;
@@ -723,11 +745,11 @@ double TfmSimulation::StepCapped(double dt_cap) {
     if (over) update_phi();
   }
   const double phi_new_max = phi_new.maxCoeff(), phi_new_min = phi_new.minCoeff();
-  if (!(phi_new_max <= phi_max + 1e-9) || !(phi_new_min >= -1e-12))
+  if (!(phi_new_max <= phi_max + bound_slack) || !(phi_new_min >= -bound_slack))
     Bad(at + "the solids fraction left [0, packing_limit = " + fmt(phi_max) + "] (min " +
         fmt(phi_new_min) + ", max " + fmt(phi_new_max) +
         ") although the flux limiter ran; remedy: lower cfl");
-  phi_new = phi_new.max(0.0).min(phi_max);
+  phi_new = phi_new.max(0.0).min(phi_max);  // round-off only (bound_slack)
   // The limited faces: the solids velocity carries the limited flux, the gas the rest of the
   // unchanged mixture flux.
   long limited = 0;
@@ -846,13 +868,15 @@ double TfmSimulation::StepCapped(double dt_cap) {
   ++dg.steps;
   dg.time_s = m.time;
   dg.last_dt_s = dt;
-  dg.min_dt_s = dg.steps == 1 ? dt : std::min(dg.min_dt_s, dt);
+  if (!landing) dg.min_dt_s = dg.min_dt_s == 0.0 ? dt : std::min(dg.min_dt_s, dt);
   dg.last_limit = why;
   ++dg.steps_by_limit[static_cast<int>(why)];
   dg.solids_mass_kg = m.phi.sum() * volume * m.depth * rho_s;
   dg.max_solids_fraction = std::max(dg.max_solids_fraction, phi_new_max);
   dg.max_theta_m2_s2 = std::max(dg.max_theta_m2_s2, theta_new.maxCoeff());
   dg.flux_limited_faces += limited;
+  dg.positivity_limited_cells += positivity_limited;
+  dg.packing_limited_cells += packing_limited;
   dg.max_wave_speed_m_s = std::max(
       dg.max_wave_speed_m_s, std::sqrt(std::max(c.pressure_derivative.maxCoeff(), 0.0) / rho_s));
   dg.poisson_residual = m.pressure->diagnostics().relative_residual;

@@ -8,7 +8,7 @@
 //   eps rho_g Du/Dt = -eps grad p + div(eps mu_g grad u) + beta (v - u) + eps rho_g g
 //   phi rho_s Dv/Dt = -phi grad p - grad P_s + div tau_s + beta (u - v) + phi rho_s g
 //   (3/2)[d(phi rho_s theta)/dt + div(phi rho_s theta v)]
-//       = -(P_s I + tau_s):grad v + div(kappa grad theta) - 3 beta theta - gamma
+//       = (-P_s I + tau_s):grad v + div(kappa grad theta) - 3 beta theta - gamma
 // with beta = Law::beta(eps, mu_g, rho_g, |u - v|, d) (interstitial slip, the draglab
 // convention), P_s, tau_s (shear and bulk viscosity), kappa and gamma from ktgf.h.
 //
@@ -49,7 +49,7 @@ struct TfmOptions {
   GasOptions gas;
   double particle_diameter_m = 2.5e-3;     ///< > 0.
   double particle_density_kg_m3 = 2526.0;  ///< > rho_g.
-  KtgfOptions ktgf;
+  KtgfOptions ktgf;  ///< knudsen_length_m = 0 here means the cell size (min(dx, dz)).
   // Initial state: solids fraction initial_solids below initial_bed_height_m, 0 above.
   double initial_solids = 0.58;       ///< [0, packing_limit).
   double initial_bed_height_m = 0.0;  ///< [0, height].
@@ -60,7 +60,7 @@ struct TfmOptions {
   double dt_min_s = 1e-8;             ///< Stop with a diagnosis below it, (0, dt_max].
   /// Fixed step [s] instead of the adaptive one (0: adaptive). A fixed step above the stability
   /// limit stops the run with a diagnosis naming the limit.
-  double fixed_dt_s = 0.0;
+  double fixed_dt_s = 0.0;      ///< [0, dt_max_s].
   bool freeze_solids = false;   ///< Solids held at rest (fixed bed): validation.
   bool interphase_drag = true;  ///< false: beta = 0 (granular-gas validations).
 
@@ -68,7 +68,15 @@ struct TfmOptions {
 };
 
 /// What limited a time step.
-enum class TfmStepLimit { kGasCfl, kSolidsCfl, kPressureWave, kSolidsViscosity, kMaximum, kFixed };
+enum class TfmStepLimit {
+  kGasCfl,
+  kSolidsCfl,
+  kPressureWave,
+  kSolidsViscosity,
+  kMaximum,
+  kFixed,
+  kLanding,  ///< Shortened to land on an output time (not a stability limit).
+};
 const char* to_string(TfmStepLimit limit);
 
 /// Diagnostics: conservation, bounds, the time step and its limits.
@@ -76,17 +84,19 @@ struct TfmDiagnostics {
   double time_s = 0.0;
   long steps = 0;
   double last_dt_s = 0.0;
-  double min_dt_s = 0.0;
+  double min_dt_s = 0.0;  ///< Smallest step a stability limit set (landing steps left out).
   TfmStepLimit last_limit = TfmStepLimit::kMaximum;
-  long steps_by_limit[6] = {0, 0, 0, 0, 0, 0};  ///< Indexed by TfmStepLimit.
-  double solids_mass_kg = 0.0;                  ///< Current, full depth.
+  long steps_by_limit[7] = {0, 0, 0, 0, 0, 0, 0};  ///< Indexed by TfmStepLimit.
+  double solids_mass_kg = 0.0;                     ///< Current, full depth.
   double initial_solids_mass_kg = 0.0;
   double gas_mass_imbalance_kg = 0.0;  ///< Integrated in - out - storage since start.
   double gas_mass_in_kg = 0.0;         ///< Integrated inflow since start.
   double max_solids_fraction = 0.0;
   double max_theta_m2_s2 = 0.0;
-  long flux_limited_faces = 0;      ///< Faces whose solids flux the bounds limited.
-  double max_wave_speed_m_s = 0.0;  ///< sqrt(dP_s/dphi / rho_s), max over cells and steps.
+  long flux_limited_faces = 0;        ///< Faces whose solids flux the bounds limited.
+  long positivity_limited_cells = 0;  ///< Cell-steps whose outflow was cut to their content.
+  long packing_limited_cells = 0;     ///< Cell-steps whose inflow was cut at the packing limit.
+  double max_wave_speed_m_s = 0.0;    ///< sqrt(dP_s/dphi / rho_s), max over cells and steps.
   double poisson_residual = 0.0;
   std::string BriefReport() const;
 };
