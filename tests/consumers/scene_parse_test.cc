@@ -100,6 +100,9 @@ TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
   EXPECT_DOUBLE_EQ(s.tfm.packing_limit, 0.64);
   EXPECT_DOUBLE_EQ(s.tfm.restitution, -1.0) << "from [particles] unless given";
   EXPECT_DOUBLE_EQ(s.geometry.height_m, 0.60) << "the seed's TFM box is 60 cm high";
+  const Scene kuipers = parse_scene(read("tfm_kuipers_jet.toml"), "tfm_kuipers_jet.toml");
+  EXPECT_EQ(kuipers.solver, "tfm");
+  EXPECT_DOUBLE_EQ(kuipers.particles.diameter_m, 5e-4) << "the 1992 experiment's glass";
   expect_bad(edit(base, "scene", "solver", "solver = \"lbm\""), {"[scene] solver", "tfm", "dpm"});
   expect_bad(base.substr(0, base.find("[tfm]")) + base.substr(base.find("[outputs]")),
              {"[tfm] table is missing"});
