@@ -21,6 +21,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
@@ -32,7 +34,8 @@ namespace {
 class SceneUmfTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    path_ = ::testing::TempDir() + "/scene_umf_test.db";
+    // One file per process: ctest runs the tests of this suite side by side.
+    path_ = ::testing::TempDir() + "/scene_umf_test_" + std::to_string(::getpid()) + ".db";
     std::remove(path_.c_str());
     db_ = std::make_unique<Database>(path_);
   }

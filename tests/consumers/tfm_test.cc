@@ -12,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/ktgf.h"
 #include "draglab/consumers/scene.h"
@@ -46,7 +48,8 @@ double MaxSolidsSpeed(const TfmSimulation& tfm, double min_phi = 1e-3) {
 class TfmTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    path_ = ::testing::TempDir() + "/tfm_test.db";
+    // One file per process: ctest runs the tests of this suite side by side.
+    path_ = ::testing::TempDir() + "/tfm_test_" + std::to_string(::getpid()) + ".db";
     std::remove(path_.c_str());
     db_ = std::make_unique<Database>(path_);
   }
