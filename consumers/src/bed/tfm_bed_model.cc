@@ -43,6 +43,7 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   k.packing_limit = s.tfm.packing_limit;
   k.friction_min_solids = s.tfm.friction_min_solids;
   k.friction_angle_deg = s.tfm.friction_angle_deg;
+  k.friction_delta = s.tfm.friction_delta;
   o.initial_solids = 1.0 - s.eps_mf;
   o.initial_bed_height_m = s.bed_height_mf_m();
   o.initial_theta_m2_s2 = s.tfm.theta_initial_m2_s2;

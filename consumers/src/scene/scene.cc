@@ -213,6 +213,7 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                 num("friction_min_solids",
                     [](S& s) -> double& { return s.tfm.friction_min_solids; }),
                 num("friction_angle_deg", [](S& s) -> double& { return s.tfm.friction_angle_deg; }),
+                num("friction_delta", [](S& s) -> double& { return s.tfm.friction_delta; }),
                 num("theta_initial_m2_s2",
                     [](S& s) -> double& { return s.tfm.theta_initial_m2_s2; }),
                 num("residual_solids", [](S& s) -> double& { return s.tfm.residual_solids; }),
@@ -276,6 +277,7 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
   k.packing_limit = s.tfm.packing_limit;
   k.friction_min_solids = s.tfm.friction_min_solids;
   k.friction_angle_deg = s.tfm.friction_angle_deg;
+  k.friction_delta = s.tfm.friction_delta;
   if (!(s.tfm.packing_limit > 1.0 - s.eps_mf)) {
     return fail(error, "[tfm] packing_limit = " + fmt(s.tfm.packing_limit) +
                            " must exceed the bed's solids fraction at minimum fluidization 1 - "

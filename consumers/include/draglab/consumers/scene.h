@@ -130,6 +130,7 @@ struct SceneTfm {
   std::string friction = "johnson_jackson_schaeffer";  ///< Or "none".
   double friction_min_solids = 0.5;   ///< Johnson-Jackson phi_min, (0, packing_limit).
   double friction_angle_deg = 28.5;   ///< (0, 90).
+  double friction_delta = 0.02;       ///< Johnson-Jackson delta (the gap clip), (0, 0.1].
   double theta_initial_m2_s2 = 1e-4;  ///< Initial granular temperature of the bed, >= 0.
   double residual_solids = 1e-4;      ///< (0, 1e-2].
   double cfl = 0.3;                   ///< (0, 0.5].
