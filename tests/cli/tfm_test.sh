@@ -24,6 +24,11 @@ print(c.execute("SELECT count(*) FROM consumer_results").fetchone()[0])
 
 check "scene check" 0 "$draglab" --db "$db" scene check "$scene"
 ok "check names the two-fluid model" grep -q "solver tfm" "$work/out"
+# The shipped two-fluid scenes, the OpenFOAM benchmark's included, stay valid.
+for shipped in "$src/data/scenes/tfm_bubble.toml" "$src/data/scenes/tfm_kuipers_jet.toml" \
+               "$src/bench/openfoam/fluidised_bed.toml"; do
+  check "scene check $(basename "$shipped")" 0 "$draglab" --db "$db" scene check "$shipped"
+done
 check "scene run" 0 "$draglab" --db "$db" scene run "$scene" --json
 pycheck "run result: model, bubble, conservation" '
 import json, sys
