@@ -124,6 +124,32 @@ TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
              {"[tfm] is read only with solver = \"tfm\""});
 }
 
+// Scene files written before the [dem] table (DEM keys in [particles] and [time]) still parse,
+// to the same values: stored scene texts are re-parsed by `draglab regress`.
+TEST(SceneParse, DemKeysInTheirOldSectionsStillParse) {
+  std::string old = read("dpm_bubble.toml");
+  const std::size_t dem = old.find("[dem]");
+  ASSERT_NE(dem, std::string::npos);
+  const std::size_t grid = old.find("[grid]");
+  std::string moved = old.substr(0, dem) + old.substr(grid);
+  moved = edit(moved, "particles", "bed_height_mf_m",
+               "bed_height_mf_m = 0.22\nrestitution = 0.97\nfriction = 0.1\n"
+               "spring_stiffness_n_m = 7000.0");
+  moved = edit(moved, "time", "gas_dt_s",
+               "gas_dt_s = 0.0\nsettle_s = 0.3\ndem_dt_s = 0.0\n"
+               "contact_steps = 20");
+  const Scene a = parse_scene(old, "new.toml"), b = parse_scene(moved, "old.toml");
+  EXPECT_TRUE(a.dem_table);
+  EXPECT_FALSE(b.dem_table);
+  EXPECT_DOUBLE_EQ(a.particles.restitution, b.particles.restitution);
+  EXPECT_DOUBLE_EQ(a.particles.friction, b.particles.friction);
+  EXPECT_DOUBLE_EQ(a.particles.spring_stiffness_n_m, b.particles.spring_stiffness_n_m);
+  EXPECT_DOUBLE_EQ(a.time.settle_s, b.time.settle_s);
+  EXPECT_EQ(a.time.contact_steps, b.time.contact_steps);
+  expect_bad(edit(moved, "particles", "restitution", "restitution = 1.2"),
+             {"[particles] restitution"});
+}
+
 TEST(SceneParse, EveryBadInputIsNamed) {
   const std::string base = read("dpm_bubble.toml");
   expect_bad(base + "\n[extra]\nx = 1\n", {"unknown section", "extra", "[geometry]"});
@@ -145,10 +171,9 @@ TEST(SceneParse, EveryBadInputIsNamed) {
   expect_bad(edit(base, "gas", "viscosity_pa_s", "viscosity_pa_s = -1e-5"),
              {"[gas] viscosity_pa_s"});
   expect_bad(edit(base, "particles", "density_kg_m3", "density_kg_m3 = 1.0"), {"must exceed"});
-  expect_bad(edit(base, "particles", "restitution", "restitution = 1.2"),
-             {"[particles] restitution", "(0, 1]"});
-  expect_bad(edit(base, "particles", "friction", "friction = -0.1"),
-             {"[particles] friction", "[0, 1]"});
+  expect_bad(edit(base, "dem", "restitution", "restitution = 1.2"),
+             {"[dem] restitution", "(0, 1]"});
+  expect_bad(edit(base, "dem", "friction", "friction = -0.1"), {"[dem] friction", "[0, 1]"});
   expect_bad(edit(base, "particles", "diameter_m", "diameter_m = 0.02"), {"does not fit the box"});
   // A jet wider than the bed; a slot that sticks out of the bottom.
   expect_bad(edit(base, "jet", "slot_width_m", "slot_width_m = 0.2"),
@@ -166,14 +191,23 @@ TEST(SceneParse, EveryBadInputIsNamed) {
   expect_bad(edit(base, "particles", "bed_height_mf_m", "# none"), {"exactly one"});
   expect_bad(edit(base, "particles", "bed_height_mf_m", "count = 0"), {"[particles] count"});
   // Times and steps: a DEM step above t_c/20 (t_c = 1.2e-4 s) is refused.
-  expect_bad(edit(base, "time", "dem_dt_s", "dem_dt_s = 1e-5"),
-             {"[time] dem_dt_s", "stability limit"});
+  expect_bad(edit(base, "dem", "dem_dt_s", "dem_dt_s = 1e-5"),
+             {"[dem] dem_dt_s", "stability limit"});
   expect_bad(edit(base, "time", "gas_dt_s", "gas_dt_s = 1e-30"),
              {"[time] gas_dt_s", "more than 1e9"});
-  expect_bad(edit(base, "time", "dem_dt_s", "dem_dt_s = 1e-30"),
-             {"[time] dem_dt_s", "more than 1e9"});
-  expect_bad(edit(base, "time", "contact_steps", "contact_steps = 10"),
-             {"[time] contact_steps", "[20, 1000]"});
+  expect_bad(edit(base, "dem", "dem_dt_s", "dem_dt_s = 1e-30"),
+             {"[dem] dem_dt_s", "more than 1e9"});
+  expect_bad(edit(base, "dem", "contact_steps", "contact_steps = 10"),
+             {"[dem] contact_steps", "[20, 1000]"});
+  // The DEM keys stand in [dem] or, in older files, in [particles] and [time], never in both;
+  // [dem] is the DPM's.
+  expect_bad(
+      edit(base, "particles", "bed_height_mf_m", "bed_height_mf_m = 0.22\nrestitution = 0.9"),
+      {"restitution", "[dem]", "[particles]"});
+  expect_bad(edit(base, "time", "gas_dt_s", "gas_dt_s = 0.0\ncontact_steps = 30"),
+             {"contact_steps", "[dem]", "[time]"});
+  expect_bad(read("tfm_bubble.toml") + "\n[dem]\ncontact_steps = 30\n",
+             {"[dem] is read only with solver = \"dpm\""});
   expect_bad(edit(base, "time", "t_ref_s", "t_ref_s = 0.5"), {"[time] t_ref_s", "duration_s"});
   expect_bad(edit(base, "time", "duration_s", "duration_s = 0"), {"[time] duration_s"});
   expect_bad(edit(base, "grid", "cells_x", "cells_x = 100"), {"[grid]", "smaller than a particle"});

@@ -79,6 +79,23 @@ bool as_bool(const toml::node& n, const std::string& field, const std::string& a
   bad(at + ": " + field + " must be true or false");
 }
 
+void read_contact_steps(Scene& s, const toml::node& n, const std::string& f,
+                        const std::string& at) {
+  const std::int64_t v = as_integer(n, f, at);
+  if (v < 20 || v > 1000) {
+    bad(at + ": " + f + " = " + std::to_string(v) +
+        " is outside [20, 1000] (DEM steps per contact time)");
+  }
+  s.time.contact_steps = static_cast<int>(v);
+}
+
+/// The DEM's keys: read from [dem] (the per-model table), or, in older scene files, from
+/// [particles] (restitution, friction, spring_stiffness_n_m) and [time] (settle_s, dem_dt_s,
+/// contact_steps). A key may stand in one of the two places only.
+const char* const kDemKeys[][2] = {
+    {"restitution", "particles"}, {"friction", "particles"}, {"spring_stiffness_n_m", "particles"},
+    {"settle_s", "time"},         {"dem_dt_s", "time"},      {"contact_steps", "time"}};
+
 template <typename Member>
 Key num(const std::string& name, Member member) {
   return {name, [member](Scene& s, const toml::node& n, const std::string& f,
@@ -158,15 +175,7 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                 num("t_ref_s", [](S& s) -> double& { return s.time.t_ref_s; }),
                 num("settle_s", [](S& s) -> double& { return s.time.settle_s; }),
                 num("dem_dt_s", [](S& s) -> double& { return s.time.dem_dt_s; }),
-                {"contact_steps",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   const std::int64_t v = as_integer(n, f, at);
-                   if (v < 20 || v > 1000) {
-                     bad(at + ": " + f + " = " + std::to_string(v) +
-                         " is outside [20, 1000] (DEM steps per contact time)");
-                   }
-                   s.time.contact_steps = static_cast<int>(v);
-                 }},
+                {"contact_steps", read_contact_steps},
                 num("gas_dt_s", [](S& s) -> double& { return s.time.gas_dt_s; })}},
               {"grid",
                {{"cells_x",
@@ -199,6 +208,14 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                    s.outputs.particles = as_bool(n, f, at);
                  }},
                 num("interval_s", [](S& s) -> double& { return s.outputs.interval_s; })}},
+              {"dem",
+               {num("restitution", [](S& s) -> double& { return s.particles.restitution; }),
+                num("friction", [](S& s) -> double& { return s.particles.friction; }),
+                num("spring_stiffness_n_m",
+                    [](S& s) -> double& { return s.particles.spring_stiffness_n_m; }),
+                num("settle_s", [](S& s) -> double& { return s.time.settle_s; }),
+                num("dem_dt_s", [](S& s) -> double& { return s.time.dem_dt_s; }),
+                {"contact_steps", read_contact_steps}}},
               {"tfm",
                {{"closures", [](S& s, const toml::node& n, const std::string& f,
                                 const std::string& at) { s.tfm.closures = as_text(n, f, at); }},
@@ -336,6 +353,16 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
     const toml::table* table = section_node.as_table();
     if (!table) bad(where(origin, section_node) + ": '" + section + "' must be a [section]");
     if (section == "tfm") s.tfm.present = true;
+    if (section == "dem") {
+      s.dem_table = true;
+      for (const auto& key : kDemKeys) {
+        const toml::table* old = root[key[1]].as_table();
+        if (table->contains(key[0]) && old && old->contains(key[0])) {
+          bad(where(origin, section_node) + ": " + key[0] + " is given in [dem] and in [" + key[1] +
+              "]: keep it in [dem] only");
+        }
+      }
+    }
     for (const auto& [key_name, node] : *table) {
       const std::string key(key_name.str());
       const Key* found = nullptr;
@@ -365,6 +392,10 @@ Scene load_scene(const std::string& path) {
 }
 
 bool Scene::IsValid(std::string* error) const {
+  // Where the DEM's keys stand in this file (messages name the section the user wrote).
+  auto dem_at = [this](const char* old_section) {
+    return std::string(dem_table ? "[dem]" : old_section);
+  };
   if (name.empty()) return fail(error, "[scene] name is missing or empty");
   for (char c : name) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) {
@@ -391,11 +422,12 @@ bool Scene::IsValid(std::string* error) const {
   if (!in_range(d, 0.0, 0.1, true, false, "[particles] diameter_m", "m", error)) return false;
   if (!in_range(particles.density_kg_m3, 0.0, 30000.0, true, false, "[particles] density_kg_m3",
                 "kg/m^3", error) ||
-      !in_range(particles.restitution, 0.0, 1.0, true, false, "[particles] restitution", "",
+      !in_range(particles.restitution, 0.0, 1.0, true, false,
+                dem_at("[particles]") + " restitution", "", error) ||
+      !in_range(particles.friction, 0.0, 1.0, false, false, dem_at("[particles]") + " friction", "",
                 error) ||
-      !in_range(particles.friction, 0.0, 1.0, false, false, "[particles] friction", "", error) ||
       !in_range(particles.spring_stiffness_n_m, 0.0, 1e9, true, false,
-                "[particles] spring_stiffness_n_m", "N/m", error)) {
+                dem_at("[particles]") + " spring_stiffness_n_m", "N/m", error)) {
     return false;
   }
   const double min_box = std::min({geometry.width_m, geometry.height_m, geometry.depth_m});
@@ -473,13 +505,15 @@ bool Scene::IsValid(std::string* error) const {
   // Times.
   if (!in_range(time.duration_s, 0.0, 1e4, true, false, "[time] duration_s", "s", error) ||
       !in_range(time.t_ref_s, 0.0, 1e4, false, false, "[time] t_ref_s", "s", error) ||
-      !in_range(time.settle_s, 0.0, 1e4, false, false, "[time] settle_s", "s", error) ||
-      !in_range(time.dem_dt_s, 0.0, 1.0, false, false, "[time] dem_dt_s", "s (0 = auto)", error) ||
+      !in_range(time.settle_s, 0.0, 1e4, false, false, dem_at("[time]") + " settle_s", "s",
+                error) ||
+      !in_range(time.dem_dt_s, 0.0, 1.0, false, false, dem_at("[time]") + " dem_dt_s",
+                "s (0 = auto)", error) ||
       !in_range(time.gas_dt_s, 0.0, 1.0, false, false, "[time] gas_dt_s", "s (0 = auto)", error)) {
     return false;
   }
   if (time.contact_steps < 20 || time.contact_steps > 1000) {
-    return fail(error, "[time] contact_steps = " + std::to_string(time.contact_steps) +
+    return fail(error, dem_at("[time]") + " contact_steps = " + std::to_string(time.contact_steps) +
                            " is outside [20, 1000]");
   }
   if (jet.start_s + time.t_ref_s > time.duration_s * (1.0 + 1e-12)) {
@@ -497,7 +531,7 @@ bool Scene::IsValid(std::string* error) const {
                            fmt(time.duration_s / kMaxSteps) + " s");
   }
   if (time.dem_dt_s > 0.0 && (time.settle_s + time.duration_s) / time.dem_dt_s > kMaxSteps) {
-    return fail(error, "[time] dem_dt_s = " + fmt(time.dem_dt_s) + " s would take " +
+    return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) + " s would take " +
                            fmt((time.settle_s + time.duration_s) / time.dem_dt_s) +
                            " DEM steps for settle_s + duration_s (more than 1e9): use 0 = auto, "
                            "or a step >= (settle_s + duration_s) / 1e9 = " +
@@ -506,7 +540,7 @@ bool Scene::IsValid(std::string* error) const {
   if (time.dem_dt_s > 0.0) {
     const double limit = contact_time_s(particles) / 20.0;
     if (time.dem_dt_s > limit) {
-      return fail(error, "[time] dem_dt_s = " + fmt(time.dem_dt_s) +
+      return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) +
                              " s is above the stability limit t_c/20 = " + fmt(limit) +
                              " s of the contact model (use 0 = auto, or a smaller step)");
     }
@@ -547,6 +581,10 @@ bool Scene::IsValid(std::string* error) const {
     }
   }
   if (!tfm_is_valid(*this, error)) return false;
+  if (dem_table && solver != "dpm") {
+    return fail(error, "[dem] is read only with solver = \"dpm\" (this scene's solver is \"" +
+                           solver + "\"): remove the table or change the solver");
+  }
   if (range_policy != "clamp" && range_policy != "extrapolate" && range_policy != "error") {
     return fail(error, "[drag] range_policy = '" + range_policy +
                            "' is not one of clamp, extrapolate, error");

@@ -153,6 +153,9 @@ struct Scene {
   SceneBubble bubble;
   SceneOutputs outputs;
   SceneTfm tfm;
+  /// The file has a [dem] table (the DPM's contact and DEM-step keys there; older files keep
+  /// them in [particles] and [time], which messages then name).
+  bool dem_table = false;
   std::vector<std::string> laws;  ///< "name@version" references, at least one.
   double eps_mf = 0.42;           ///< Gas fraction of the bed at minimum fluidization.
   /// Range policy the solver uses for drag evaluations outside a law's validity box during a
