@@ -136,6 +136,24 @@ SensitivityRun MakeBedRun(const BedResult& r, const Scene& s) {
   return run;
 }
 
+/// A work-precision row from one run of its configuration.
+WorkPrecisionRow RowOf(const SensitivityRun& run, int contact_steps) {
+  WorkPrecisionRow row;
+  row.cells_x = run.cells_x;
+  row.cells_y = run.cells_y;
+  row.contact_steps = contact_steps;
+  row.cell_size_m = run.cell_size_m;
+  row.bubble_found = run.bubble_found;
+  row.reached_t_ref = run.reached_t_ref;
+  row.bubble_diameter_m = run.bubble_diameter_m;
+  row.wall_s = run.wall_s;
+  row.gas_steps = run.gas_steps;
+  row.dem_steps = run.dem_steps;
+  row.gas_dt_s = run.gas_dt_s;
+  row.dem_dt_s = run.dem_dt_s;
+  return row;
+}
+
 /// The snapshot of a bed-model run for the figures: the gas fraction and its bubble, no
 /// particles (the figure draws the solids fraction as a grey scale then).
 DpmSnapshot BedSnapshot(const BedResult& r) {
@@ -616,18 +634,7 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
       const std::string tag = GridText(c.grid.cells_x, c.grid.cells_y);
       const BedResult r = run_bed_model(c, Load(load_law, options.law), run_options,
                                         study.Unit(options.law + " " + tag));
-      WorkPrecisionRow row;
-      row.cells_x = c.grid.cells_x;
-      row.cells_y = c.grid.cells_y;
-      row.contact_steps = c.time.contact_steps;
-      row.cell_size_m = CellSize(c);
-      row.bubble_found = r.metrics.bubble_present;
-      row.reached_t_ref = r.has_snapshot;
-      row.bubble_diameter_m = r.metrics.bubble_present ? r.metrics.bubble_diameter_m : 0.0;
-      row.wall_s = r.wall_s;
-      row.gas_steps = r.steps;
-      row.gas_dt_s = r.mean_dt_s;
-      result.rows.push_back(row);
+      result.rows.push_back(RowOf(MakeBedRun(r, c), c.time.contact_steps));
       result.umf_m_s = r.metrics.umf_m_s;
       result.background_m_s = r.metrics.background_m_s;
       continue;
@@ -637,20 +644,7 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
     DpmSimulation sim(c, Load(load_law, options.law), RunOptions(options.dpm, c, options.law, tag));
     sim.Start(packing);
     const DpmResult r = sim.Run(study.Unit(options.law + " " + tag));
-    WorkPrecisionRow row;
-    row.cells_x = c.grid.cells_x;
-    row.cells_y = c.grid.cells_y;
-    row.contact_steps = c.time.contact_steps;
-    row.cell_size_m = CellSize(c);
-    row.bubble_found = r.bubble_at_t_ref;
-    row.reached_t_ref = r.has_snapshot;
-    row.bubble_diameter_m = r.bubble_at_t_ref ? r.bubble_diameter_m : 0.0;
-    row.wall_s = r.wall_s;
-    row.gas_steps = r.gas_steps;
-    row.dem_steps = r.dem_steps;
-    row.gas_dt_s = r.gas_dt_s;
-    row.dem_dt_s = r.dem_dt_s;
-    result.rows.push_back(row);
+    result.rows.push_back(RowOf(MakeRun(r, c), c.time.contact_steps));
     result.umf_m_s = r.umf_m_s;
     result.background_m_s = r.background_m_s;
   }
