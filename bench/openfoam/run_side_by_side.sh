@@ -13,7 +13,8 @@
 # (equilibrium off, residualAlpha 1e-4), and its virtual mass is removed; draglab runs
 # bench/openfoam/fluidised_bed.toml, which declares the same (gidaspow@1 = GidaspowErgunWenYu).
 # What still differs: OpenFOAM's air is a perfect gas with an energy equation (draglab's is
-# incompressible, 1.16 kg/m^3: OpenFOAM's density at 300 K and 1 bar), OpenFOAM runs PIMPLE with
+# incompressible, 0.579 kg/m^3: OpenFOAM's density at the tutorial's 600 K and 1 bar), its
+# momentum advection is limitedLinearV (draglab's upwind), OpenFOAM runs PIMPLE with
 # 3 outer correctors and an implicit phase pressure, draglab one explicit projection step whose
 # size adapts below 2e-4 s when its stability limits ask (the steps and their limits are
 # reported; the run is then at "the same step where stable").

@@ -19,8 +19,17 @@
 //     proportional to phi; the
 //     Johnson-Jackson pressure and the Schaeffer viscosity follow their formulas (the latter
 //     capped); dP/dphi matches a finite difference of P.
+// (5) Local-equilibrium theta (the algebraic option) in simple shear at rate G (D':D' = G^2/2,
+//     div v = 0) with the Gidaspow book forms of (2): mu = M sqrt(theta), gamma = Q theta^1.5
+//     and a drag sink s theta give Q x^2 + s x - M G^2 = 0 for x = sqrt(theta), solved here by
+//     the textbook root; without the sink theta = M G^2 / Q (with the collisional viscosity
+//     alone this is the classical dense-limit d^2 G^2 / (15 (1 - e))).
+//     Under compression and expansion with the Nieuwland set the returned theta balances the
+//     Eq. 15 source terms evaluated at that theta (residual 1e-10 of the production), the
+//     expansion work counted where div v > 0 only (ktgf.h says why).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -177,6 +186,63 @@ TEST(Ktgf, JohnsonJacksonSchaefferFriction) {
                      k.Evaluate(0.58 - h, th, 0, rate).pressure_pa) /
                     (2.0 * h);
   EXPECT_NEAR(k.Evaluate(0.58, th, 0, rate).pressure_derivative_pa, fd, 1e-5 * fd);
+}
+
+TEST(Ktgf, EquilibriumThetaInSimpleShearMatchesTheClosedForm) {
+  const double rate = 10.0;
+  for (const State st : {State{0.1, 0.0, 0.9}, State{0.35, 0.0, 0.97}, State{0.55, 0.0, 0.8}}) {
+    KtgfOptions o;
+    o.closures = KtgfClosureSet::kGidaspow;
+    o.restitution = st.e;
+    const KtgfClosures k(o, kD, kRho);
+    const double g0 = k.RadialDistributionAt(st.phi), e = st.e, phi = st.phi;
+    const double m = 0.8 * phi * phi * kRho * kD * g0 * (1.0 + e) / std::sqrt(kPi) +
+                     10.0 * kRho * kD * std::sqrt(kPi) / (96.0 * (1.0 + e) * g0) *
+                         std::pow(1.0 + 0.8 * g0 * phi * (1.0 + e), 2);
+    const double q = 12.0 * (1.0 - e * e) * phi * phi * kRho * g0 / (kD * std::sqrt(kPi));
+    const double dev2 = 0.5 * rate * rate;
+    const double theta = k.EquilibriumTheta(phi, 0.0, dev2, 0.0);
+    EXPECT_NEAR(theta, m * rate * rate / q, 1e-12 * theta) << "phi = " << phi;
+    const double sink = 3.0 * 2e4;  // 3 beta of a dense gas-fluidised bed [kg m^-3 s^-1]
+    const double x = (-sink + std::sqrt(sink * sink + 4.0 * q * m * rate * rate)) / (2.0 * q);
+    EXPECT_NEAR(k.EquilibriumTheta(phi, 0.0, dev2, sink), x * x, 1e-10 * x * x);
+  }
+}
+
+TEST(Ktgf, EquilibriumThetaBalancesTheSourcesUnderCompressionAndExpansion) {
+  KtgfOptions o;  // Nieuwland: the dissipation has its -div v term
+  o.restitution = 0.9;
+  o.friction = FrictionModel::kJohnsonJacksonSchaeffer;  // friction produces no fluctuations
+  const KtgfClosures k(o, kD, kRho);
+  for (const double div : {-20.0, -1.0, 0.0, 5.0})
+    for (const double phi : {0.05, 0.4, 0.6}) {
+      const double dev2 = 50.0, sink = 3.0 * 1e4;
+      const double theta = k.EquilibriumTheta(phi, div, dev2, sink);
+      ASSERT_GT(theta, 0.0);
+      const KtgfCoefficients c = k.Evaluate(phi, theta, div, std::sqrt(0.5 * dev2));
+      const double mu_kinetic = c.shear_viscosity_pa_s - c.frictional_viscosity_pa_s;
+      const double production = 2.0 * mu_kinetic * dev2 + c.bulk_viscosity_pa_s * div * div;
+      const double sinks = c.kinetic_pressure_per_theta * theta * std::max(div, 0.0) +
+                           c.dissipation_rate_coefficient * theta + sink * theta;
+      EXPECT_NEAR(production, sinks, 1e-10 * production) << "phi " << phi << " div " << div;
+    }
+  EXPECT_EQ(k.EquilibriumTheta(0.4, 0.0, 0.0, 0.0), 0.0) << "no shear, no compression";
+  EXPECT_EQ(k.EquilibriumTheta(0.0, 0.0, 50.0, 0.0), 0.0) << "no solids";
+}
+
+TEST(Ktgf, EquilibriumThetaOfElasticParticlesNeedsADragSink) {
+  KtgfOptions o;
+  o.restitution = 1.0;
+  const KtgfClosures k(o, kD, kRho);
+  try {
+    k.EquilibriumTheta(0.4, 0.0, 50.0, 0.0);
+    ADD_FAILURE() << "elastic, sheared, no gas: nothing bounds theta";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("restitution"), std::string::npos) << e.what();
+  }
+  EXPECT_GT(k.EquilibriumTheta(0.4, 0.0, 50.0, 3e4), 0.0);
+  EXPECT_THROW(k.EquilibriumTheta(0.4, 0.0, -1.0, 0.0), Error);
+  EXPECT_THROW(k.EquilibriumTheta(0.4, std::nan(""), 1.0, 0.0), Error);
 }
 
 TEST(Ktgf, BadOptionsNameTheField) {

@@ -122,6 +122,29 @@ TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
   expect_bad(edit(base, "tfm", "closures", "cloures = \"nieuwland\""), {"unknown key", "cloures"});
   expect_bad(read("dpm_bubble.toml") + "\n[tfm]\nclosures = \"nieuwland\"\n",
              {"[tfm] is read only with solver = \"tfm\""});
+  // The numerical and modelling options: defaults, values, and bad names.
+  EXPECT_EQ(s.tfm.solids_walls, "free_slip");
+  EXPECT_EQ(s.tfm.fraction_scheme, "upwind");
+  EXPECT_EQ(s.tfm.granular_temperature, "transport");
+  EXPECT_DOUBLE_EQ(s.tfm.friction_max_viscosity_pa_s, 10.0);
+  const Scene options =
+      parse_scene(edit(base, "tfm", "closures",
+                       "closures = \"nieuwland\"\nsolids_walls = \"no_slip\"\nfraction_scheme = "
+                       "\"van_leer\"\ngranular_temperature = \"algebraic\"\n"
+                       "friction_max_viscosity_pa_s = 100.0"),
+                  "edited.toml");
+  EXPECT_EQ(options.tfm.solids_walls, "no_slip");
+  EXPECT_EQ(options.tfm.fraction_scheme, "van_leer");
+  EXPECT_EQ(options.tfm.granular_temperature, "algebraic");
+  EXPECT_DOUBLE_EQ(options.tfm.friction_max_viscosity_pa_s, 100.0);
+  expect_bad(edit(base, "tfm", "closures", "solids_walls = \"sticky\""),
+             {"[tfm] solids_walls", "no_slip"});
+  expect_bad(edit(base, "tfm", "closures", "fraction_scheme = \"quick\""),
+             {"[tfm] fraction_scheme", "van_leer"});
+  expect_bad(edit(base, "tfm", "closures", "granular_temperature = \"none\""),
+             {"[tfm] granular_temperature", "algebraic"});
+  expect_bad(edit(base, "tfm", "closures", "friction_max_viscosity_pa_s = 0"),
+             {"friction_max_viscosity_pa_s"});
 }
 
 // Scene files written before the [dem] table (DEM keys in [particles] and [time]) still parse,

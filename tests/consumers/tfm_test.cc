@@ -11,6 +11,8 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <unistd.h>
 
@@ -241,6 +243,89 @@ TEST_F(TfmTest, SedimentingColumnWithFrictionRestsOnItsContactPressure) {
   EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
 }
 
+// Solids wall condition: the sedimenting column of the test above, 8 cells wide, settling for
+// 0.1 s with theta0 = 1e-2 m^2/s^2 (a kinetic viscosity of ~0.1 Pa s). References: with free
+// slip nothing varies across the width, so every column settles alike (to round-off); with no
+// slip the wall shear (ghost velocity -w) retards the columns next to the walls, so they settle
+// more slowly than the middle, the profile stays mirror-symmetric, and the solids are conserved.
+TEST_F(TfmTest, NoSlipSolidsWallsRetardTheSettlingNextToThem) {
+  auto settle = [&](WallSlip walls) {
+    TfmOptions o = column(8, 40, 0.04, 0.2);
+    o.particle_diameter_m = 5e-4;
+    o.initial_solids = 0.3;
+    o.initial_bed_height_m = 0.12;
+    o.initial_theta_m2_s2 = 1e-2;
+    o.solids_walls = walls;
+    auto tfm = std::make_unique<TfmSimulation>(o, law("ergun@1"));
+    tfm->AdvanceTo(0.1);
+    return tfm;
+  };
+  const auto free = settle(WallSlip::kFreeSlip);
+  const auto noslip = settle(WallSlip::kNoSlip);
+  const int j = 10;  // a z-face in the lower half of the suspension
+  const Eigen::ArrayXXd& wf = free->solids_w();
+  const Eigen::ArrayXXd& wn = noslip->solids_w();
+  ASSERT_LT(wf(4, j), -1e-3) << "settling";
+  for (int i = 0; i < 8; ++i) EXPECT_NEAR(wf(i, j), wf(4, j), 1e-9 * std::abs(wf(4, j)));
+  std::printf("settling w at z = %.3f m: free slip %.5f; no slip wall %.5f, middle %.5f m/s\n",
+              j * noslip->dz(), wf(4, j), wn(0, j), wn(4, j));
+  EXPECT_GT(wn(0, j), wn(3, j)) << "the wall column settles more slowly";
+  EXPECT_LT(wn(0, j), 0.0);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(wn(i, j), wn(7 - i, j), 1e-9 * std::abs(wn(4, j)));
+  const TfmDiagnostics& dg = noslip->diagnostics();
+  EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
+}
+
+// Transport of the solids fraction: no gravity, no drag, theta = 0 (no solids stress), both
+// phases moving up at U = 0.5 m/s through the inlet and the outlet, a bed of phi = 0.3 up to
+// 0.2 m. Reference: pure advection, so the bed's top front moves to 0.2 + U t = 0.35 m at
+// t = 0.3 s, phi stays in [0, 0.3] (no new extrema: both schemes are TVD) and the solids
+// volume is conserved (none leaves: the bottom face carries none, the top is far). Upwind
+// diffuses the front with D = U dz / 2 (sigma = sqrt(2 D t) ~ 5.5 cells, so its 10-90 % part,
+// 0.03 < phi < 0.27, spans ~2.6 sigma ~ 14 cells); van Leer keeps it sharp. The test asks
+// for an upwind front of at least 4 cells, a van Leer front at most half as wide, and the
+// half-height position within one cell of the exact one for both.
+TEST_F(TfmTest, SolidsFrontAdvectsAndVanLeerKeepsItSharp) {
+  auto advect = [&](FractionScheme scheme) {
+    TfmOptions o = column(2, 120, 0.01, 0.6);
+    o.gas.gravity_z = 0.0;
+    o.gas.background_velocity_m_s = 0.5;
+    o.interphase_drag = false;
+    o.initial_solids = 0.3;
+    o.initial_bed_height_m = 0.2;
+    o.initial_theta_m2_s2 = 0.0;
+    o.fraction_scheme = scheme;
+    auto tfm = std::make_unique<TfmSimulation>(o, law("ergun@1"));
+    tfm->SetUniformVelocity(0.0, 0.5, 0.0, 0.5);
+    tfm->AdvanceTo(0.3);
+    return tfm;
+  };
+  int width[2] = {0, 0};
+  for (const FractionScheme scheme : {FractionScheme::kUpwind, FractionScheme::kVanLeer}) {
+    const auto tfm = advect(scheme);
+    const Eigen::ArrayXXd& phi = tfm->solids_fraction();
+    const double dz = tfm->dz();
+    double front = 0.0;
+    int cells = 0;
+    for (int j = 0; j + 1 < phi.cols(); ++j) {
+      EXPECT_LE(phi(0, j), 0.3 + 1e-12);
+      EXPECT_GE(phi(0, j), -1e-12);
+      if (phi(0, j) > 0.03 && phi(0, j) < 0.27 && (j + 0.5) * dz > 0.25) ++cells;
+      if (phi(0, j) >= 0.15 && phi(0, j + 1) < 0.15)
+        front = (j + 0.5 + (phi(0, j) - 0.15) / (phi(0, j) - phi(0, j + 1))) * dz;
+    }
+    const bool vl = scheme == FractionScheme::kVanLeer;
+    width[vl] = cells;
+    std::printf("%s: front at %.4f m (exact 0.35), %d cells wide\n", vl ? "van Leer" : "upwind",
+                front, cells);
+    EXPECT_NEAR(front, 0.35, dz);
+    const TfmDiagnostics& dg = tfm->diagnostics();
+    EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
+  }
+  EXPECT_GE(width[0], 4);
+  EXPECT_LE(2 * width[1], width[0]);
+}
+
 // Homogeneous cooling (Haff's law): a closed box, no gravity, no gas drag, uniform phi = 0.3
 // and theta0 = 1e-2 m^2/s^2 at rest. Eq. 15 reduces to (3/2) phi rho_s dtheta/dt = -gamma with
 // the Nieuwland dissipation gamma = 3 (1 - e^2) phi^2 rho_s g0 theta (4/d) sqrt(theta/pi), so
@@ -310,6 +395,15 @@ std::string Edit(std::string text, const std::string& section, const std::string
   return text.substr(0, at + 1) + key + " = " + value + text.substr(end);
 }
 
+/// Adds `key = value` at the top of `section`.
+std::string Add(std::string text, const std::string& section, const std::string& key,
+                const std::string& value) {
+  const std::size_t sec = text.find("[" + section + "]\n");
+  EXPECT_NE(sec, std::string::npos) << section;
+  const std::size_t at = sec + section.size() + 3;
+  return text.substr(0, at) + key + " = " + value + "\n" + text.substr(at);
+}
+
 // Bubble rise: the seed's TFM bed (tfm_bubble.toml: 2.5 mm glass at U_mf, the 13 m/s slot jet)
 // made 30 cm wide so that the bubble is far from the walls (D/W ~ 0.17: the Kunii-Levenspiel
 // wall factor 1.2 exp(-1.49 D/W) is 0.93, i.e. none), with a 30 ms pulse that makes a ~5 cm
@@ -318,8 +412,11 @@ std::string Edit(std::string text, const std::string& section, const std::string
 // scatter by about +-25 % around it, and a pseudo-2-D bed's bubble is a cylinder, for which the
 // literature quotes lower values, so the test takes u_b / sqrt(g D) in [0.53, 0.89] (0.711
 // +-25 %). u_b: least-squares slope of the centroid height over the samples from 0.1 s after the
-// pulse (the bubble has left the plate) to the end; D: their mean.
-TEST_F(TfmTest, BubbleRiseVelocityMatchesDavidson) {
+// pulse (the bubble has left the plate) to the end; D: their mean. The same holds with each
+// numerical and modelling option of the [tfm] table: the granular temperature in local
+// equilibrium instead of transported, and van Leer's face fractions with no-slip solids walls.
+void ExpectDavidsonRise(const std::shared_ptr<const Law>& law,
+                        const std::vector<std::pair<std::string, std::string>>& tfm_keys) {
   std::ifstream file(std::string(DRAGLAB_DATA_DIR) + "/scenes/tfm_bubble.toml");
   std::stringstream text;
   text << file.rdbuf();
@@ -331,8 +428,9 @@ TEST_F(TfmTest, BubbleRiseVelocityMatchesDavidson) {
   t = Edit(t, "jet", "duration_s", "0.03");
   t = Edit(t, "time", "duration_s", "0.35");
   t = Edit(t, "time", "t_ref_s", "0.25");
+  for (const auto& [key, value] : tfm_keys) t = Add(t, "tfm", key, value);
   const Scene scene = parse_scene(t, "tfm_bubble (30 cm wide, 30 ms pulse)");
-  const BedResult r = run_bed_model(scene, law("gidaspow@1"));
+  const BedResult r = run_bed_model(scene, law);
   const double from = scene.jet.duration_s + 0.1;
   double n = 0, st = 0, sz = 0, stt = 0, stz = 0, sd = 0;
   for (const BedSample& smp : r.series) {
@@ -354,6 +452,18 @@ TEST_F(TfmTest, BubbleRiseVelocityMatchesDavidson) {
   EXPECT_LT(d / scene.geometry.width_m, 0.3) << "a bubble, not a slug";
   EXPECT_GE(coefficient, 0.711 * 0.75);
   EXPECT_LE(coefficient, 0.711 * 1.25);
+  EXPECT_LT(r.max_relative_mass_imbalance, 1e-12);
+}
+
+TEST_F(TfmTest, BubbleRiseVelocityMatchesDavidson) { ExpectDavidsonRise(law("gidaspow@1"), {}); }
+
+TEST_F(TfmTest, BubbleRiseVelocityMatchesDavidsonWithAlgebraicTheta) {
+  ExpectDavidsonRise(law("gidaspow@1"), {{"granular_temperature", "\"algebraic\""}});
+}
+
+TEST_F(TfmTest, BubbleRiseVelocityMatchesDavidsonWithVanLeerAndNoSlipSolidsWalls) {
+  ExpectDavidsonRise(law("gidaspow@1"),
+                     {{"fraction_scheme", "\"van_leer\""}, {"solids_walls", "\"no_slip\""}});
 }
 
 }  // namespace

@@ -44,6 +44,7 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   k.friction_min_solids = s.tfm.friction_min_solids;
   k.friction_angle_deg = s.tfm.friction_angle_deg;
   k.friction_delta = s.tfm.friction_delta;
+  k.friction_max_viscosity_pa_s = s.tfm.friction_max_viscosity_pa_s;
   o.initial_solids = 1.0 - s.eps_mf;
   o.initial_bed_height_m = s.bed_height_mf_m();
   o.initial_theta_m2_s2 = s.tfm.theta_initial_m2_s2;
@@ -51,6 +52,12 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   o.cfl = s.tfm.cfl;
   o.dt_max_s = s.tfm.dt_max_s;
   o.fixed_dt_s = s.time.gas_dt_s;
+  o.solids_walls = s.tfm.solids_walls == "no_slip" ? WallSlip::kNoSlip : WallSlip::kFreeSlip;
+  o.fraction_scheme =
+      s.tfm.fraction_scheme == "van_leer" ? FractionScheme::kVanLeer : FractionScheme::kUpwind;
+  o.granular_temperature = s.tfm.granular_temperature == "algebraic"
+                               ? GranularTemperature::kAlgebraic
+                               : GranularTemperature::kTransport;
   return o;
 }
 

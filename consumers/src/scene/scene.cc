@@ -231,11 +231,25 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                     [](S& s) -> double& { return s.tfm.friction_min_solids; }),
                 num("friction_angle_deg", [](S& s) -> double& { return s.tfm.friction_angle_deg; }),
                 num("friction_delta", [](S& s) -> double& { return s.tfm.friction_delta; }),
+                num("friction_max_viscosity_pa_s",
+                    [](S& s) -> double& { return s.tfm.friction_max_viscosity_pa_s; }),
                 num("theta_initial_m2_s2",
                     [](S& s) -> double& { return s.tfm.theta_initial_m2_s2; }),
                 num("residual_solids", [](S& s) -> double& { return s.tfm.residual_solids; }),
                 num("cfl", [](S& s) -> double& { return s.tfm.cfl; }),
-                num("dt_max_s", [](S& s) -> double& { return s.tfm.dt_max_s; })}},
+                num("dt_max_s", [](S& s) -> double& { return s.tfm.dt_max_s; }),
+                {"solids_walls",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.tfm.solids_walls = as_text(n, f, at);
+                 }},
+                {"fraction_scheme",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.tfm.fraction_scheme = as_text(n, f, at);
+                 }},
+                {"granular_temperature",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.tfm.granular_temperature = as_text(n, f, at);
+                 }}}},
               {"drag",
                {{"laws",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
@@ -286,6 +300,18 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
     return fail(error, "[tfm] friction = '" + s.tfm.friction +
                            "' is not one of none, johnson_jackson_schaeffer");
   }
+  if (s.tfm.solids_walls != "free_slip" && s.tfm.solids_walls != "no_slip") {
+    return fail(error, "[tfm] solids_walls = '" + s.tfm.solids_walls +
+                           "' is not one of free_slip, no_slip");
+  }
+  if (s.tfm.fraction_scheme != "upwind" && s.tfm.fraction_scheme != "van_leer") {
+    return fail(error, "[tfm] fraction_scheme = '" + s.tfm.fraction_scheme +
+                           "' is not one of upwind, van_leer");
+  }
+  if (s.tfm.granular_temperature != "transport" && s.tfm.granular_temperature != "algebraic") {
+    return fail(error, "[tfm] granular_temperature = '" + s.tfm.granular_temperature +
+                           "' is not one of transport, algebraic");
+  }
   if (s.tfm.restitution != -1.0 &&
       !in_range(s.tfm.restitution, 0.0, 1.0, true, false, "[tfm] restitution", "", error)) {
     return false;
@@ -295,6 +321,7 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
   k.friction_min_solids = s.tfm.friction_min_solids;
   k.friction_angle_deg = s.tfm.friction_angle_deg;
   k.friction_delta = s.tfm.friction_delta;
+  k.friction_max_viscosity_pa_s = s.tfm.friction_max_viscosity_pa_s;
   if (!(s.tfm.packing_limit > 1.0 - s.eps_mf)) {
     return fail(error, "[tfm] packing_limit = " + fmt(s.tfm.packing_limit) +
                            " must exceed the bed's solids fraction at minimum fluidization 1 - "

@@ -178,5 +178,41 @@ KtgfCoefficients KtgfClosures::Evaluate(double phi, double theta, double div_v,
   return c;
 }
 
+double KtgfClosures::EquilibriumTheta(double phi, double div_v, double dev2,
+                                      double drag_sink_kg_m3_s) const {
+  if (!(std::isfinite(phi) && std::isfinite(div_v) && std::isfinite(dev2) && dev2 >= 0.0 &&
+        std::isfinite(drag_sink_kg_m3_s) && drag_sink_kg_m3_s >= 0.0))
+    throw Error(ErrorCode::kInvalidArgument,
+                "KtgfClosures::EquilibriumTheta: phi, div_v, dev2 >= 0 and drag_sink >= 0 must "
+                "be finite (phi = " +
+                    fmt(phi) + ", div_v = " + fmt(div_v) + ", dev2 = " + fmt(dev2) +
+                    ", drag_sink = " + fmt(drag_sink_kg_m3_s) + ")");
+  if (phi <= 0.0) return 0.0;
+  // Coefficients per sqrt(theta) (their values at theta = 1) and the theta-independent part of
+  // the dissipation coefficient (Nieuwland's -div v term).
+  const KtgfCoefficients one = Evaluate(phi, 1.0, div_v, 1.0);
+  const KtgfCoefficients zero = Evaluate(phi, 0.0, div_v, 1.0);
+  const double mu_kinetic = one.shear_viscosity_pa_s - one.frictional_viscosity_pa_s;
+  const double source = 2.0 * mu_kinetic * dev2 + one.bulk_viscosity_pa_s * div_v * div_v;
+  const double a = one.dissipation_rate_coefficient - zero.dissipation_rate_coefficient;
+  // Expansion work cools; compression heating is left out (see the header).
+  const double b = one.kinetic_pressure_per_theta * std::max(div_v, 0.0) +
+                   zero.dissipation_rate_coefficient + drag_sink_kg_m3_s;
+  // a x^2 + b x - source = 0 for x = sqrt(theta) >= 0; the form without cancellation.
+  const double disc = b * b + 4.0 * a * source;
+  double x = 0.0;
+  if (b > 0.0) {
+    x = 2.0 * source / (b + std::sqrt(disc));
+  } else if (a > 0.0) {
+    x = (-b + std::sqrt(disc)) / (2.0 * a);
+  } else if (source > 0.0 || b < 0.0) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "no local equilibrium of the granular temperature at phi = " + fmt(phi) +
+                    ": nothing dissipates (restitution = 1, no drag sink) what the shear or "
+                    "compression produces; remedy: restitution < 1 or the transported theta");
+  }
+  return x * x;
+}
+
 }  // namespace consumers
 }  // namespace draglab

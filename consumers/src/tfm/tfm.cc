@@ -110,6 +110,10 @@ bool TfmOptions::IsValid(std::string* error) const {
                 "[time] gas_dt_s = " + fmt(fixed_dt_s) +
                     " s (the two-fluid model's fixed step) is outside [0, [tfm] dt_max_s = " +
                     fmt(dt_max_s) + " s]");
+  if (!(std::isfinite(algebraic_theta_min_solids) && algebraic_theta_min_solids >= 0.0 &&
+        algebraic_theta_min_solids < ktgf.packing_limit))
+    return fail(error, "tfm: algebraic_theta_min_solids = " + fmt(algebraic_theta_min_solids) +
+                           " is outside [0, packing_limit = " + fmt(ktgf.packing_limit) + ")");
   if (!(initial_solids <= ktgf.packing_limit * (1.0 - 1e-2)))
     return fail(error, "[tfm] the bed's solids fraction " + fmt(initial_solids) +
                            " is within 1 % of packing_limit = " + fmt(ktgf.packing_limit) +
@@ -262,25 +266,37 @@ double TfmSimulation::PressureDrop(double z_low, double z_high) const {
 namespace {
 
 /// Strain of the solids velocity at cell (i, j): normal rates, the cell-averaged shear rate
-/// S_xz = (du/dz + dw/dx)/2 from the corners (zero on the free-slip walls), divergence, the
-/// deviatoric D':D' and sqrt(I_2D).
+/// S_xz = (du/dz + dw/dx)/2 from the corners, divergence, the deviatoric D':D' and
+/// sqrt(I_2D). On a free-slip wall the corner shear is zero; on a no-slip wall the tangential
+/// velocity vanishes half a cell from the adjacent face centre (ghost = -inner value).
 struct Strain {
   double div = 0.0, dev2 = 0.0, shear_rate = 0.0;
 };
 
-double CornerShear(const Array& us, const Array& ws, int i, int j, double dx, double dz) {
+double CornerShear(const Array& us, const Array& ws, int i, int j, double dx, double dz,
+                   WallSlip walls) {
   const int nx = static_cast<int>(ws.rows()), nz = static_cast<int>(us.cols());
-  if (i <= 0 || i >= nx || j <= 0 || j >= nz) return 0.0;  // free slip: no wall shear
+  const bool side = i <= 0 || i >= nx, floor_or_top = j <= 0 || j >= nz;
+  if (side && floor_or_top) return 0.0;  // a domain corner: both velocities vanish
+  if (side || floor_or_top) {
+    if (walls == WallSlip::kFreeSlip) return 0.0;
+    if (i <= 0) return ws(0, j) / dx;  // 0.5 * (w - (-w)) / dx
+    if (i >= nx) return -ws(nx - 1, j) / dx;
+    if (j <= 0) return us(i, 0) / dz;
+    return -us(i, nz - 1) / dz;
+  }
   return 0.5 * ((us(i, j) - us(i, j - 1)) / dz + (ws(i, j) - ws(i - 1, j)) / dx);
 }
 
-Strain StrainAt(const Array& us, const Array& ws, int i, int j, double dx, double dz) {
+Strain StrainAt(const Array& us, const Array& ws, int i, int j, double dx, double dz,
+                WallSlip walls) {
   Strain s;
   const double uxx = (us(i + 1, j) - us(i, j)) / dx;
   const double wzz = (ws(i, j + 1) - ws(i, j)) / dz;
-  const double sxz =
-      0.25 * (CornerShear(us, ws, i, j, dx, dz) + CornerShear(us, ws, i + 1, j, dx, dz) +
-              CornerShear(us, ws, i, j + 1, dx, dz) + CornerShear(us, ws, i + 1, j + 1, dx, dz));
+  const double sxz = 0.25 * (CornerShear(us, ws, i, j, dx, dz, walls) +
+                             CornerShear(us, ws, i + 1, j, dx, dz, walls) +
+                             CornerShear(us, ws, i, j + 1, dx, dz, walls) +
+                             CornerShear(us, ws, i + 1, j + 1, dx, dz, walls));
   s.div = uxx + wzz;
   const double third = s.div / 3.0;
   // 3-D deviator of a plane strain (D_yy = 0).
@@ -300,7 +316,7 @@ CellClosures TfmSimulation::Impl::Closures(const TfmOptions& o) const {
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
       if (phi(i, j) < o.residual_solids) continue;  // no solids stress in empty cells
-      const Strain st = StrainAt(us, ws, i, j, dx, dz);
+      const Strain st = StrainAt(us, ws, i, j, dx, dz, o.solids_walls);
       const KtgfCoefficients k = ktgf->Evaluate(phi(i, j), theta(i, j), st.div, st.shear_rate);
       c.pressure(i, j) = k.pressure_pa;
       c.pressure_derivative(i, j) = k.pressure_derivative_pa;
@@ -438,12 +454,21 @@ double TfmSimulation::StepCapped(double dt_cap) {
       sxx(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * uxx + bulk;
       szz(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * wzz + bulk;
     }
-  Array sxz = Array::Zero(nx + 1, nz + 1);  // corners; zero on the free-slip walls
-  for (int j = 1; j < nz; ++j)
-    for (int i = 1; i < nx; ++i) {
-      const double mu_corner =
-          0.25 * (c.mu(i - 1, j - 1) + c.mu(i, j - 1) + c.mu(i - 1, j) + c.mu(i, j));
-      sxz(i, j) = 2.0 * mu_corner * CornerShear(m.us, m.ws, i, j, dx, dz);
+  // Corners: the viscosity averages the cells around the corner (two on a wall).
+  Array sxz = Array::Zero(nx + 1, nz + 1);
+  for (int j = 0; j <= nz; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      const double shear = CornerShear(m.us, m.ws, i, j, dx, dz, o.solids_walls);
+      if (shear == 0.0) continue;
+      double mu_sum = 0.0;
+      int cells = 0;
+      for (int b = j - 1; b <= j; ++b)
+        for (int a = i - 1; a <= i; ++a)
+          if (a >= 0 && a < nx && b >= 0 && b < nz) {
+            mu_sum += c.mu(a, b);
+            ++cells;
+          }
+      sxz(i, j) = 2.0 * mu_sum / cells * shear;
     }
 
   // ---- ghost values of the tangential velocities ----
@@ -459,8 +484,17 @@ double TfmSimulation::StepCapped(double dt_cap) {
     if (i >= nx) return noslip ? -m.wg(nx - 1, j) : m.wg(nx - 1, j);
     return m.wg(i, j);
   };
-  auto us_at = [&](int i, int j) { return m.us(i, std::clamp(j, 0, nz - 1)); };  // free slip
-  auto ws_at = [&](int i, int j) { return m.ws(std::clamp(i, 0, nx - 1), j); };
+  const bool solids_noslip = o.solids_walls == WallSlip::kNoSlip;
+  auto us_at = [&](int i, int j) {
+    if (j < 0) return solids_noslip ? -m.us(i, 0) : m.us(i, 0);
+    if (j >= nz) return solids_noslip ? -m.us(i, nz - 1) : m.us(i, nz - 1);
+    return m.us(i, j);
+  };
+  auto ws_at = [&](int i, int j) {
+    if (i < 0) return solids_noslip ? -m.ws(0, j) : m.ws(0, j);
+    if (i >= nx) return solids_noslip ? -m.ws(nx - 1, j) : m.ws(nx - 1, j);
+    return m.ws(i, j);
+  };
   auto upwind = [](double speed, double centre, double behind, double ahead, double h) {
     return speed > 0.0 ? (centre - behind) / h : (ahead - centre) / h;
   };
@@ -492,9 +526,21 @@ double TfmSimulation::StepCapped(double dt_cap) {
   // The volume fluxes carry the donor cell's fractions (upwind by the predicted solids velocity),
   // in the pressure equation as in the transport: at the bed surface, particles that would fall
   // out of an empty cell carry no volume, so the gas is not asked to take their place.
-  auto donor = [](double v, double lower, double upper, double central) {
-    return v > 0.0 ? lower : v < 0.0 ? upper : central;
+  // With the van Leer scheme the donor value is corrected towards the acceptor by the harmonic
+  // mean of the two one-sided differences (zero at an extremum), which keeps the face value
+  // between the donor's and the acceptor's (TVD); a missing cell behind the donor (a wall) makes
+  // it upwind there.
+  const bool van_leer = o.fraction_scheme == FractionScheme::kVanLeer;
+  auto donor = [van_leer](double v, double behind_lower, double lower, double upper,
+                          double behind_upper, double central) {
+    if (v == 0.0) return central;
+    const double d = v > 0.0 ? lower : upper, a = v > 0.0 ? upper : lower;
+    const double behind = v > 0.0 ? behind_lower : behind_upper;
+    if (!van_leer || std::isnan(behind)) return d;
+    const double back = d - behind, ahead = a - d;
+    return back * ahead > 0.0 ? d + back * ahead / (back + ahead) : d;
   };
+  const double none = std::numeric_limits<double>::quiet_NaN();
 
   // Constraints on a face's solids (after the elimination, so the projection sees them):
   //  - between two empty cells there are no solids: they move with the gas, so the neighbours
@@ -564,7 +610,8 @@ double TfmSimulation::StepCapped(double dt_cap) {
       Face& f = fx_at(i, j);
       f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
       const double old_gradient = (m.p(i, j) - m.p(i - 1, j)) / dx;
-      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, phi(i - 1, j), phi(i, j), pf);
+      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, i >= 2 ? phi(i - 2, j) : none,
+                         phi(i - 1, j), phi(i, j), i + 1 < nx ? phi(i + 1, j) : none, pf);
       constrain(f, phi(i - 1, j), phi(i, j), a_g, bf, rhs_g, old_gradient);
     }
 
@@ -614,7 +661,8 @@ double TfmSimulation::StepCapped(double dt_cap) {
       Face& f = fz_at(i, j);
       f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
       const double old_gradient = (m.p(i, j) - m.p(i, j - 1)) / dz;
-      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, phi(i, j - 1), phi(i, j), pf);
+      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, j >= 2 ? phi(i, j - 2) : none,
+                         phi(i, j - 1), phi(i, j), j + 1 < nz ? phi(i, j + 1) : none, pf);
       constrain(f, phi(i, j - 1), phi(i, j), a_g, bf, rhs_g, old_gradient);
     }
 
@@ -770,86 +818,111 @@ double TfmSimulation::StepCapped(double dt_cap) {
       m.wg(i, j) = (mix_z(i, j) / dx - up * m.ws(i, j)) / (1.0 - up);
     }
 
-  // ---- granular temperature (Eq. 15): transport and production explicit; conduction and
-  // the sinks (dissipation, drag, expansion) implicit, an M-matrix, so theta >= 0 for any step.
-  // Cells below residual_solids hold theta = 0 and no conduction reaches them. ----
-  Array kappa_x = Array::Zero(nx + 1, nz), kappa_z = Array::Zero(nx, nz + 1);
-  auto active = [&](int i, int j) { return phi_new(i, j) >= phi_res && phi(i, j) >= phi_res; };
-  // Harmonic face mean: a dilute cell next to a dense one exchanges at its own, small rate.
-  auto harmonic = [](double a, double b) { return a + b > 0.0 ? 2.0 * a * b / (a + b) : 0.0; };
-  for (int j = 0; j < nz; ++j)
-    for (int i = 1; i < nx; ++i)
-      if (active(i - 1, j) && active(i, j))
-        kappa_x(i, j) = harmonic(c.kappa(i - 1, j), c.kappa(i, j));
-  for (int j = 1; j < nz; ++j)
-    for (int i = 0; i < nx; ++i)
-      if (active(i, j - 1) && active(i, j))
-        kappa_z(i, j) = harmonic(c.kappa(i, j - 1), c.kappa(i, j));
-  const Array& th = m.theta;
-  auto theta_c = [&](int i, int j) {
-    return th(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1));
-  };
-  const int cells = nx * nz;
-  auto id = [nx](int i, int j) { return i + nx * j; };
-  Eigen::VectorXd energy_rhs = Eigen::VectorXd::Zero(cells);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(5 * cells));
-  for (int j = 0; j < nz; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int k = id(i, j);
-      // Every coupling is entered (zero where inactive) so the pattern never changes.
-      const double gx_e = i + 1 < nx ? kappa_x(i + 1, j) / (dx * dx) : 0.0;
-      const double gx_w = i > 0 ? kappa_x(i, j) / (dx * dx) : 0.0;
-      const double gz_n = j + 1 < nz ? kappa_z(i, j + 1) / (dz * dz) : 0.0;
-      const double gz_s = j > 0 ? kappa_z(i, j) / (dz * dz) : 0.0;
-      if (i + 1 < nx) triplets.emplace_back(k, id(i + 1, j), -gx_e);
-      if (i > 0) triplets.emplace_back(k, id(i - 1, j), -gx_w);
-      if (j + 1 < nz) triplets.emplace_back(k, id(i, j + 1), -gz_n);
-      if (j > 0) triplets.emplace_back(k, id(i, j - 1), -gz_s);
-      if (phi_new(i, j) < phi_res) {
-        triplets.emplace_back(k, k, 1.0);  // theta = 0
-        continue;
+  // ---- granular temperature ----
+  auto transported_theta = [&]() -> Array {
+    // ---- granular temperature (Eq. 15): transport and production explicit; conduction and
+    // the sinks (dissipation, drag, expansion) implicit, an M-matrix, so theta >= 0 for any step.
+    // Cells below residual_solids hold theta = 0 and no conduction reaches them. ----
+    Array kappa_x = Array::Zero(nx + 1, nz), kappa_z = Array::Zero(nx, nz + 1);
+    auto active = [&](int i, int j) { return phi_new(i, j) >= phi_res && phi(i, j) >= phi_res; };
+    // Harmonic face mean: a dilute cell next to a dense one exchanges at its own, small rate.
+    auto harmonic = [](double a, double b) { return a + b > 0.0 ? 2.0 * a * b / (a + b) : 0.0; };
+    for (int j = 0; j < nz; ++j)
+      for (int i = 1; i < nx; ++i)
+        if (active(i - 1, j) && active(i, j))
+          kappa_x(i, j) = harmonic(c.kappa(i - 1, j), c.kappa(i, j));
+    for (int j = 1; j < nz; ++j)
+      for (int i = 0; i < nx; ++i)
+        if (active(i, j - 1) && active(i, j))
+          kappa_z(i, j) = harmonic(c.kappa(i, j - 1), c.kappa(i, j));
+    const Array& th = m.theta;
+    auto theta_c = [&](int i, int j) {
+      return th(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1));
+    };
+    const int cells = nx * nz;
+    auto id = [nx](int i, int j) { return i + nx * j; };
+    Eigen::VectorXd energy_rhs = Eigen::VectorXd::Zero(cells);
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(static_cast<std::size_t>(5 * cells));
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const int k = id(i, j);
+        // Every coupling is entered (zero where inactive) so the pattern never changes.
+        const double gx_e = i + 1 < nx ? kappa_x(i + 1, j) / (dx * dx) : 0.0;
+        const double gx_w = i > 0 ? kappa_x(i, j) / (dx * dx) : 0.0;
+        const double gz_n = j + 1 < nz ? kappa_z(i, j + 1) / (dz * dz) : 0.0;
+        const double gz_s = j > 0 ? kappa_z(i, j) / (dz * dz) : 0.0;
+        if (i + 1 < nx) triplets.emplace_back(k, id(i + 1, j), -gx_e);
+        if (i > 0) triplets.emplace_back(k, id(i - 1, j), -gx_w);
+        if (j + 1 < nz) triplets.emplace_back(k, id(i, j + 1), -gz_n);
+        if (j > 0) triplets.emplace_back(k, id(i, j - 1), -gz_s);
+        if (phi_new(i, j) < phi_res) {
+          triplets.emplace_back(k, k, 1.0);  // theta = 0
+          continue;
+        }
+        // Upwind transport of phi theta with the final solids fluxes (out: own theta, in: the
+        // donor's).
+        auto carried = [&](double flux_out, int ni, int nj) {
+          return flux_out * (flux_out > 0.0 ? th(i, j) : theta_c(ni, nj));
+        };
+        const double adv = carried(fs_x(i + 1, j), i + 1, j) + carried(-fs_x(i, j), i - 1, j) +
+                           carried(fs_z(i, j + 1), i, j + 1) + carried(-fs_z(i, j), i, j - 1);
+        const Strain st = StrainAt(m.us, m.ws, i, j, dx, dz, o.solids_walls);
+        const double production =
+            2.0 * c.mu_kinetic(i, j) * st.dev2 + c.lambda(i, j) * st.div * st.div;
+        const double expansion = c.kinetic_pressure_per_theta(i, j) * st.div;  // P_s div v / theta
+        const double dissipation = c.dissipation(i, j);
+        energy_rhs(k) = 1.5 * rho_s * (phi(i, j) * th(i, j) - dt * adv / volume) / dt + production +
+                        std::max(-expansion, 0.0) * th(i, j) +
+                        std::max(-dissipation, 0.0) * th(i, j);
+        const double diagonal = 1.5 * rho_s * phi_new(i, j) / dt + std::max(dissipation, 0.0) +
+                                std::max(expansion, 0.0) +
+                                (o.interphase_drag ? 3.0 * m.beta(i, j) : 0.0);
+        triplets.emplace_back(k, k, diagonal + gx_e + gx_w + gz_n + gz_s);
       }
-      // Upwind transport of phi theta with the final solids fluxes (out: own theta, in: the
-      // donor's).
-      auto carried = [&](double flux_out, int ni, int nj) {
-        return flux_out * (flux_out > 0.0 ? th(i, j) : theta_c(ni, nj));
-      };
-      const double adv = carried(fs_x(i + 1, j), i + 1, j) + carried(-fs_x(i, j), i - 1, j) +
-                         carried(fs_z(i, j + 1), i, j + 1) + carried(-fs_z(i, j), i, j - 1);
-      const Strain st = StrainAt(m.us, m.ws, i, j, dx, dz);
-      const double production =
-          2.0 * c.mu_kinetic(i, j) * st.dev2 + c.lambda(i, j) * st.div * st.div;
-      const double expansion = c.kinetic_pressure_per_theta(i, j) * st.div;  // P_s div v / theta
-      const double dissipation = c.dissipation(i, j);
-      energy_rhs(k) = 1.5 * rho_s * (phi(i, j) * th(i, j) - dt * adv / volume) / dt + production +
-                      std::max(-expansion, 0.0) * th(i, j) + std::max(-dissipation, 0.0) * th(i, j);
-      const double diagonal = 1.5 * rho_s * phi_new(i, j) / dt + std::max(dissipation, 0.0) +
-                              std::max(expansion, 0.0) +
-                              (o.interphase_drag ? 3.0 * m.beta(i, j) : 0.0);
-      triplets.emplace_back(k, k, diagonal + gx_e + gx_w + gz_n + gz_s);
+    Eigen::SparseMatrix<double> energy(cells, cells);
+    energy.setFromTriplets(triplets.begin(), triplets.end());
+    if (!m.energy_ordered) {
+      m.energy_solver.analyzePattern(energy);
+      m.energy_ordered = true;
     }
-  Eigen::SparseMatrix<double> energy(cells, cells);
-  energy.setFromTriplets(triplets.begin(), triplets.end());
-  if (!m.energy_ordered) {
-    m.energy_solver.analyzePattern(energy);
-    m.energy_ordered = true;
-  }
-  m.energy_solver.factorize(energy);
-  if (m.energy_solver.info() != Eigen::Success)
-    Bad(at + "the granular temperature equation could not be factorised; remedy: lower cfl");
-  const Eigen::VectorXd theta_vector = m.energy_solver.solve(energy_rhs);
-  Array theta_new = Eigen::Map<const Array>(theta_vector.data(), nx, nz);
-  const double theta_min = theta_new.minCoeff();
-  if (!theta_new.allFinite()) Bad(at + "non-finite granular temperature; remedy: lower cfl");
-  if (theta_min < -1e-9 * std::max(theta_new.maxCoeff(), 1e-12)) {
-    // The explicit parts are non-negative under the CFL limit; a negative value means the
-    // transport outran it.
-    Bad(at + "the granular temperature became negative (" + fmt(theta_min) +
-        " m^2/s^2) with a step of " + fmt(dt) + " s (limit: " + to_string(why) +
-        "); remedy: lower cfl");
-  }
-  theta_new = theta_new.max(0.0);
+    m.energy_solver.factorize(energy);
+    if (m.energy_solver.info() != Eigen::Success)
+      Bad(at + "the granular temperature equation could not be factorised; remedy: lower cfl");
+    const Eigen::VectorXd theta_vector = m.energy_solver.solve(energy_rhs);
+    Array theta_new = Eigen::Map<const Array>(theta_vector.data(), nx, nz);
+    const double theta_min = theta_new.minCoeff();
+    if (!theta_new.allFinite()) Bad(at + "non-finite granular temperature; remedy: lower cfl");
+    if (theta_min < -1e-9 * std::max(theta_new.maxCoeff(), 1e-12)) {
+      // The explicit parts are non-negative under the CFL limit; a negative value means the
+      // transport outran it.
+      Bad(at + "the granular temperature became negative (" + fmt(theta_min) +
+          " m^2/s^2) with a step of " + fmt(dt) + " s (limit: " + to_string(why) +
+          "); remedy: lower cfl");
+    }
+    return theta_new.max(0.0);
+  };
+  // Local equilibrium (the algebraic option): from the new velocities, nothing transported;
+  // theta = 0 below algebraic_theta_min_solids (TfmOptions says why).
+  auto equilibrium_theta = [&]() -> Array {
+    Array theta = Array::Zero(nx, nz);
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        if (phi_new(i, j) < std::max(phi_res, o.algebraic_theta_min_solids)) continue;
+        const Strain st = StrainAt(m.us, m.ws, i, j, dx, dz, o.solids_walls);
+        try {
+          theta(i, j) = m.ktgf->EquilibriumTheta(phi_new(i, j), st.div, st.dev2,
+                                                 o.interphase_drag ? 3.0 * m.beta(i, j) : 0.0);
+        } catch (const Error& e) {
+          throw Error(e.code(), at + "cell (" + std::to_string(i) + ", " + std::to_string(j) +
+                                    "): " + e.what());
+        }
+      }
+    return theta;
+  };
+  const Array theta_new = o.granular_temperature == GranularTemperature::kAlgebraic
+                              ? equilibrium_theta()
+                              : transported_theta();
 
   // ---- diagnostics ----
   double gas_in = 0.0, gas_out = 0.0;

@@ -109,6 +109,20 @@ class KtgfClosures {
   /// shear_rate = sqrt(I_2D) [1/s] for the Schaeffer viscosity.
   KtgfCoefficients Evaluate(double phi, double theta, double div_v, double shear_rate) const;
 
+  /// Granular temperature in local equilibrium, the algebraic alternative to transporting it
+  /// (Eq. 15 without its convection and conduction): production by the kinetic-collisional
+  /// shear and bulk viscosities equals expansion work, collisional dissipation and the drag
+  /// sink, 2 mu_k D':D' + lambda (div v)^2 = P_s max(div v, 0) + gamma + drag_sink theta.
+  /// Compression heating (div v < 0) is left to the transported theta: in equilibrium it would
+  /// heat a compressing dense cell at once to (P_s/theta |div v| / dissipation)^2, a pressure
+  /// the explicit solids stress cannot follow (the step collapses), whereas transported it grows
+  /// only over the compression's duration. Every kinetic coefficient is sqrt(theta) times a
+  /// function of phi, so this is a quadratic in sqrt(theta) with one non-negative root. dev2 =
+  /// D':D' [1/s^2], div_v [1/s], drag_sink_kg_m3_s = 3 beta (0 without gas). Frictional stresses
+  /// produce no fluctuations (they are not in the balance). Throws Error(kInvalidArgument) where
+  /// nothing bounds theta (e = 1 and no drag sink, sheared).
+  double EquilibriumTheta(double phi, double div_v, double dev2, double drag_sink_kg_m3_s) const;
+
   const KtgfOptions& options() const { return opt_; }
 
  private:

@@ -128,13 +128,17 @@ struct SceneTfm {
   double restitution = -1.0;    ///< Particle-particle e, (0, 1]; -1: [particles] restitution.
   double packing_limit = 0.64;  ///< phi_max, (1 - eps_mf, 0.74].
   std::string friction = "johnson_jackson_schaeffer";  ///< Or "none".
-  double friction_min_solids = 0.5;   ///< Johnson-Jackson phi_min, (0, packing_limit).
-  double friction_angle_deg = 28.5;   ///< (0, 90).
-  double friction_delta = 0.02;       ///< Johnson-Jackson delta (the gap clip), (0, 0.1].
-  double theta_initial_m2_s2 = 1e-4;  ///< Initial granular temperature of the bed, >= 0.
-  double residual_solids = 1e-4;      ///< (0, 1e-2].
-  double cfl = 0.3;                   ///< (0, 0.5].
-  double dt_max_s = 5e-4;             ///< (0, 0.1].
+  double friction_min_solids = 0.5;           ///< Johnson-Jackson phi_min, (0, packing_limit).
+  double friction_angle_deg = 28.5;           ///< (0, 90).
+  double friction_delta = 0.02;               ///< Johnson-Jackson delta (the gap clip), (0, 0.1].
+  double friction_max_viscosity_pa_s = 10.0;  ///< Cap of the Schaeffer viscosity, (0, 1e4].
+  double theta_initial_m2_s2 = 1e-4;          ///< Initial granular temperature of the bed, >= 0.
+  double residual_solids = 1e-4;              ///< (0, 1e-2].
+  double cfl = 0.3;                           ///< (0, 0.5].
+  double dt_max_s = 5e-4;                     ///< (0, 0.1].
+  std::string solids_walls = "free_slip";     ///< Or "no_slip": the solids' wall condition.
+  std::string fraction_scheme = "upwind";     ///< Or "van_leer": face solids fractions.
+  std::string granular_temperature = "transport";  ///< Or "algebraic" (local equilibrium).
 };
 
 /// A scene file, parsed. Built by parse_scene / load_scene; IsValid checks every range.

@@ -43,6 +43,15 @@
 namespace draglab {
 namespace consumers {
 
+/// How a face's solids fraction is taken from its cells: the donor cell's (first-order upwind)
+/// or van Leer's TVD reconstruction (second order where the fraction is smooth, upwind at
+/// extrema and walls).
+enum class FractionScheme { kUpwind, kVanLeer };
+
+/// How the granular temperature is found: transported (Eq. 15 with convection and conduction)
+/// or in local equilibrium each step (KtgfClosures::EquilibriumTheta; cheaper, no memory).
+enum class GranularTemperature { kTransport, kAlgebraic };
+
 /// Everything a TFM run needs besides the law. The gas member holds the grid, the gas, gravity
 /// (gravity_z < 0 points down) and the inflow (background, jet, ramp).
 struct TfmOptions {
@@ -63,6 +72,17 @@ struct TfmOptions {
   double fixed_dt_s = 0.0;      ///< [0, dt_max_s].
   bool freeze_solids = false;   ///< Solids held at rest (fixed bed): validation.
   bool interphase_drag = true;  ///< false: beta = 0 (granular-gas validations).
+  /// Tangential solids velocity at the walls and the bottom plate: free slip (no wall shear)
+  /// or no slip (v = 0 on the wall, the wall shear from the solids viscosity).
+  WallSlip solids_walls = WallSlip::kFreeSlip;
+  FractionScheme fraction_scheme = FractionScheme::kUpwind;
+  GranularTemperature granular_temperature = GranularTemperature::kTransport;
+  /// With the algebraic theta: cells below this solids fraction get theta = 0. Local
+  /// equilibrium needs collisions to relax theta faster than the flow changes it; in a dilute
+  /// cell (dissipation ~ phi^2) the equilibrium under the shear of the gas-borne particles is
+  /// unbounded (10^4-10^5 m^2/s^2 at phi ~ 1e-4), where transported it never builds up.
+  /// [0, packing_limit).
+  double algebraic_theta_min_solids = 0.05;
 
   bool IsValid(std::string* error) const;
 };
