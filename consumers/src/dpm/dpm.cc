@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "draglab/drag_db/error.h"
+#include "gas/particle_kernel.h"
 
 namespace draglab {
 namespace consumers {
@@ -31,29 +32,10 @@ std::string Num(double x) {
   return s.str();
 }
 
-/// Bilinear tent kernel on cell centres: the two cells (per axis) around the point and their
-/// weights; weight that would fall outside the grid is folded into the boundary cell, so the
-/// mapped solids volume is exactly the particles' volume and eps stays continuous as particles
-/// cross cell faces.
-struct Tent {
-  int i[2], j[2];
-  double wx[2], wz[2];
-};
-Tent TentAt(double x, double z, double dx, double dz, int nx, int nz) {
-  Tent t;
-  const double sx = x / dx - 0.5, sz = z / dz - 0.5;
-  const double fx = std::floor(sx), fz = std::floor(sz);
-  const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fz);
-  t.wx[1] = sx - fx;
-  t.wx[0] = 1.0 - t.wx[1];
-  t.wz[1] = sz - fz;
-  t.wz[0] = 1.0 - t.wz[1];
-  t.i[0] = std::clamp(i0, 0, nx - 1);
-  t.i[1] = std::clamp(i0 + 1, 0, nx - 1);
-  t.j[0] = std::clamp(j0, 0, nz - 1);
-  t.j[1] = std::clamp(j0 + 1, 0, nz - 1);
-  return t;
-}
+using internal::Deposit;
+using internal::Interpolate;
+using internal::Tent;
+using internal::TentAt;
 
 }  // namespace
 
@@ -262,11 +244,8 @@ void DpmSimulation::Start(Particles settled) {
     const double dx = impl_->gas->dx(), dz = impl_->gas->dz();
     const double vcell = dx * dz * s.geometry.depth_m;
     Eigen::ArrayXXd solid = Eigen::ArrayXXd::Zero(nx, nz);
-    for (std::size_t n = 0; n < p.size(); ++n) {
-      const Tent t = TentAt(p.x[n], p.y[n], dx, dz, nx, nz);
-      for (int a = 0; a < 2; ++a)
-        for (int b = 0; b < 2; ++b) solid(t.i[a], t.j[b]) += p.volume(n) * t.wx[a] * t.wz[b];
-    }
+    for (std::size_t n = 0; n < p.size(); ++n)
+      Deposit(solid, TentAt(p.x[n], p.y[n], dx, dz, nx, nz), p.volume(n));
     impl_->eps = (1.0 - solid / vcell).max(opt_.min_void_fraction);
     impl_->gas->SetVoidFraction(impl_->eps);
   }
@@ -326,9 +305,7 @@ const DpmStepDiagnostics& DpmSimulation::Step() {
   Eigen::ArrayXXd solid = Eigen::ArrayXXd::Zero(nx, nz);
   for (std::size_t n = 0; n < np; ++n) {
     tents[n] = TentAt(p.x[n], p.y[n], dx, dz, nx, nz);
-    const Tent& t = tents[n];
-    for (int a = 0; a < 2; ++a)
-      for (int b = 0; b < 2; ++b) solid(t.i[a], t.j[b]) += p.volume(n) * t.wx[a] * t.wz[b];
+    Deposit(solid, tents[n], p.volume(n));
   }
   Eigen::ArrayXXd eps_next = 1.0 - solid / vcell;
   diag.min_void_fraction = eps_next.minCoeff();
@@ -345,17 +322,11 @@ const DpmStepDiagnostics& DpmSimulation::Step() {
 
   // 2. Per particle: eps and gas velocity at the centre (transpose of the mapping), beta, c_p.
   m.c.assign(np, 0.0);
-  auto interp = [&](const Eigen::ArrayXXd& f, const Tent& t) {
-    double v = 0.0;
-    for (int a = 0; a < 2; ++a)
-      for (int b = 0; b < 2; ++b) v += f(t.i[a], t.j[b]) * t.wx[a] * t.wz[b];
-    return v;
-  };
   Eigen::ArrayXXd csum = Eigen::ArrayXXd::Zero(nx, nz), cux = csum, cuz = csum;
   for (std::size_t n = 0; n < np; ++n) {
     const Tent& t = tents[n];
-    const double eps_p = std::min(1.0, interp(eps_next, t));
-    const double sx = interp(ugx, t) - p.vx[n], sz = interp(ugz, t) - p.vy[n];
+    const double eps_p = std::min(1.0, Interpolate(eps_next, t));
+    const double sx = Interpolate(ugx, t) - p.vx[n], sz = Interpolate(ugz, t) - p.vy[n];
     const double slip = std::hypot(sx, sz);
     // dga = beta / phi: c_p = beta V_p / (1 - eps) without the 0/0 at eps = 1.
     m.c[n] = law_->dga(eps_p, mu, rho_g, slip, p.diameter[n]) * p.volume(n);
@@ -385,8 +356,8 @@ const DpmStepDiagnostics& DpmSimulation::Step() {
   // pressure-gradient force; gas-side drag of the cell fields for the action-reaction check.
   for (std::size_t n = 0; n < np; ++n) {
     const Tent& t = tents[n];
-    const double fx = m.c[n] * (interp(ugx, t) - p.vx[n]);
-    const double fz = m.c[n] * (interp(ugz, t) - p.vy[n]);
+    const double fx = m.c[n] * (Interpolate(ugx, t) - p.vx[n]);
+    const double fz = m.c[n] * (Interpolate(ugz, t) - p.vy[n]);
     const Eigen::Vector2d gp = gas.PressureGradientAt(p.x[n], p.y[n]);
     diag.drag_on_particles_x += fx;
     diag.drag_on_particles_z += fz;

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "draglab/drag_db/error.h"
+#include "gas/mac_operators.h"
 
 namespace draglab {
 namespace consumers {
@@ -267,7 +268,6 @@ void GasPhase::Step(double dt) {
   const double t_new = time_ + dt;
   auto wrap = [&](int j) { return periodic ? (j + nz) % nz : std::clamp(j, 0, nz - 1); };
   auto eps_new = [&](int i, int j) { return eps_next_(std::clamp(i, 0, nx - 1), wrap(j)); };
-  auto eps_old = [&](int i, int j) { return eps_(std::clamp(i, 0, nx - 1), wrap(j)); };
 
   // ---- momentum predictor: u_hat = rhs / a, with u^{n+1} = u_hat - (dt eps / a) dp/dn ----
   // Advective form eps rho (du/dt + u.grad u): equal to the conservative form of Eq. 9 when
@@ -276,43 +276,16 @@ void GasPhase::Step(double dt) {
                   a_u = Eigen::ArrayXXd::Ones(nx + 1, nz);
   Eigen::ArrayXXd w_hat = Eigen::ArrayXXd::Zero(nx, nz + 1),
                   a_w = Eigen::ArrayXXd::Ones(nx, nz + 1);
-  // Tangential u next to the bottom plate: no slip (ghost -u); at the outlet: zero gradient.
-  auto u_at = [&](int i, int j) {
-    if (periodic) return u_(i, (j + nz) % nz);
-    if (j < 0) return -u_(i, 0);
-    if (j >= nz) return u_(i, nz - 1);
-    return u_(i, j);
-  };
-  // Tangential w next to the side walls: ghost -w (no slip) or +w (free slip).
-  auto w_at = [&](int i, int j) {
-    if (periodic) j = (j + nz) % nz;
-    j = std::clamp(j, 0, nz);
-    if (i < 0) return noslip ? -w_(0, j) : w_(0, j);
-    if (i >= nx) return noslip ? -w_(nx - 1, j) : w_(nx - 1, j);
-    return w_(i, j);
-  };
+  const internal::MacGasOperators ops(u_, w_, eps_, dx_, dz_, mu, noslip, periodic);
   for (int j = 0; j < nz; ++j) {
     for (int i = 1; i < nx; ++i) {
       const double ef = 0.5 * (eps_new(i - 1, j) + eps_new(i, j));
       const double bf = 0.5 * (beta_(i - 1, j) + beta_(i, j));
       const double upf = 0.5 * (upx_(i - 1, j) + upx_(i, j));
       const double uc = u_(i, j);
-      const double wc = 0.25 * (w_(i - 1, j) + w_(i, j) + w_(i - 1, j + 1) + w_(i, j + 1));
-      const double dudx = uc > 0 ? (uc - u_(i - 1, j)) / dx_ : (u_(i + 1, j) - uc) / dx_;
-      const double dudz = wc > 0 ? (uc - u_at(i, j - 1)) / dz_ : (u_at(i, j + 1) - uc) / dz_;
-      // div(eps mu grad u) with eps at the cell centres (x) and the corners (z).
-      const double e_e = eps_old(i, j), e_w = eps_old(i - 1, j);
-      const double e_n =
-          0.25 * (eps_old(i - 1, j) + eps_old(i, j) + eps_old(i - 1, j + 1) + eps_old(i, j + 1));
-      const double e_s =
-          0.25 * (eps_old(i - 1, j) + eps_old(i, j) + eps_old(i - 1, j - 1) + eps_old(i, j - 1));
-      const double flux_n = (!periodic && j == nz - 1) ? 0.0 : e_n * (u_at(i, j + 1) - uc) / dz_;
-      const double flux_s = e_s * (uc - u_at(i, j - 1)) / dz_;
-      const double visc =
-          mu * ((e_e * (u_(i + 1, j) - uc) - e_w * (uc - u_(i - 1, j))) / (dx_ * dx_) +
-                (flux_n - flux_s) / dz_);
+      const internal::FaceMomentumTerms terms = ops.XFace(i, j);
       double rhs = ef * rho * uc +
-                   dt * (-ef * rho * (uc * dudx + wc * dudz) + visc + ef * opt_.body_force_x);
+                   dt * (-ef * rho * terms.advection + terms.viscous + ef * opt_.body_force_x);
       double a = ef * rho;
       if (implicit) {
         rhs += dt * bf * upf;
@@ -334,23 +307,8 @@ void GasPhase::Step(double dt) {
       const double bf = top ? beta_(i, nz - 1) : 0.5 * (beta_(i, wrap(j - 1)) + beta_(i, wrap(j)));
       const double upf = top ? upz_(i, nz - 1) : 0.5 * (upz_(i, wrap(j - 1)) + upz_(i, wrap(j)));
       const double wc = w_(i, j);
-      const int jc0 = wrap(j - 1), jc1 = top ? nz - 1 : wrap(j);
-      const double uc = 0.25 * (u_(i, jc0) + u_(i + 1, jc0) + u_(i, jc1) + u_(i + 1, jc1));
-      const double w_below = w_at(i, j - 1);
-      const double w_above = top ? wc : w_at(i, j + 1);
-      const double dwdz = wc > 0 ? (wc - w_below) / dz_ : (w_above - wc) / dz_;
-      const double dwdx = uc > 0 ? (wc - w_at(i - 1, j)) / dx_ : (w_at(i + 1, j) - wc) / dx_;
-      const double e_up = top ? eps_old(i, nz - 1) : eps_old(i, j);
-      const double e_dn = eps_old(i, j - 1);
-      const double e_e = 0.25 * (eps_old(i, j - 1) + eps_old(i + 1, j - 1) + e_up +
-                                 eps_old(i + 1, top ? nz - 1 : j));
-      const double e_w = 0.25 * (eps_old(i, j - 1) + eps_old(i - 1, j - 1) + e_up +
-                                 eps_old(i - 1, top ? nz - 1 : j));
-      // Side walls: the ghost value already encodes no slip (-w) or free slip (+w, zero flux).
-      const double visc =
-          mu * ((e_e * (w_at(i + 1, j) - wc) - e_w * (wc - w_at(i - 1, j))) / (dx_ * dx_) +
-                (e_up * (w_above - wc) - e_dn * (wc - w_below)) / (dz_ * dz_));
-      double rhs = ef * rho * wc + dt * (-ef * rho * (uc * dwdx + wc * dwdz) + visc +
+      const internal::FaceMomentumTerms terms = ops.ZFace(i, j);
+      double rhs = ef * rho * wc + dt * (-ef * rho * terms.advection + terms.viscous +
                                          ef * rho * opt_.gravity_z + ef * opt_.body_force_z);
       double a = ef * rho;
       if (implicit) {

@@ -25,6 +25,7 @@
 
 #include "draglab/consumers/mac_pressure.h"
 #include "draglab/drag_db/error.h"
+#include "gas/mac_operators.h"
 #include "scene/scene_util.h"
 
 namespace draglab {
@@ -471,19 +472,10 @@ double TfmSimulation::StepCapped(double dt_cap) {
       sxz(i, j) = 2.0 * mu_sum / cells * shear;
     }
 
-  // ---- ghost values of the tangential velocities ----
-  auto eg = [&](int i, int j) { return eps(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1)); };
-  auto ug_at = [&](int i, int j) {  // no slip at the bottom plate, zero gradient at the outlet
-    if (j < 0) return -m.ug(i, 0);
-    if (j >= nz) return m.ug(i, nz - 1);
-    return m.ug(i, j);
-  };
-  auto wg_at = [&](int i, int j) {
-    j = std::clamp(j, 0, nz);
-    if (i < 0) return noslip ? -m.wg(0, j) : m.wg(0, j);
-    if (i >= nx) return noslip ? -m.wg(nx - 1, j) : m.wg(nx - 1, j);
-    return m.wg(i, j);
-  };
+  // ---- the gas's advective and viscous terms; ghost values of the solids' tangential
+  // velocities ----
+  const internal::MacGasOperators gas_ops(m.ug, m.wg, eps, dx, dz, mu_g, noslip,
+                                          /*periodic=*/false);
   const bool solids_noslip = o.solids_walls == WallSlip::kNoSlip;
   auto us_at = [&](int i, int j) {
     if (j < 0) return solids_noslip ? -m.us(i, 0) : m.us(i, 0);
@@ -584,21 +576,12 @@ double TfmSimulation::StepCapped(double dt_cap) {
       const double pf = 1.0 - ef;
       const double pm = std::max(pf, phi_res);
       const double bf = ef * 0.5 * (resistance(i - 1, j) + resistance(i, j));
-      // Gas: advective upwind, div(eps mu grad u) (gas_phase.h).
+      // Gas: advective upwind, div(eps mu grad u) (the shared MAC operators).
       const double uc = m.ug(i, j);
-      const double wc = 0.25 * (m.wg(i - 1, j) + m.wg(i, j) + m.wg(i - 1, j + 1) + m.wg(i, j + 1));
-      const double adv_g = uc * upwind(uc, uc, m.ug(i - 1, j), m.ug(i + 1, j), dx) +
-                           wc * upwind(wc, uc, ug_at(i, j - 1), ug_at(i, j + 1), dz);
-      const double e_n = 0.25 * (eg(i - 1, j) + eg(i, j) + eg(i - 1, j + 1) + eg(i, j + 1));
-      const double e_s = 0.25 * (eg(i - 1, j) + eg(i, j) + eg(i - 1, j - 1) + eg(i, j - 1));
-      const double flux_n = j == nz - 1 ? 0.0 : e_n * (ug_at(i, j + 1) - uc) / dz;
-      const double flux_s = e_s * (uc - ug_at(i, j - 1)) / dz;
-      const double visc =
-          mu_g *
-          ((eg(i, j) * (m.ug(i + 1, j) - uc) - eg(i - 1, j) * (uc - m.ug(i - 1, j))) / (dx * dx) +
-           (flux_n - flux_s) / dz);
+      const internal::FaceMomentumTerms gas = gas_ops.XFace(i, j);
       const double a_g = ef * rho_g / dt;
-      const double rhs_g = a_g * uc - ef * rho_g * adv_g + visc + ef * o.gas.body_force_x;
+      const double rhs_g =
+          a_g * uc - ef * rho_g * gas.advection + gas.viscous + ef * o.gas.body_force_x;
       // Solids: advective upwind, the stress divergence.
       const double vc = m.us(i, j);
       const double wsc = 0.25 * (m.ws(i - 1, j) + m.ws(i, j) + m.ws(i - 1, j + 1) + m.ws(i, j + 1));
@@ -626,22 +609,11 @@ double TfmSimulation::StepCapped(double dt_cap) {
       const double pm = std::max(pf, phi_res);
       const double bf =
           top ? m.beta(i, nz - 1) : ef * 0.5 * (resistance(i, j - 1) + resistance(i, j));
-      const int jc1 = top ? nz - 1 : j;
       const double wc = m.wg(i, j);
-      const double uc =
-          0.25 * (m.ug(i, j - 1) + m.ug(i + 1, j - 1) + m.ug(i, jc1) + m.ug(i + 1, jc1));
-      const double w_below = m.wg(i, j - 1), w_above = top ? wc : m.wg(i, j + 1);
-      const double adv_g = wc * upwind(wc, wc, w_below, w_above, dz) +
-                           uc * upwind(uc, wc, wg_at(i - 1, j), wg_at(i + 1, j), dx);
-      const double e_up = eg(i, jc1), e_dn = eg(i, j - 1);
-      const double e_e = 0.25 * (eg(i, j - 1) + eg(i + 1, j - 1) + e_up + eg(i + 1, jc1));
-      const double e_w = 0.25 * (eg(i, j - 1) + eg(i - 1, j - 1) + e_up + eg(i - 1, jc1));
-      const double visc =
-          mu_g * ((e_e * (wg_at(i + 1, j) - wc) - e_w * (wc - wg_at(i - 1, j))) / (dx * dx) +
-                  (e_up * (w_above - wc) - e_dn * (wc - w_below)) / (dz * dz));
+      const internal::FaceMomentumTerms gas = gas_ops.ZFace(i, j);
       const double a_g = ef * rho_g / dt;
-      const double rhs_g =
-          a_g * wc - ef * rho_g * adv_g + visc + ef * rho_g * g_z + ef * o.gas.body_force_z;
+      const double rhs_g = a_g * wc - ef * rho_g * gas.advection + gas.viscous + ef * rho_g * g_z +
+                           ef * o.gas.body_force_z;
       if (top) {  // the outlet: gas only (the solids see a wall)
         Face f;
         f.eps = ef;
