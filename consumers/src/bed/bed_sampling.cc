@@ -2,6 +2,7 @@
 #include "bed/bed_sampling.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 
 namespace draglab {
@@ -51,6 +52,29 @@ GridField2D scene_grid_field(const Scene& scene, const Eigen::ArrayXXd& values) 
   for (int j = 0; j < f.ny; ++j)
     for (int i = 0; i < f.nx; ++i) f.values[static_cast<std::size_t>(j) * f.nx + i] = values(i, j);
   return f;
+}
+
+BedSampler::BedSampler(const Scene& scene, double initial_bed_height_m)
+    : scene_(scene),
+      bubble_(scene_bubble_options(scene, initial_bed_height_m)),
+      t_ref_abs_(scene.jet.start_s + scene.time.t_ref_s),
+      best_gap_(0.5 * scene.bubble.sample_interval_s + 1e-12) {}
+
+BedSampler::Taken BedSampler::Take(double t_abs, const Eigen::ArrayXXd& gas_fraction,
+                                   double pressure_drop_pa) {
+  Taken t;
+  t.bubble = measure_bubble(scene_grid_field(scene_, gas_fraction), bubble_);
+  t.sample.t_s = t_abs - scene_.jet.start_s;
+  t.sample.bubble_diameter_m = t.bubble.found ? t.bubble.diameter_m : 0.0;
+  t.sample.bubble_centroid_m = t.bubble.found ? t.bubble.centroid_y_m : 0.0;
+  t.sample.bed_height_m = t.bubble.bed_height_m;
+  t.sample.pressure_drop_pa = pressure_drop_pa;
+  const double gap = std::abs(t_abs - t_ref_abs_);
+  if (gap < best_gap_) {
+    best_gap_ = gap;
+    t.nearest_to_ref = true;
+  }
+  return t;
 }
 
 }  // namespace internal

@@ -25,6 +25,30 @@ BubbleOptions scene_bubble_options(const Scene& scene, double initial_bed_height
 /// A cell field (nx x nz, Eigen index (i, j)) on the scene's grid as a GridField2D.
 GridField2D scene_grid_field(const Scene& scene, const Eigen::ArrayXXd& values);
 
+/// The bubble sampling every bed model does: at each sample time, the bubble in the gas
+/// fraction (the scene's criterion), the bed height and the pressure drop, and whether the
+/// sample is the nearest to t_ref so far (the one the result reports; a sample counts only
+/// within half a sample interval of t_ref).
+class BedSampler {
+ public:
+  BedSampler(const Scene& scene, double initial_bed_height_m);
+
+  struct Taken {
+    BedSample sample;
+    BubbleMetrics bubble;
+    bool nearest_to_ref = false;
+  };
+  /// A sample at the model's time t_abs [s] (the jet starts at scene.jet.start_s) from its gas
+  /// fraction (nx x nz) and width-averaged pressure drop.
+  Taken Take(double t_abs, const Eigen::ArrayXXd& gas_fraction, double pressure_drop_pa);
+
+ private:
+  const Scene& scene_;
+  BubbleOptions bubble_;
+  double t_ref_abs_;
+  double best_gap_;
+};
+
 }  // namespace internal
 }  // namespace consumers
 }  // namespace draglab

@@ -120,7 +120,7 @@ class TfmBedModel : public BedModel {
     const double duration = options.duration_s > 0.0 ? options.duration_s : scene.time.duration_s;
     const double interval = scene.bubble.sample_interval_s;
     const double t_ref_abs = scene.jet.start_s + scene.time.t_ref_s;
-    const BubbleOptions bubble = internal::scene_bubble_options(scene, scene.bed_height_mf_m());
+    internal::BedSampler sampler(scene, scene.bed_height_mf_m());
     const double dz = tfm.dz();
 
     BedResult out;
@@ -135,7 +135,6 @@ class TfmBedModel : public BedModel {
     m.background_m_s = background;
     m.t_ref_s = scene.time.t_ref_s;
     nlohmann::json series = nlohmann::json::array();
-    double best_gap = 0.5 * interval + 1e-12;
     BedSample at_ref;
     bool have_ref = false;
     BubbleMetrics ref_bubble;
@@ -166,22 +165,15 @@ class TfmBedModel : public BedModel {
           writer->WriteFields(tfm.time(), TfmCellFields(tfm));
           continue;
         }
-        const BubbleMetrics b =
-            measure_bubble(internal::scene_grid_field(scene, tfm.gas_fraction()), bubble);
-        BedSample smp;
-        smp.t_s = tfm.time() - scene.jet.start_s;
-        smp.bubble_diameter_m = b.found ? b.diameter_m : 0.0;
-        smp.bubble_centroid_m = b.found ? b.centroid_y_m : 0.0;
-        smp.bed_height_m = b.bed_height_m;
-        smp.pressure_drop_pa = tfm.PressureDrop(0.5 * dz, scene.geometry.height_m);
+        const internal::BedSampler::Taken taken = sampler.Take(
+            tfm.time(), tfm.gas_fraction(), tfm.PressureDrop(0.5 * dz, scene.geometry.height_m));
+        const BedSample& smp = taken.sample;
         out.series.push_back(smp);
         m.max_bed_height_m = std::max(m.max_bed_height_m, smp.bed_height_m);
-        const double gap = std::abs(tfm.time() - t_ref_abs);
-        if (gap < best_gap) {
-          best_gap = gap;
+        if (taken.nearest_to_ref) {
           at_ref = smp;
           have_ref = true;
-          ref_bubble = b;
+          ref_bubble = taken.bubble;
           out.snapshot_void_fraction = internal::scene_grid_field(scene, tfm.gas_fraction());
         }
         series.push_back({{"t_s", smp.t_s},

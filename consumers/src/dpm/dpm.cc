@@ -414,7 +414,7 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   const double area = s.geometry.width_m * s.geometry.depth_m;
   const double g = s.gas.gravity_m_s2, rho_g = s.gas.density_kg_m3;
   const double particle_mass = static_cast<double>(result_.particles) * s.particle_mass_kg();
-  const BubbleOptions bo = internal::scene_bubble_options(s, settled_height_);
+  internal::BedSampler sampler(s, settled_height_);
 
   // Vertical momentum of gas + particles [kg m/s].
   auto total_momentum = [&]() {
@@ -461,7 +461,6 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   bool t_ref_written = false;
   double next_sample = 0.0;
   const double t_ref_abs = s.jet.start_s + s.time.t_ref_s;
-  double best_ref_gap = 0.5 * interval + 1e-12;
   const double p_start = total_momentum();
   double f_prev = external_force();
   for (long n = 0; n < steps; ++n) {
@@ -470,19 +469,12 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
     m.impulse_z += 0.5 * (f_prev + f_now) * gas_dt_ + m.wall_impulse_step;
     f_prev = f_now;
     if (m.time + 1e-12 >= next_sample) {
-      BubbleMetrics b = measure_bubble(VoidFractionField(), bo);
-      DpmSample smp;
-      smp.t_s = m.time - s.jet.start_s;
-      smp.bubble_diameter_m = b.found ? b.diameter_m : 0.0;
-      smp.bubble_centroid_m = b.found ? b.centroid_y_m : 0.0;
-      smp.bed_height_m = b.bed_height_m;
-      smp.pressure_drop_pa = m.gas->PressureDrop(0.5 * m.gas->dz(), s.geometry.height_m);
-      result_.series.push_back(smp);
-      const double gap = std::abs(m.time - t_ref_abs);
-      if (opt_.jet && gap < best_ref_gap) {
-        best_ref_gap = gap;
-        result_.bubble_at_t_ref = b.found;
-        result_.bubble_diameter_m = smp.bubble_diameter_m;
+      const internal::BedSampler::Taken taken =
+          sampler.Take(m.time, m.eps, m.gas->PressureDrop(0.5 * m.gas->dz(), s.geometry.height_m));
+      result_.series.push_back(taken.sample);
+      if (opt_.jet && taken.nearest_to_ref) {
+        result_.bubble_at_t_ref = taken.bubble.found;
+        result_.bubble_diameter_m = taken.sample.bubble_diameter_m;
         result_.snapshot = Snapshot();
         result_.has_snapshot = true;
       }

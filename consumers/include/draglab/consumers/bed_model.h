@@ -32,15 +32,6 @@ struct BedRunOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// One sample of the bubble time series (t after the jet start; negative before it).
-struct BedSample {
-  double t_s = 0.0;
-  double bubble_diameter_m = 0.0;  ///< 0 when no bubble is found.
-  double bubble_centroid_m = 0.0;  ///< Height of the bubble centroid.
-  double bed_height_m = 0.0;
-  double pressure_drop_pa = 0.0;  ///< Width-averaged, bottom cell centre to outlet.
-};
-
 /// What every model reports.
 struct BedResult {
   std::string model;  ///< Registry key ("dpm").

@@ -78,5 +78,14 @@ struct BubbleSample {
   BubbleMetrics metrics;
 };
 
+/// One sample of a bed model's bubble time series (t after the jet start; negative before it).
+struct BedSample {
+  double t_s = 0.0;
+  double bubble_diameter_m = 0.0;  ///< 0 when no bubble is found.
+  double bubble_centroid_m = 0.0;  ///< Height of the bubble centroid [m].
+  double bed_height_m = 0.0;       ///< From the width-averaged gas fraction.
+  double pressure_drop_pa = 0.0;   ///< Width-averaged p(first cell centre) - p(outlet).
+};
+
 }  // namespace consumers
 }  // namespace draglab

@@ -51,14 +51,8 @@ struct DpmOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// One sample of the time series (t after jet start; negative before it).
-struct DpmSample {
-  double t_s = 0.0;
-  double bubble_diameter_m = 0.0;  ///< 0 when no bubble is found.
-  double bubble_centroid_m = 0.0;  ///< Height of the bubble centroid [m].
-  double bed_height_m = 0.0;       ///< From the width-averaged eps (bubble.h).
-  double pressure_drop_pa = 0.0;   ///< Width-averaged p(first cell centre) - p(outlet).
-};
+/// One sample of the time series: the sample every bed model takes (bubble.h).
+using DpmSample = BedSample;
 
 /// Number of initial layers the particles are coloured by (equal-height bands of the settled
 /// bed, bottom = 0), as the experiment colours them so that mixing shows.
