@@ -5,16 +5,19 @@
 # closures and step. Prints a table and, last, one JSON line; both also go to --out.
 #
 # The case: 0.15 x 1.0 m, 30 x 200 cells (one across the 20 mm depth), 300 um particles of
-# 2500 kg/m^3 at alpha = 0.55 up to 0.5 m, air in at 0.25 m/s through the bottom, 2e-4 s steps.
+# 2500 kg/m^3 at alpha = 0.55 up to 0.5 m, air in at 0.25 m/s and 300 K through the bottom
+# (0.5 m/s once heated to the bed's 600 K), 2e-4 s steps.
 # OpenFOAM is switched from the tutorial's phasePressure model to its own kinetic theory (the
 # dormant kineticTheoryCoeffs block: Gidaspow viscosity and conductivity, Lun pressure,
 # Sinclair-Jackson g0 with alpha_max 0.62, Johnson-Jackson friction Fr 0.05, 2, 5, 28.5 deg,
 # alphaMinFriction 0.5, alphaDeltaMin 0.05, e = 0.8) with the granular temperature transported
 # (equilibrium off, residualAlpha 1e-4), and its virtual mass is removed; draglab runs
 # bench/openfoam/fluidised_bed.toml, which declares the same (gidaspow@1 = GidaspowErgunWenYu).
-# What still differs: OpenFOAM's air is a perfect gas with an energy equation (draglab's is
-# incompressible, 0.579 kg/m^3: OpenFOAM's density at the tutorial's 600 K and 1 bar), its
-# momentum advection is limitedLinearV (draglab's upwind), OpenFOAM runs PIMPLE with
+# What still differs: OpenFOAM's air is a perfect gas with an energy equation, entering at 300 K
+# into a 600 K bed and heated there within the first cell row, so the bed sees twice the inlet's
+# volume flow; draglab's gas is incompressible and isothermal at 600 K (0.579 kg/m^3) with that
+# doubled flow, 0.5 m/s (the scene's header). OpenFOAM's momentum advection is limitedLinearV
+# (draglab's upwind), and OpenFOAM runs PIMPLE with
 # 3 outer correctors and an implicit phase pressure, draglab one explicit projection step whose
 # size adapts below 2e-4 s when its stability limits ask (the steps and their limits are
 # reported; the run is then at "the same step where stable").
@@ -28,7 +31,9 @@
 # the solids inventory, and the mean absolute difference of the width-averaged alpha_p profiles
 # over the lower 0.6 m (OpenFOAM 1 rank against draglab). A short run compares the expansion of
 # the bed, not its bubbling statistics; a time-averaged profile needs seconds of simulated time
-# (--end-time 2 takes ~8 min per OpenFOAM run on one core here).
+# (--end-time 2 takes ~8 min per OpenFOAM run on one core here): --results-window A:B runs each
+# code once more, untimed, to B with fields every 0.05 s, and compares the time-averaged
+# width-averaged alpha_p profiles, bed heights and solids centroids over [A, B].
 #
 # Installs nothing: it needs `twoPhaseEulerFoam`, `blockMesh`, `setFields`, `decomposePar`,
 # `mpirun` (apt-get install openfoam openfoam-examples openmpi-bin), Debian's python3 with h5py
@@ -51,6 +56,8 @@ usage: bench/openfoam/run_side_by_side.sh [options]
   --end-time S      simulated time of each run [s], (0, 10]       [0.2; --quick 0.02]
   --repeat R        interleaved repetitions, >= 1                 [3; --quick 1]
   --quick           smoke check: short runs, one repetition
+  --results-window A:B  also compare the time-averaged bed over [A, B] s: one more run of
+                    each (OpenFOAM 2 ranks, draglab) to B with fields every 0.05 s, untimed
 EOF
 }
 fail_usage() {
@@ -59,7 +66,7 @@ fail_usage() {
   exit 2
 }
 
-build_dir="$root/build" out="" end_time="" repeat="" quick=0
+build_dir="$root/build" out="" end_time="" repeat="" quick=0 window=""
 while [ "$#" -gt 0 ]; do
   case "$1" in
     --build-dir) build_dir="${2:?}"; shift 2 ;;
@@ -67,6 +74,7 @@ while [ "$#" -gt 0 ]; do
     --end-time) end_time="${2:?}"; shift 2 ;;
     --repeat) repeat="${2:?}"; shift 2 ;;
     --quick) quick=1; shift ;;
+    --results-window) window="${2:?}"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) fail_usage "unknown option '$1'" ;;
   esac
@@ -78,6 +86,14 @@ python3_bin=/usr/bin/python3
 "$python3_bin" -c "import sys; t = float(sys.argv[1]); sys.exit(0 if 0 < t <= 10 else 1)" \
   "$end_time" 2>/dev/null || fail_usage "--end-time $end_time is outside (0, 10] s"
 [[ "$repeat" =~ ^[1-9][0-9]*$ ]] || fail_usage "--repeat $repeat must be an integer >= 1"
+window_from="" window_to=""
+if [ -n "$window" ]; then
+  [[ "$window" =~ ^([0-9.]+):([0-9.]+)$ ]] || fail_usage "--results-window $window is not A:B"
+  window_from="${BASH_REMATCH[1]}" window_to="${BASH_REMATCH[2]}"
+  "$python3_bin" -c "import sys; a, b = map(float, sys.argv[1:]); sys.exit(0 if 0 <= a < b <= 20 else 1)" \
+    "$window_from" "$window_to" 2>/dev/null ||
+    fail_usage "--results-window $window must satisfy 0 <= A < B <= 20 s"
+fi
 draglab="$build_dir/cli/draglab"
 [ -x "$draglab" ] || fail_usage "no $draglab: build draglab first (see the header)"
 for tool in twoPhaseEulerFoam blockMesh setFields decomposePar mpirun; do
@@ -178,10 +194,33 @@ for r in $(seq 1 "$repeat"); do
   echo "repetition $r of $repeat done" >&2
 done
 
-"$python3_bin" - "$out" "$end_time" "$(nproc)" <<'PY'
-import glob, json, re, statistics, sys
+# ---- untimed: the time-averaged bed over the results window ----
+if [ -n "$window" ]; then
+  win_case="$out/openfoam_window"
+  rm -rf "$win_case" && cp -r "$case_dir" "$win_case"
+  (cd "$win_case" && find . -maxdepth 2 -type d -regex '.*/[0-9.e-]+' ! -name 0 -exec rm -rf {} +)
+  sed -i "s/^endTime .*/endTime         $window_to;/; s/^writeInterval .*/writeInterval   0.05;/" \
+    "$win_case/system/controlDict"
+  echo "results window: OpenFOAM (2 ranks) to $window_to s, fields every 0.05 s" >&2
+  (cd "$win_case" && mpirun --allow-run-as-root --oversubscribe -np 2 twoPhaseEulerFoam -parallel \
+     >log.window 2>&1 && reconstructPar -fields '(alpha.particles)' >log.reconstruct 2>&1) ||
+    { echo "run_side_by_side: the OpenFOAM window run failed, see $win_case/log.*" >&2; exit 1; }
+  echo "results window: draglab to $window_to s" >&2
+  win_scene="$out/fluidised_bed_window.toml"
+  sed "s/^duration_s = 0.1$/duration_s = $window_to/; s/^t_ref_s = 0.1$/t_ref_s = $window_to/" \
+    "$here/fluidised_bed.toml" >"$win_scene"
+  sed -i "s|^range_policy = \"clamp\"|range_policy = \"clamp\"\n\n[outputs]\nfields = true\ninterval_s = 0.05\ndirectory = \"$out/draglab_window\"|" "$win_scene"
+  rm -rf "$out/draglab_window"
+  OMP_NUM_THREADS=1 "$draglab" --db "$out/bench.db" scene run "$win_scene" --no-store --json \
+    >"$out/draglab_window.json" 2>"$out/draglab_window.err" ||
+    { echo "run_side_by_side: draglab's window run failed, see $out/draglab_window.err" >&2; exit 1; }
+fi
+
+"$python3_bin" - "$out" "$end_time" "$(nproc)" "$window_from" "$window_to" <<'PY'
+import glob, json, os, re, statistics, sys
 import h5py, numpy as np
 out, end, cores = sys.argv[1], float(sys.argv[2]), int(sys.argv[3])
+window = (float(sys.argv[4]), float(sys.argv[5])) if sys.argv[4] else None
 cells, nx, nz, dz = 6000, 30, 200, 0.005
 runs = {}
 for line in open(out + "/times.txt"):
@@ -217,6 +256,37 @@ result = {
     "solids_inventory_m": {"openfoam": float(of.sum() * dz), "draglab": float(dl.sum() * dz)},
     "profile_mean_abs_difference": float(np.abs(of[:120] - dl[:120]).mean()),
 }
+if window:
+    # Width-averaged alpha_p per sample in [A, B]; their mean profile, the solids centroid.
+    z = (np.arange(nz) + 0.5) * dz
+    def of_profile(path):
+        txt = open(path).read()
+        mm = re.search(r"internalField\s+nonuniform\s+List<scalar>\s*(\d+)\s*\((.*?)\)\s*;", txt, re.S)
+        return np.array(mm.group(2).split(), float).reshape(nz, nx).mean(axis=1)
+    of_samples = [of_profile(d + "/alpha.particles")
+                  for d in glob.glob(out + "/openfoam_window/[0-9]*")
+                  if window[0] - 1e-9 <= float(os.path.basename(d)) <= window[1] + 1e-9
+                  and os.path.exists(d + "/alpha.particles")]
+    dl_samples = []
+    with h5py.File(glob.glob(out + "/draglab_window/*.h5")[0], "r") as f:
+        for k in f:
+            if k.startswith("t") and window[0] - 1e-9 <= f[k].attrs["time_s"] <= window[1] + 1e-9:
+                dl_samples.append(f[k]["phi"][0].mean(axis=1))
+    def summary(samples):
+        mean = np.mean(samples, axis=0)
+        c = [float((z * p).sum() / p.sum()) for p in samples]
+        return mean, {"samples": len(samples), "bed_height_m": height(mean),
+                      "centroid_m": float(np.mean(c)), "centroid_sd_m": float(np.std(c)),
+                      "mean_solids_fraction_0_to_0.4_m": float(mean[:80].mean())}
+    of_mean, of_sum = summary(of_samples)
+    dl_mean, dl_sum = summary(dl_samples)
+    result["window_s"] = list(window)
+    result["time_averaged"] = {"openfoam": of_sum, "draglab": dl_sum,
+                               "profile_mean_abs_difference_0_to_0.8_m":
+                                   float(np.abs(of_mean[:160] - dl_mean[:160]).mean()),
+                               "profiles_every_5_cm": [[round(float(z[j]), 4), round(float(of_mean[j]), 4),
+                                                        round(float(dl_mean[j]), 4)]
+                                                       for j in range(0, 180, 10)]}
 lines = ["%-22s %10s %8s %16s %12s" % ("run", "wall s", "steps", "cell-steps/s", "sim s/wall s")]
 for key, label in (("openfoam_1_rank", "OpenFOAM 1 rank"), ("draglab_1_thread", "draglab 1 thread"),
                    ("openfoam_2_ranks", "OpenFOAM 2 ranks")):
@@ -231,6 +301,18 @@ lines.append("results at t = %g s: bed height OpenFOAM %.3f m, draglab %.3f m; s
                  end, result["bed_height_m"]["openfoam"], result["bed_height_m"]["draglab"],
                  result["solids_inventory_m"]["openfoam"], result["solids_inventory_m"]["draglab"],
                  result["profile_mean_abs_difference"]))
+if window:
+    ta = result["time_averaged"]
+    lines.append("time-averaged over %g-%g s (%d / %d samples): bed height OpenFOAM %.3f m, draglab "
+                 "%.3f m; solids centroid %.3f +- %.3f / %.3f +- %.3f m (sample sd); mean alpha_p "
+                 "0-0.4 m %.3f / %.3f; mean |alpha_p difference| over 0-0.8 m %.4f" % (
+                     window[0], window[1], ta["openfoam"]["samples"], ta["draglab"]["samples"],
+                     ta["openfoam"]["bed_height_m"], ta["draglab"]["bed_height_m"],
+                     ta["openfoam"]["centroid_m"], ta["openfoam"]["centroid_sd_m"],
+                     ta["draglab"]["centroid_m"], ta["draglab"]["centroid_sd_m"],
+                     ta["openfoam"]["mean_solids_fraction_0_to_0.4_m"],
+                     ta["draglab"]["mean_solids_fraction_0_to_0.4_m"],
+                     ta["profile_mean_abs_difference_0_to_0.8_m"]))
 with open(out + "/results.txt", "w") as f:
     f.write("\n".join(lines) + "\n")
 with open(out + "/results.json", "w") as f:
