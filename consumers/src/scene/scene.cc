@@ -300,17 +300,16 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
     return fail(error, "[tfm] friction = '" + s.tfm.friction +
                            "' is not one of none, johnson_jackson_schaeffer");
   }
-  if (s.tfm.solids_walls != "free_slip" && s.tfm.solids_walls != "no_slip") {
-    return fail(error, "[tfm] solids_walls = '" + s.tfm.solids_walls +
-                           "' is not one of free_slip, no_slip");
-  }
-  if (s.tfm.fraction_scheme != "upwind" && s.tfm.fraction_scheme != "van_leer") {
-    return fail(error, "[tfm] fraction_scheme = '" + s.tfm.fraction_scheme +
-                           "' is not one of upwind, van_leer");
-  }
-  if (s.tfm.granular_temperature != "transport" && s.tfm.granular_temperature != "algebraic") {
-    return fail(error, "[tfm] granular_temperature = '" + s.tfm.granular_temperature +
-                           "' is not one of transport, algebraic");
+  // A key whose value names one of two choices.
+  auto either = [error](const std::string& value, const char* field, const char* a, const char* b) {
+    if (value == a || value == b) return true;
+    return fail(error,
+                std::string("[tfm] ") + field + " = '" + value + "' is not one of " + a + ", " + b);
+  };
+  if (!either(s.tfm.solids_walls, "solids_walls", "free_slip", "no_slip") ||
+      !either(s.tfm.fraction_scheme, "fraction_scheme", "upwind", "van_leer") ||
+      !either(s.tfm.granular_temperature, "granular_temperature", "transport", "algebraic")) {
+    return false;
   }
   if (s.tfm.restitution != -1.0 &&
       !in_range(s.tfm.restitution, 0.0, 1.0, true, false, "[tfm] restitution", "", error)) {
