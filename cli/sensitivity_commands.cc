@@ -353,8 +353,8 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   } else if (args.t_ref_s != -1.0) {
     throw UsageError("--t-ref must be >= 0 s (the snapshot time after the jet start)");
   }
-  consumers::DpmOptions dpm;
-  dpm.duration_s = args.duration_s;
+  consumers::BedRunOptions run;
+  run.duration_s = args.duration_s;
 
   consumers::SensitivityOptions sens;
   consumers::WorkPrecisionOptions wp;
@@ -372,7 +372,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
         wp.contact_steps.push_back(static_cast<int>(v));
       }
     }
-    wp.dpm = dpm;
+    wp.run = run;
     if (!wp.IsValid(&why)) throw UsageError(why);
   } else {
     if (!args.laws.empty()) sens.laws = split_list(args.laws, "--laws");
@@ -382,7 +382,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (sens.uncertainty == consumers::UncertaintyMethod::kGrids && args.realizations != 2)
       throw UsageError("--realizations applies to --uncertainty realizations only");
     sens.realizations = args.realizations;
-    sens.dpm = dpm;
+    sens.run = run;
     if (!sens.IsValid(&why)) throw UsageError(why);
   }
 

@@ -66,9 +66,9 @@ Scene SceneOnGrid(const Scene& scene, GridSize grid, int contact_steps, const st
 
 /// Run controls for one run: the scene's file outputs, if it asks for any, go to a folder per
 /// run instead of every run overwriting the same files.
-DpmOptions RunOptions(const DpmOptions& base, const Scene& s, const std::string& law,
-                      const std::string& tag) {
-  DpmOptions o = base;
+BedRunOptions RunOptions(const BedRunOptions& base, const Scene& s, const std::string& law,
+                         const std::string& tag) {
+  BedRunOptions o = base;
   if (!(s.outputs.fields || s.outputs.particles)) return o;
   std::string dir = !base.output_directory.empty() ? base.output_directory
                     : !s.outputs.directory.empty() ? s.outputs.directory
@@ -76,6 +76,14 @@ DpmOptions RunOptions(const DpmOptions& base, const Scene& s, const std::string&
   std::string name = law;
   std::replace(name.begin(), name.end(), '@', '_');
   o.output_directory = dir + "/" + name + "_" + tag;
+  return o;
+}
+
+/// The DPM's controls for a study run: the jet on, the particles free (the bubble needs both).
+DpmOptions DpmRunOptions(const BedRunOptions& run) {
+  DpmOptions o;
+  o.duration_s = run.duration_s;
+  o.output_directory = run.output_directory;
   return o;
 }
 
@@ -269,15 +277,10 @@ bool SensitivityOptions::IsValid(std::string* error) const {
     why = "SensitivityOptions.grid_refinement must be in (1, 4], got " + Num(grid_refinement);
     ok = false;
   }
-  if (ok && !dpm.jet) {
-    why = "SensitivityOptions.dpm.jet must be true (the bubble is the jet's)";
+  if (ok && !run.IsValid(&why)) {
+    why = "SensitivityOptions.run: " + why;
     ok = false;
   }
-  if (ok && dpm.freeze_particles) {
-    why = "SensitivityOptions.dpm.freeze_particles must be false (a frozen bed has no bubble)";
-    ok = false;
-  }
-  if (ok && !dpm.IsValid(&why)) ok = false;
   if (!ok && error) *error = why;
   return ok;
 }
@@ -314,11 +317,10 @@ bool WorkPrecisionOptions::IsValid(std::string* error) const {
       }
     }
   }
-  if (ok && (!dpm.jet || dpm.freeze_particles)) {
-    why = "WorkPrecisionOptions.dpm: the jet must be on and the particles free (no bubble else)";
+  if (ok && !run.IsValid(&why)) {
+    why = "WorkPrecisionOptions.run: " + why;
     ok = false;
   }
-  if (ok && !dpm.IsValid(&why)) ok = false;
   if (!ok && error) *error = why;
   return ok;
 }
@@ -469,12 +471,11 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
       progress, static_cast<int>(particles ? seeds.size() * (1 + grid_scenes.size() * laws.size())
                                            : grid_scenes.size() * laws.size()));
   if (!particles) {
-    BedRunOptions run_options;
-    run_options.duration_s = options.dpm.duration_s;
     for (const Scene& run_scene : grid_scenes) {
       const std::string tag = GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
       for (std::size_t i = 0; i < laws.size(); ++i) {
-        const BedResult r = run_bed_model(run_scene, Load(load_law, laws[i]), run_options,
+        const BedResult r = run_bed_model(run_scene, Load(load_law, laws[i]),
+                                          RunOptions(options.run, run_scene, laws[i], tag),
                                           study.Unit(laws[i] + " " + tag));
         SensitivityLawResult& lr = summary.laws[i];
         lr.runs.push_back(MakeBedRun(r, run_scene));
@@ -495,7 +496,7 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
     SensitivityPacking packing_info;
     // Settled once per realization; every law and grid starts from this same packing.
     const Particles packing =
-        SettlePacking(seeded, Load(load_law, laws.front()), options.dpm,
+        SettlePacking(seeded, Load(load_law, laws.front()), DpmRunOptions(options.run),
                       study.Unit("settle packing seed " + std::to_string(seeds[k])), &packing_info);
     summary.packings.push_back(packing_info);
     for (std::size_t g = 0; g < grid_scenes.size(); ++g) {
@@ -505,7 +506,7 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
                               GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
       for (std::size_t i = 0; i < laws.size(); ++i) {
         DpmSimulation sim(run_scene, Load(load_law, laws[i]),
-                          RunOptions(options.dpm, run_scene, laws[i], tag));
+                          DpmRunOptions(RunOptions(options.run, run_scene, laws[i], tag)));
         sim.Start(packing);
         const DpmResult r = sim.Run(study.Unit(laws[i] + " " + tag));
         SensitivityLawResult& lr = summary.laws[i];
@@ -620,7 +621,7 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   if (particles) {
     SensitivityPacking packing_info;
     // One packing, settled with the scene's own DEM settings, for every configuration.
-    packing = SettlePacking(scene, Load(load_law, options.law), options.dpm,
+    packing = SettlePacking(scene, Load(load_law, options.law), DpmRunOptions(options.run),
                             study.Unit("settle packing seed " + std::to_string(scene.seed)),
                             &packing_info);
     result.settle_wall_s = packing_info.settle_wall_s;
@@ -629,10 +630,9 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   }
   for (const Scene& c : configs) {
     if (!particles) {
-      BedRunOptions run_options;
-      run_options.duration_s = options.dpm.duration_s;
       const std::string tag = GridText(c.grid.cells_x, c.grid.cells_y);
-      const BedResult r = run_bed_model(c, Load(load_law, options.law), run_options,
+      const BedResult r = run_bed_model(c, Load(load_law, options.law),
+                                        RunOptions(options.run, c, options.law, tag),
                                         study.Unit(options.law + " " + tag));
       result.rows.push_back(RowOf(MakeBedRun(r, c), c.time.contact_steps));
       result.umf_m_s = r.metrics.umf_m_s;
@@ -641,7 +641,8 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
     }
     const std::string tag =
         GridText(c.grid.cells_x, c.grid.cells_y) + "_cs" + std::to_string(c.time.contact_steps);
-    DpmSimulation sim(c, Load(load_law, options.law), RunOptions(options.dpm, c, options.law, tag));
+    DpmSimulation sim(c, Load(load_law, options.law),
+                      DpmRunOptions(RunOptions(options.run, c, options.law, tag)));
     sim.Start(packing);
     const DpmResult r = sim.Run(study.Unit(options.law + " " + tag));
     result.rows.push_back(RowOf(MakeRun(r, c), c.time.contact_steps));

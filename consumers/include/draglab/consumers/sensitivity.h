@@ -38,6 +38,7 @@
 #include <string>
 #include <vector>
 
+#include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/law.h"
@@ -76,9 +77,9 @@ struct SensitivityOptions {
   int realizations = 2;
   /// kGrids: the finer grid has round(factor x cells) cells each way; (1, 4].
   double grid_refinement = 1.5;
-  /// Run controls (duration, settling); jet must stay on (the bubble needs it). A scene of
-  /// another bed model (tfm) takes its duration_s only.
-  DpmOptions dpm;
+  /// Run controls every model takes (the simulated time, the output folder); each run writes
+  /// the files its scene asks for into a subfolder per law and grid.
+  BedRunOptions run;
   bool IsValid(std::string* error) const;
 };
 
@@ -182,7 +183,7 @@ struct WorkPrecisionOptions {
   std::string law;                 ///< One "name@version"; required.
   std::vector<GridSize> grids;     ///< Empty: the scene's grid. No duplicates.
   std::vector<int> contact_steps;  ///< DEM steps per contact time, [20, 1000]; empty: scene's.
-  DpmOptions dpm;                  ///< Run controls (jet on); other models: duration_s only.
+  BedRunOptions run;               ///< Run controls every model takes.
   bool IsValid(std::string* error) const;
 };
 
