@@ -375,6 +375,9 @@ TEST_F(TfmTest, TinySceneThroughTheRegistryMakesABubbleAndConservesMass) {
   const nlohmann::json j = nlohmann::json::parse(r.result_json);
   EXPECT_EQ(j.at("solver"), "tfm");
   EXPECT_EQ(j.at("closures").at("set"), "nieuwland");
+  EXPECT_EQ(j.at("closures").at("granular_temperature"), "transport");
+  EXPECT_EQ(j.at("numerics").at("fraction_scheme"), "upwind");
+  EXPECT_EQ(j.at("numerics").at("solids_walls"), "free_slip");
   EXPECT_LT(std::abs(j.at("relative_solids_mass_change").get<double>()), 1e-12);
   EXPECT_LE(j.at("max_solids_fraction").get<double>(), 0.64 + 1e-12);
   const double dz = scene.geometry.height_m / scene.grid.cells_y;
