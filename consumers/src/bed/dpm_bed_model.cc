@@ -35,10 +35,7 @@ class DpmBedModel : public BedModel {
     out.metrics = consumer_metrics_of(r);
     out.background_mode = r.background_mode;
     out.eps_mf = r.eps_mf;
-    for (const DpmSample& s : r.series) {
-      out.series.push_back(
-          {s.t_s, s.bubble_diameter_m, s.bubble_centroid_m, s.bed_height_m, s.pressure_drop_pa});
-    }
+    out.series = r.series;
     out.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
     out.momentum_mismatch = r.momentum_mismatch;
     out.law_out_of_range = r.law_out_of_range;

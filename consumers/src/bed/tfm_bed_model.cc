@@ -17,6 +17,7 @@
 #include "draglab/consumers/dpm_output.h"
 #include "draglab/consumers/tfm.h"
 #include "draglab/drag_db/error.h"
+#include "scene/scene_ktgf.h"
 
 namespace draglab {
 namespace consumers {
@@ -35,16 +36,7 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   o.gas = internal::scene_gas_options(s, background_m_s, /*with_jet=*/true);
   o.particle_diameter_m = s.particles.diameter_m;
   o.particle_density_kg_m3 = s.particles.density_kg_m3;
-  KtgfOptions& k = o.ktgf;
-  parse_closure_set(s.tfm.closures, &k.closures);
-  parse_radial_distribution(s.tfm.radial_distribution, &k.radial);
-  parse_friction_model(s.tfm.friction, &k.friction);
-  k.restitution = s.tfm.restitution == -1.0 ? s.particles.restitution : s.tfm.restitution;
-  k.packing_limit = s.tfm.packing_limit;
-  k.friction_min_solids = s.tfm.friction_min_solids;
-  k.friction_angle_deg = s.tfm.friction_angle_deg;
-  k.friction_delta = s.tfm.friction_delta;
-  k.friction_max_viscosity_pa_s = s.tfm.friction_max_viscosity_pa_s;
+  o.ktgf = internal::scene_ktgf_options(s);
   o.initial_solids = 1.0 - s.eps_mf;
   o.initial_bed_height_m = s.bed_height_mf_m();
   o.initial_theta_m2_s2 = s.tfm.theta_initial_m2_s2;

@@ -19,6 +19,7 @@
 #include "draglab/consumers/ktgf.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
+#include "scene/scene_ktgf.h"
 #include "scene/scene_util.h"
 
 namespace draglab {
@@ -271,6 +272,26 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
   return table;
 }
 
+}  // namespace
+
+namespace internal {
+KtgfOptions scene_ktgf_options(const Scene& s) {
+  KtgfOptions k;
+  parse_closure_set(s.tfm.closures, &k.closures);
+  parse_radial_distribution(s.tfm.radial_distribution, &k.radial);
+  parse_friction_model(s.tfm.friction, &k.friction);
+  k.restitution = s.tfm.restitution == -1.0 ? s.particles.restitution : s.tfm.restitution;
+  k.packing_limit = s.tfm.packing_limit;
+  k.friction_min_solids = s.tfm.friction_min_solids;
+  k.friction_angle_deg = s.tfm.friction_angle_deg;
+  k.friction_delta = s.tfm.friction_delta;
+  k.friction_max_viscosity_pa_s = s.tfm.friction_max_viscosity_pa_s;
+  return k;
+}
+}  // namespace internal
+
+namespace {
+
 /// The [tfm] table: required by solver = "tfm", refused by the others; ranges via ktgf.h.
 bool tfm_is_valid(const Scene& s, std::string* error) {
   const bool tfm = s.solver == "tfm";
@@ -315,12 +336,7 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
       !in_range(s.tfm.restitution, 0.0, 1.0, true, false, "[tfm] restitution", "", error)) {
     return false;
   }
-  k.restitution = s.tfm.restitution == -1.0 ? s.particles.restitution : s.tfm.restitution;
-  k.packing_limit = s.tfm.packing_limit;
-  k.friction_min_solids = s.tfm.friction_min_solids;
-  k.friction_angle_deg = s.tfm.friction_angle_deg;
-  k.friction_delta = s.tfm.friction_delta;
-  k.friction_max_viscosity_pa_s = s.tfm.friction_max_viscosity_pa_s;
+  k = internal::scene_ktgf_options(s);
   if (!(s.tfm.packing_limit > 1.0 - s.eps_mf)) {
     return fail(error, "[tfm] packing_limit = " + fmt(s.tfm.packing_limit) +
                            " must exceed the bed's solids fraction at minimum fluidization 1 - "

@@ -129,15 +129,7 @@ SensitivityRun MakeBedRun(const BedResult& r, const Scene& s) {
   run.wall_s = r.wall_s;
   run.gas_steps = r.steps;
   run.gas_dt_s = r.mean_dt_s;
-  for (const BedSample& b : r.series) {
-    DpmSample d;
-    d.t_s = b.t_s;
-    d.bubble_diameter_m = b.bubble_diameter_m;
-    d.bubble_centroid_m = b.bubble_centroid_m;
-    d.bed_height_m = b.bed_height_m;
-    d.pressure_drop_pa = b.pressure_drop_pa;
-    run.series.push_back(d);
-  }
+  run.series = r.series;
   run.momentum_mismatch = r.momentum_mismatch;
   run.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
   run.drag_out_of_range = r.law_out_of_range;
