@@ -1,11 +1,13 @@
-// `draglab sensitivity`: a DPM scene per drag law, the bubble diameter at t_ref with its
-// numerical uncertainty, the seed's Fig. 4 as a PNG; and --work-precision (bubble diameter
-// against grid size and DEM step, with run times). docs/scenes.md, "Sensitivity and
-// work-precision".
+// `draglab sensitivity`: a bed scene (any model) per drag law, the bubble diameter at t_ref with
+// its numerical uncertainty, the seed's Fig. 4 (and with --beside Fig. 5) as a PNG; and
+// --work-precision (bubble diameter against grid size and the model's time step, with run
+// times). docs/scenes.md, "Sensitivity and work-precision".
 //   draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1
 //   draglab sensitivity SCENE --uncertainty grids --out out/quick --json
 //   draglab sensitivity SCENE --work-precision --law ergun@1 --grids 8x24,12x36 --contact-steps
 //   20,40
+//   draglab sensitivity data/scenes/tfm_bubble.toml --work-precision --law gidaspow@1 --cfl
+//   0.3,0.15
 //
 // The C++ side runs everything and writes DIR/sensitivity.json (or DIR/work_precision.json) with
 // every number and the snapshots; scripts/draglab_fig4.py (Debian's /usr/bin/python3 +
@@ -30,6 +32,8 @@
 #include "cli/cli_context.h"
 #include "cli/file_util.h"
 #include "cli/progress.h"
+#include "draglab/consumers/bed_model.h"
+#include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/consumers/sensitivity.h"
 #include "draglab/drag_db/error.h"
@@ -57,7 +61,8 @@ struct SensitivityArgs {
   bool work_precision = false;
   std::string law;            // --work-precision --law
   std::string grids;          // --grids 8x24,12x36
-  std::string contact_steps;  // --contact-steps 20,40
+  std::string contact_steps;  // --contact-steps 20,40 (DPM)
+  std::string cfl;            // --cfl 0.3,0.15 (TFM)
 };
 
 std::vector<std::string> split_list(const std::string& text, const std::string& field) {
@@ -130,7 +135,7 @@ nlohmann::json bubble_json(const consumers::BubbleMetrics& b) {
           {"bed_height_m", b.bed_height_m}};
 }
 
-nlohmann::json snapshot_json(const consumers::DpmSnapshot& s) {
+nlohmann::json snapshot_json(const consumers::BedSnapshot& s) {
   const auto& f = s.void_fraction;
   return {{"t_s", s.t_s},
           {"layers", consumers::kInitialLayers},
@@ -237,7 +242,8 @@ nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
   for (const auto& r : w.rows) {
     rows.push_back({{"cells_x", r.cells_x},
                     {"cells_y", r.cells_y},
-                    {"contact_steps", r.contact_steps},
+                    {"time_resolution", r.time_resolution},
+                    {w.time_resolution_name, r.time_resolution},
                     {"cell_size_m", r.cell_size_m},
                     {"bubble_diameter_m", r.bubble_diameter_m},
                     {"bubble_found", r.bubble_found},
@@ -256,6 +262,7 @@ nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
           {"scene_hash", w.scene_hash},
           {"law", w.law},
           {"seed", w.seed},
+          {"time_resolution_name", w.time_resolution_name},
           {"umf_m_s", w.umf_m_s},
           {"background_m_s", w.background_m_s},
           {"t_ref_s", w.t_ref_s},
@@ -303,12 +310,12 @@ void print_sensitivity_table(const consumers::SensitivitySummary& s) {
 void print_work_precision_table(const consumers::WorkPrecisionResult& w) {
   std::cout << w.BriefReport();
   std::cout << fmt::format("{:>9} {:>13} {:>7} {:>7} {:>11} {:>9} {:>10} {:>8}\n", "grid",
-                           "contact_steps", "h cm", "D cm", "error cm", "gas steps", "DEM steps",
+                           w.time_resolution_name, "h cm", "D cm", "error cm", "steps", "DEM steps",
                            "wall s");
   for (const auto& r : w.rows) {
     std::cout << fmt::format("{:>9} {:>13} {:>7} {:>7} {:>11} {:>9} {:>10} {:>8.1f}\n",
-                             fmt::format("{}x{}", r.cells_x, r.cells_y), r.contact_steps,
-                             cm(r.cell_size_m),
+                             fmt::format("{}x{}", r.cells_x, r.cells_y),
+                             format_number(r.time_resolution, 4), cm(r.cell_size_m),
                              r.bubble_found ? cm(r.bubble_diameter_m) : std::string("-"),
                              std::isfinite(r.error_m) ? cm(r.error_m) : std::string("(ref)"),
                              r.gas_steps, r.dem_steps, r.wall_s);
@@ -335,9 +342,10 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (args.law.empty()) throw UsageError("--work-precision needs --law NAME@V (one law)");
     if (args.law.find(',') != std::string::npos)
       throw UsageError("--law: --work-precision takes one NAME@V, got '" + args.law + "'");
-  } else if (!args.law.empty() || !args.grids.empty() || !args.contact_steps.empty()) {
+  } else if (!args.law.empty() || !args.grids.empty() || !args.contact_steps.empty() ||
+             !args.cfl.empty()) {
     throw UsageError(
-        "--law, --grids and --contact-steps belong to --work-precision (the law "
+        "--law, --grids, --contact-steps and --cfl belong to --work-precision (the law "
         "table takes --laws a@1,b@1)");
   }
   if (args.duration_s < 0.0 || !std::isfinite(args.duration_s))
@@ -362,14 +370,25 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   if (args.work_precision) {
     wp.law = args.law;
     if (!args.grids.empty()) wp.grids = consumers::parse_grid_list(args.grids, "--grids");
-    if (!args.contact_steps.empty()) {
-      for (double v : parse_double_list(args.contact_steps, "--contact-steps")) {
-        if (v != std::floor(v) || v < 20 || v > 1000)
-          throw UsageError(fmt::format(
-              "--contact-steps: {} is not a whole number in [20, 1000] (DEM steps per contact "
-              "time)",
-              format_number(v)));
-        wp.contact_steps.push_back(static_cast<int>(v));
+    // Each model names the value that sets its time step; the option of another model is a
+    // usage error rather than silently ignored.
+    const consumers::TimeResolution step =
+        consumers::find_bed_model(scene.solver).time_resolution();
+    for (const auto& [option, list] :
+         {std::pair<std::string, std::string>{"contact_steps", args.contact_steps},
+          {"cfl", args.cfl}}) {
+      if (list.empty()) continue;
+      const std::string flag = option == "cfl" ? "--cfl" : "--contact-steps";
+      if (option != step.name)
+        throw UsageError(
+            fmt::format("{}: this scene's model ({}) sets its time step by {} ({}): use --{}", flag,
+                        scene.solver, step.name, step.description,
+                        step.name == "cfl" ? "cfl" : "contact-steps"));
+      for (double v : parse_double_list(list, flag)) {
+        if (step.whole_number && v != std::floor(v))
+          throw UsageError(fmt::format("{}: {} is not a whole number ({}, {})", flag,
+                                       format_number(v), step.description, step.range));
+        wp.time_resolutions.push_back(v);
       }
     }
     wp.run = run;
@@ -381,6 +400,12 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
       throw UsageError(fmt::format("--realizations must be in [2, 32], got {}", args.realizations));
     if (sens.uncertainty == consumers::UncertaintyMethod::kGrids && args.realizations != 2)
       throw UsageError("--realizations applies to --uncertainty realizations only");
+    if (args.realizations != 2 &&
+        consumers::find_bed_model(scene.solver).realization_kind().empty())
+      throw UsageError(fmt::format(
+          "--realizations: the {} model is deterministic (no realizations); its uncertainty "
+          "comes from two grids",
+          scene.solver));
     sens.realizations = args.realizations;
     sens.run = run;
     if (!sens.IsValid(&why)) throw UsageError(why);
@@ -425,8 +450,8 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     progress.finish();
     for (const auto& r : w.rows) {
       if (!r.bubble_found)
-        ctx.warn(fmt::format("grid {}x{}, contact_steps {}: no bubble at t_ref (D = 0){}",
-                             r.cells_x, r.cells_y, r.contact_steps,
+        ctx.warn(fmt::format("grid {}x{}, {} {}: no bubble at t_ref (D = 0){}", r.cells_x,
+                             r.cells_y, w.time_resolution_name, format_number(r.time_resolution, 4),
                              r.reached_t_ref ? ""
                                              : ": the run ended before t_ref (duration rounded "
                                                "to whole gas steps; raise [time] duration_s)"));
@@ -525,13 +550,17 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
                   "Another study's sensitivity.json (e.g. the DPM's): also draw DIR/fig5.png, its "
                   "panels above this study's, per shared law");
   cmd->add_flag("--work-precision", args->work_precision,
-                "Work-precision study of one law (--law) over --grids x --contact-steps");
+                "Work-precision study of one law (--law) over --grids x the model's time step "
+                "(--contact-steps for dpm scenes, --cfl for tfm scenes)");
   cmd->add_option("--law", args->law, "--work-precision: the law NAME@V");
   cmd->add_option("--grids", args->grids,
                   "--work-precision: grids CXxCY,... (default: the scene's), e.g. 8x24,12x36");
   cmd->add_option("--contact-steps", args->contact_steps,
-                  "--work-precision: DEM steps per contact time, [20, 1000], e.g. 20,40 (default: "
-                  "the scene's)");
+                  "--work-precision, dpm scenes: DEM steps per contact time, [20, 1000], e.g. "
+                  "20,40 (default: the scene's)");
+  cmd->add_option("--cfl", args->cfl,
+                  "--work-precision, tfm scenes: Courant numbers of the coupled step, (0, 0.5], "
+                  "e.g. 0.3,0.15 (default: the scene's [tfm] cfl)");
   cmd->footer(
       "Examples:\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1\n"
@@ -540,6 +569,8 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
       "--beside out/dpm_bubble_sensitivity/sensitivity.json\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --work-precision --law ergun@1 "
       "--grids 8x24,12x36 --contact-steps 20,40\n"
+      "  draglab sensitivity data/scenes/tfm_bubble.toml --work-precision --law gidaspow@1 "
+      "--grids 12x40,18x60 --cfl 0.3,0.15\n"
       "Writes DIR/sensitivity.json + DIR/fig4.png, or DIR/work_precision.json + "
       "DIR/work_precision.png.");
   cmd->callback(

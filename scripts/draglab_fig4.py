@@ -292,10 +292,12 @@ def draw_work_precision(data, out_dir, quiet):
     if not rows:
         raise SystemExit("error: the data hold no configurations")
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
-    # A continuum model (no DEM steps) has no contact steps to show.
-    dem = any(r.get("dem_steps", 1) > 0 for r in rows)
-    for r in rows:
-        label = ("%dx%d/%d" % (r["cells_x"], r["cells_y"], r["contact_steps"]) if dem
+    # The model's time resolution (DPM: contact steps; TFM: CFL) joins the label when it varies.
+    step_name = data.get("time_resolution_name", "contact_steps")
+    steps = [r.get("time_resolution", r.get(step_name)) for r in rows]
+    varied = len(set(steps)) > 1
+    for r, step in zip(rows, steps):
+        label = ("%dx%d/%g" % (r["cells_x"], r["cells_y"], step) if varied
                  else "%dx%d" % (r["cells_x"], r["cells_y"]))
         wall = max(r["wall_s"], 1e-3)
         d_cm = 100 * r["bubble_diameter_m"]
@@ -325,8 +327,9 @@ def draw_work_precision(data, out_dir, quiet):
     right.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
     right.yaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
     right.tick_params(axis="y", which="minor", labelsize=7)
-    fig.suptitle("work-precision of %s on %s (%s per point)" % (
-        data["law"], data["scene"], "grid/contact steps" if dem else "grid"), fontsize=10)
+    fig.suptitle("work-precision of %s on %s (%s per point%s)" % (
+        data["law"], data["scene"], "grid/" + step_name if varied else "grid",
+        "" if varied else ", %s %g" % (step_name, steps[0])), fontsize=10)
     save_figure(fig, out_dir, "work_precision.png", quiet)
 
 

@@ -115,12 +115,23 @@ if "$py" -c 'import matplotlib' 2>/dev/null; then
   check "sensitivity --beside" 0 "$draglab" --db "$db" sensitivity "$scene" --laws ergun@1 --out "$work/sens2" --beside "$work/sens/sensitivity.json"
   ok "fig5.png written" [ -s "$work/sens2/fig5.png" ]
 fi
+check "--realizations on a deterministic model" 2 "$draglab" --db "$db" sensitivity "$scene" --realizations 4
+ok "the message says why" grep -q "deterministic" "$work/err"
 check "--beside a missing file" 2 "$draglab" --db "$db" sensitivity "$scene" --beside "$work/none.json"
 check "work-precision contact steps on a tfm scene" 2 "$draglab" --db "$db" sensitivity "$scene" --work-precision --law ergun@1 --grids 6x20,9x30 --contact-steps 20,40
-check "work-precision" 0 "$draglab" --db "$db" sensitivity "$scene" --work-precision --law ergun@1 --grids 6x20,9x30 --out "$work/wp" --json
-pycheck "work-precision rows" '
+check "work-precision a CFL above 0.5" 2 "$draglab" --db "$db" sensitivity "$scene" --work-precision --law ergun@1 --cfl 0.3,0.7
+ok "the CFL message names the field" grep -q "\[tfm\] cfl" "$work/err"
+check "work-precision" 0 "$draglab" --db "$db" sensitivity "$scene" --work-precision --law ergun@1 --grids 6x20,9x30 --cfl 0.3,0.15 --out "$work/wp" --json
+pycheck "work-precision rows: grids x CFL, the smaller CFL taking more steps" '
 import json, sys
 r = json.load(open(sys.argv[1] + "/out"))
-assert len(r["rows"]) == 2 and all(x["wall_s"] >= 0 and x["gas_steps"] > 0 for x in r["rows"]), r
+assert r["time_resolution_name"] == "cfl", r["time_resolution_name"]
+rows = r["rows"]
+assert [(x["cells_x"], x["cfl"]) for x in rows] == [(6, 0.3), (6, 0.15), (9, 0.3), (9, 0.15)], rows
+assert all(x["wall_s"] >= 0 and x["gas_steps"] > 0 and x["dem_steps"] == 0 for x in rows), rows
+for coarse, fine in ((rows[0], rows[1]), (rows[2], rows[3])):
+    assert fine["gas_steps"] > 1.5 * coarse["gas_steps"], (coarse, fine)
+ref = [x for x in rows if x["is_reference"]]
+assert len(ref) == 1 and ref[0]["cells_x"] == 9 and ref[0]["cfl"] == 0.15, ref
 '
 finish cli.tfm

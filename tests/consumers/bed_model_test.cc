@@ -2,7 +2,10 @@
 // one are clear errors), scene validation that accepts exactly the registered keys, dispatch by
 // the scene's solver to a model registered from outside the library, and the DPM through the
 // registry giving bit-identical results to a direct DpmSimulation run of the same scene, law and
-// thread count (the family changes no DPM number).
+// thread count (the family changes no DPM number). The realization hook: a DPM packing settled
+// once and passed to several runs gives each run bit-identical results to a run that settles its
+// own (the studies reuse one packing across laws and grids), a packing of another seed is
+// refused, and the time-resolution hook sets the value that sets each model's step.
 #include <algorithm>
 #include <fstream>
 #include <memory>
@@ -59,8 +62,13 @@ class EchoModel : public BedModel {
  public:
   std::string key() const override { return "echo_test"; }
   std::string description() const override { return "test model"; }
+  TimeResolution time_resolution() const override {
+    return {"steps", "test steps", "[1, 10]", true, true};
+  }
+  double time_resolution_of(const Scene&) const override { return 1.0; }
+  Scene WithTimeResolution(const Scene& scene, double) const override { return scene; }
   BedResult Run(const Scene& scene, std::shared_ptr<const Law> law, const BedRunOptions& options,
-                const BedProgress&) const override {
+                const BedProgress&, const BedRealization*) const override {
     BedResult r;
     r.model = key();
     r.scene = scene.name;
@@ -148,6 +156,59 @@ TEST(BedModel, DpmThroughTheRegistryIsBitIdenticalToADirectRun) {
   }
   EXPECT_EQ(a, b);
   EXPECT_EQ(a.at("solver"), "dpm");
+}
+
+TEST(BedModel, DpmRunsFromOnePackingAsFromTheirOwnSettling) {
+  const Scene scene = parse_scene(scene_text("dpm"), "tiny");
+  const BedModel& dpm = find_bed_model("dpm");
+  EXPECT_EQ(dpm.realization_kind(), "packing");
+  const std::shared_ptr<const BedRealization> packing = dpm.Realize(scene, ergun(), nullptr);
+  ASSERT_TRUE(packing);
+  EXPECT_EQ(packing->seed, scene.seed);
+  EXPECT_GT(packing->particles, 0);
+  EXPECT_GT(packing->bed_height_m, 0.0);
+  const BedResult own = run_bed_model(scene, ergun());
+  // Twice from the same packing: the packing is not consumed or changed by a run.
+  for (int pass = 0; pass < 2; ++pass) {
+    const BedResult reused = run_bed_model(scene, ergun(), BedRunOptions(), nullptr, packing.get());
+    ASSERT_EQ(reused.series.size(), own.series.size()) << pass;
+    for (std::size_t i = 0; i < own.series.size(); ++i) {
+      EXPECT_EQ(reused.series[i].bubble_diameter_m, own.series[i].bubble_diameter_m) << i;
+      EXPECT_EQ(reused.series[i].bed_height_m, own.series[i].bed_height_m) << i;
+      EXPECT_EQ(reused.series[i].pressure_drop_pa, own.series[i].pressure_drop_pa) << i;
+    }
+    EXPECT_EQ(reused.inner_steps, own.inner_steps);
+    EXPECT_GT(reused.inner_steps, 0);
+    EXPECT_EQ(reused.momentum_mismatch, own.momentum_mismatch);
+  }
+  Scene other = scene;
+  other.seed = scene.seed + 1;
+  try {
+    run_bed_model(other, ergun(), BedRunOptions(), nullptr, packing.get());
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("seed"), std::string::npos) << e.what();
+  }
+}
+
+TEST(BedModel, TimeResolutionHooksSetTheValueThatSetsTheStep) {
+  const Scene scene = parse_scene(scene_text("dpm"), "tiny");
+  const BedModel& dpm = find_bed_model("dpm");
+  EXPECT_EQ(dpm.time_resolution().name, "contact_steps");
+  EXPECT_TRUE(dpm.time_resolution().whole_number);
+  const Scene finer = dpm.WithTimeResolution(scene, 40);
+  EXPECT_EQ(dpm.time_resolution_of(finer), 40.0);
+  EXPECT_EQ(finer.time.dem_dt_s, 0.0);  // so that contact_steps alone sets the DEM step
+  EXPECT_TRUE(finer.IsValid(nullptr));
+  EXPECT_FALSE(dpm.WithTimeResolution(scene, 10).IsValid(nullptr));  // below the DEM limit 20
+
+  const BedModel& tfm = find_bed_model("tfm");
+  EXPECT_EQ(tfm.realization_kind(), "");  // deterministic
+  EXPECT_THROW(tfm.Realize(scene, ergun(), nullptr), Error);
+  EXPECT_EQ(tfm.time_resolution().name, "cfl");
+  EXPECT_FALSE(tfm.time_resolution().larger_is_finer);
+  EXPECT_EQ(tfm.time_resolution_of(tfm.WithTimeResolution(scene, 0.15)), 0.15);
 }
 
 }  // namespace

@@ -123,10 +123,13 @@ TEST(SensitivityOptionsTest, ParsesGridsAndMethodsAndNamesBadFields) {
 
   WorkPrecisionOptions w;
   w.law = "ergun@1";
-  w.contact_steps = {20, 10};
+  w.time_resolutions = {20, 20};
   EXPECT_FALSE(w.IsValid(&why));
-  EXPECT_NE(why.find("contact_steps"), std::string::npos) << why;
-  w.contact_steps = {20};
+  EXPECT_NE(why.find("time_resolutions"), std::string::npos) << why;
+  w.time_resolutions = {20, -1};
+  EXPECT_FALSE(w.IsValid(&why));
+  EXPECT_NE(why.find("positive"), std::string::npos) << why;
+  w.time_resolutions = {20};
   w.grids = {{4, 12}, {4, 12}};
   EXPECT_FALSE(w.IsValid(&why));
   EXPECT_NE(why.find("twice"), std::string::npos) << why;
@@ -201,6 +204,18 @@ TEST(SensitivityRunner, RefusesBadLawsAndGridsBeforeAnySettling) {
     wp.law = "gidaspow@1";
     wp.grids = {{4, 12}, {20, 60}};
     EXPECT_THROW(run_work_precision(scene, loader, wp, count), Error);
+    // The DPM's time resolution is its contact steps: below the DEM limit, or not whole.
+    wp.grids = {{4, 12}};
+    for (double bad : {10.0, 20.5}) {
+      wp.time_resolutions = {20, bad};
+      try {
+        run_work_precision(scene, loader, wp, count);
+        ADD_FAILURE() << "contact_steps " << bad << " was accepted";
+      } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+        EXPECT_NE(std::string(e.what()).find("contact_steps"), std::string::npos) << e.what();
+      }
+    }
     EXPECT_EQ(reports, 0) << "a run started before the input was checked";
   }
   std::remove(path.c_str());

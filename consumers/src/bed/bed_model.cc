@@ -80,11 +80,18 @@ const BedModel& find_bed_model(const std::string& key) {
   return *it->second;
 }
 
+std::shared_ptr<const BedRealization> BedModel::Realize(const Scene&, std::shared_ptr<const Law>,
+                                                        const BedProgress&) const {
+  throw Error(ErrorCode::kInvalidArgument,
+              "bed model '" + key() + "' is deterministic: it has no realizations to prepare");
+}
+
 BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
-                        const BedRunOptions& options, const BedProgress& progress) {
+                        const BedRunOptions& options, const BedProgress& progress,
+                        const BedRealization* start) {
   std::string why;
   if (!options.IsValid(&why)) throw Error(ErrorCode::kInvalidArgument, "bed run options: " + why);
-  return find_bed_model(scene.solver).Run(scene, std::move(law), options, progress);
+  return find_bed_model(scene.solver).Run(scene, std::move(law), options, progress, start);
 }
 
 }  // namespace consumers

@@ -1,15 +1,25 @@
 // The DPM (CFD-DEM, dpm.h) as a bed model: one coupled run of the scene, its result in the
-// family's neutral form, and its full DpmResult as the stored JSON.
+// family's neutral form, and its full DpmResult as the stored JSON. Its realization is a packing
+// settled with the scene's seed; its time resolution the DEM steps per contact time.
+#include <chrono>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "bed/builtin_models.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/regress.h"
+#include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
+
+/// A settled packing of one seed.
+class DpmPacking : public BedRealization {
+ public:
+  Particles settled;
+};
 
 class DpmBedModel : public BedModel {
  public:
@@ -17,8 +27,49 @@ class DpmBedModel : public BedModel {
   std::string description() const override {
     return "CFD-DEM: soft-sphere particles in a volume-averaged gas (dpm.h)";
   }
+
+  std::string realization_kind() const override { return "packing"; }
+
+  std::shared_ptr<const BedRealization> Realize(const Scene& scene, std::shared_ptr<const Law> law,
+                                                const BedProgress& progress) const override {
+    const auto t0 = std::chrono::steady_clock::now();
+    DpmSimulation settler(scene, std::move(law), DpmOptions());  // settling has no gas
+    settler.Settle(progress);
+    auto packing = std::make_shared<DpmPacking>();
+    packing->settled = settler.dem().particles();
+    packing->seed = scene.seed;
+    packing->particles = static_cast<std::int64_t>(packing->settled.size());
+    packing->bed_height_m = settler.settled_bed_height_m();
+    packing->prepare_wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return packing;
+  }
+
+  TimeResolution time_resolution() const override {
+    return {"contact_steps", "DEM steps per contact time (the DEM step is t_c / contact_steps)",
+            "[20, 1000]", /*whole_number=*/true, /*larger_is_finer=*/true};
+  }
+  double time_resolution_of(const Scene& scene) const override { return scene.time.contact_steps; }
+  Scene WithTimeResolution(const Scene& scene, double value) const override {
+    Scene s = scene;
+    s.time.contact_steps = static_cast<int>(value);
+    s.time.dem_dt_s = 0.0;  // the DEM step follows contact_steps
+    return s;
+  }
+
   BedResult Run(const Scene& scene, std::shared_ptr<const Law> law, const BedRunOptions& options,
-                const BedProgress& progress) const override {
+                const BedProgress& progress, const BedRealization* start) const override {
+    const DpmPacking* packing = nullptr;
+    if (start) {
+      packing = dynamic_cast<const DpmPacking*>(start);
+      if (!packing)
+        throw Error(ErrorCode::kInvalidArgument,
+                    "dpm: the given realization was not made by the dpm model");
+      if (packing->seed != scene.seed)
+        throw Error(ErrorCode::kInvalidArgument,
+                    "dpm: the packing was settled with seed " + std::to_string(packing->seed) +
+                        ", the scene asks for seed " + std::to_string(scene.seed));
+    }
     // U_mf and the time steps first: a law whose validity box excludes the bed fails here, in
     // microseconds, rather than after the settling.
     derive_scene(scene, *law);
@@ -26,6 +77,7 @@ class DpmBedModel : public BedModel {
     dpm.duration_s = options.duration_s;
     dpm.output_directory = options.output_directory;
     DpmSimulation simulation(scene, law, dpm);
+    if (packing) simulation.Start(packing->settled);
     const DpmResult r = simulation.Run(progress);
     BedResult out;
     out.model = key();
@@ -44,12 +96,11 @@ class DpmBedModel : public BedModel {
     out.output_files = r.output_files;
     out.steps = r.gas_steps;
     out.mean_dt_s = r.gas_dt_s;
+    out.inner_steps = r.dem_steps;
+    out.inner_dt_s = r.dem_dt_s;
+    out.void_fraction_clamps = r.void_fraction_clamps;
     out.has_snapshot = r.has_snapshot;
-    if (r.has_snapshot) {
-      out.snapshot_t_s = r.snapshot.t_s;
-      out.snapshot_void_fraction = r.snapshot.void_fraction;
-      out.snapshot_bubble = r.snapshot.bubble;
-    }
+    if (r.has_snapshot) out.snapshot = r.snapshot;
     out.result_json = dpm_result_json(r);
     out.brief = r.BriefReport();
     return out;

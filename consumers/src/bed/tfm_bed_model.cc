@@ -89,11 +89,27 @@ class TfmBedModel : public BedModel {
   std::string description() const override {
     return "two-fluid model with the kinetic theory of granular flow (tfm.h)";
   }
+  TimeResolution time_resolution() const override {
+    return {"cfl",
+            "Courant number of the coupled step (the step is also bounded by [tfm] dt_max_s and "
+            "the granular pressure wave)",
+            "(0, 0.5]", /*whole_number=*/false, /*larger_is_finer=*/false};
+  }
+  double time_resolution_of(const Scene& scene) const override { return scene.tfm.cfl; }
+  Scene WithTimeResolution(const Scene& scene, double value) const override {
+    Scene s = scene;
+    s.tfm.cfl = value;
+    return s;
+  }
+
   BedResult Run(const Scene& scene, std::shared_ptr<const Law> law, const BedRunOptions& options,
-                const BedProgress& progress) const override {
+                const BedProgress& progress, const BedRealization* start) const override {
     const auto t0 = std::chrono::steady_clock::now();
     scene.Validate();
     if (!law) throw Error(ErrorCode::kInvalidArgument, "tfm: law is null");
+    if (start)
+      throw Error(ErrorCode::kInvalidArgument,
+                  "tfm: the two-fluid model is deterministic and starts from no realization");
     if (std::abs(scene.jet_center_m() - 0.5 * scene.geometry.width_m) >
         1e-9 * scene.geometry.width_m)
       throw Error(ErrorCode::kInvalidArgument,
@@ -166,7 +182,7 @@ class TfmBedModel : public BedModel {
           at_ref = smp;
           have_ref = true;
           ref_bubble = taken.bubble;
-          out.snapshot_void_fraction = internal::scene_grid_field(scene, tfm.gas_fraction());
+          out.snapshot.void_fraction = internal::scene_grid_field(scene, tfm.gas_fraction());
         }
         series.push_back({{"t_s", smp.t_s},
                           {"bubble_diameter_m", smp.bubble_diameter_m},
@@ -199,8 +215,8 @@ class TfmBedModel : public BedModel {
     out.steps = dg.steps;
     out.mean_dt_s = dg.steps > 0 ? tfm.time() / static_cast<double>(dg.steps) : 0.0;
     out.has_snapshot = have_ref;
-    out.snapshot_t_s = at_ref.t_s;
-    out.snapshot_bubble = ref_bubble;
+    out.snapshot.t_s = at_ref.t_s;
+    out.snapshot.bubble = ref_bubble;
     out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     m.wall_s = out.wall_s;
 

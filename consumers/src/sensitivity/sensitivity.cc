@@ -49,16 +49,14 @@ double CellSize(const Scene& s) {
   return std::max(s.geometry.width_m / s.grid.cells_x, s.geometry.height_m / s.grid.cells_y);
 }
 
-/// The scene on another grid (and DEM step), checked; `what` names the configuration in the
-/// message of a scene that cannot take it.
-Scene SceneOnGrid(const Scene& scene, GridSize grid, int contact_steps, const std::string& what) {
-  Scene s = scene;
+/// The scene on another grid (and, if `time_resolution` is given, at that value of the model's
+/// time resolution), checked; `what` names the configuration in the message of a scene that
+/// cannot take it.
+Scene SceneOnGrid(const Scene& scene, GridSize grid, const BedModel& model,
+                  const double* time_resolution, const std::string& what) {
+  Scene s = time_resolution ? model.WithTimeResolution(scene, *time_resolution) : scene;
   s.grid.cells_x = grid.cells_x;
   s.grid.cells_y = grid.cells_y;
-  if (contact_steps > 0) {
-    s.time.contact_steps = contact_steps;
-    s.time.dem_dt_s = 0.0;  // the DEM step follows contact_steps (t_c / contact_steps)
-  }
   std::string why;
   if (!s.IsValid(&why)) Fail(what + ": " + why);
   return s;
@@ -79,46 +77,16 @@ BedRunOptions RunOptions(const BedRunOptions& base, const Scene& s, const std::s
   return o;
 }
 
-/// The DPM's controls for a study run: the jet on, the particles free (the bubble needs both).
-DpmOptions DpmRunOptions(const BedRunOptions& run) {
-  DpmOptions o;
-  o.duration_s = run.duration_s;
-  o.output_directory = run.output_directory;
-  return o;
-}
-
 std::shared_ptr<const Law> Load(const LawLoader& load_law, const std::string& reference) {
   std::shared_ptr<const Law> law = load_law(reference);
   if (!law) Fail("law loader returned no law for '" + reference + "'");
   return law;
 }
 
-SensitivityRun MakeRun(const DpmResult& r, const Scene& s) {
+/// The study's record of one run.
+SensitivityRun MakeRun(const BedResult& r, const Scene& s, std::uint64_t seed) {
   SensitivityRun run;
-  run.seed = s.seed;
-  run.cells_x = s.grid.cells_x;
-  run.cells_y = s.grid.cells_y;
-  run.cell_size_m = CellSize(s);
-  run.bubble_found = r.bubble_at_t_ref;
-  run.reached_t_ref = r.has_snapshot;  // set at the sample nearest t_ref, if any was close
-  run.bubble_diameter_m = r.bubble_at_t_ref ? r.bubble_diameter_m : 0.0;
-  run.background_m_s = r.background_m_s;
-  run.wall_s = r.wall_s;
-  run.gas_steps = r.gas_steps;
-  run.dem_steps = r.dem_steps;
-  run.gas_dt_s = r.gas_dt_s;
-  run.dem_dt_s = r.dem_dt_s;
-  run.series = r.series;
-  run.momentum_mismatch = r.momentum_mismatch;
-  run.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
-  run.void_fraction_clamps = r.void_fraction_clamps;
-  run.drag_out_of_range = r.law_out_of_range;
-  return run;
-}
-
-/// A run of a bed model other than the DPM (no packing: seed 0, no DEM steps).
-SensitivityRun MakeBedRun(const BedResult& r, const Scene& s) {
-  SensitivityRun run;
+  run.seed = seed;
   run.cells_x = s.grid.cells_x;
   run.cells_y = s.grid.cells_y;
   run.cell_size_m = CellSize(s);
@@ -129,19 +97,22 @@ SensitivityRun MakeBedRun(const BedResult& r, const Scene& s) {
   run.wall_s = r.wall_s;
   run.gas_steps = r.steps;
   run.gas_dt_s = r.mean_dt_s;
+  run.dem_steps = r.inner_steps;
+  run.dem_dt_s = r.inner_dt_s;
   run.series = r.series;
   run.momentum_mismatch = r.momentum_mismatch;
   run.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
+  run.void_fraction_clamps = r.void_fraction_clamps;
   run.drag_out_of_range = r.law_out_of_range;
   return run;
 }
 
 /// A work-precision row from one run of its configuration.
-WorkPrecisionRow RowOf(const SensitivityRun& run, int contact_steps) {
+WorkPrecisionRow RowOf(const SensitivityRun& run, double time_resolution) {
   WorkPrecisionRow row;
   row.cells_x = run.cells_x;
   row.cells_y = run.cells_y;
-  row.contact_steps = contact_steps;
+  row.time_resolution = time_resolution;
   row.cell_size_m = run.cell_size_m;
   row.bubble_found = run.bubble_found;
   row.reached_t_ref = run.reached_t_ref;
@@ -154,30 +125,18 @@ WorkPrecisionRow RowOf(const SensitivityRun& run, int contact_steps) {
   return row;
 }
 
-/// The snapshot of a bed-model run for the figures: the gas fraction and its bubble, no
-/// particles (the figure draws the solids fraction as a grey scale then).
-DpmSnapshot BedSnapshot(const BedResult& r) {
-  DpmSnapshot snap;
-  snap.t_s = r.snapshot_t_s;
-  snap.void_fraction = r.snapshot_void_fraction;
-  snap.bubble = r.snapshot_bubble;
-  return snap;
-}
-
-/// Settles one packing of `scene` (its seed) with the DPM's own settling; the law is needed by
-/// the simulation object only (settling has no gas).
-Particles SettlePacking(const Scene& scene, std::shared_ptr<const Law> law,
-                        const DpmOptions& options, const DpmProgress& progress,
-                        SensitivityPacking* info) {
-  const auto t0 = Clock::now();
-  DpmSimulation settler(scene, std::move(law), options);
-  settler.Settle(progress);
-  Particles packing = settler.dem().particles();
-  info->seed = scene.seed;
-  info->particles = static_cast<std::int64_t>(packing.size());
-  info->settled_bed_height_m = settler.settled_bed_height_m();
-  info->settle_wall_s = Seconds(t0);
-  return packing;
+/// Prepares the realization of `scene` (its seed) for every law and grid of that seed.
+std::shared_ptr<const BedRealization> Realize(const BedModel& model, const Scene& scene,
+                                              std::shared_ptr<const Law> law,
+                                              const BedProgress& progress,
+                                              SensitivityPacking* info) {
+  std::shared_ptr<const BedRealization> realization =
+      model.Realize(scene, std::move(law), progress);
+  info->seed = realization->seed;
+  info->particles = realization->particles;
+  info->settled_bed_height_m = realization->bed_height_m;
+  info->settle_wall_s = realization->prepare_wall_s;
+  return realization;
 }
 
 /// Progress over `total` equal units (a settling or a run each). The stage text is the unit's
@@ -186,7 +145,7 @@ class StudyProgress {
  public:
   StudyProgress(const SensitivityProgress& progress, int total)
       : progress_(progress), total_(std::max(1, total)) {}
-  DpmProgress Unit(const std::string& label) {
+  BedProgress Unit(const std::string& label) {
     const int unit = done_++;
     if (!progress_) return nullptr;
     const std::string stage =
@@ -295,15 +254,15 @@ bool WorkPrecisionOptions::IsValid(std::string* error) const {
       }
     }
   }
-  for (std::size_t a = 0; ok && a < contact_steps.size(); ++a) {
-    if (contact_steps[a] < 20 || contact_steps[a] > 1000) {
-      why = "WorkPrecisionOptions.contact_steps: " + std::to_string(contact_steps[a]) +
-            " is outside [20, 1000] (DEM steps per contact time; 20 is the stability limit)";
+  for (std::size_t a = 0; ok && a < time_resolutions.size(); ++a) {
+    if (!std::isfinite(time_resolutions[a]) || time_resolutions[a] <= 0.0) {
+      why = "WorkPrecisionOptions.time_resolutions: " + Num(time_resolutions[a]) +
+            " is not a positive number";
       ok = false;
     }
     for (std::size_t b = 0; ok && b < a; ++b) {
-      if (contact_steps[a] == contact_steps[b]) {
-        why = "WorkPrecisionOptions.contact_steps: " + std::to_string(contact_steps[a]) +
+      if (time_resolutions[a] == time_resolutions[b]) {
+        why = "WorkPrecisionOptions.time_resolutions: " + Num(time_resolutions[a]) +
               " is listed twice";
         ok = false;
       }
@@ -403,16 +362,17 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   if (!options.IsValid(&why)) Fail(why);
   if (!load_law) Fail("run_sensitivity: no law loader given");
   const std::vector<std::string> laws = options.laws.empty() ? scene.laws : options.laws;
-  // A continuum model has no packing realizations: its uncertainty comes from two grids.
-  const bool particles = scene.solver == "dpm";
-  const UncertaintyMethod method = particles ? options.uncertainty : UncertaintyMethod::kGrids;
+  const BedModel& model = find_bed_model(scene.solver);
+  // A deterministic model has no realizations: its uncertainty comes from two grids.
+  const bool realized = !model.realization_kind().empty();
+  const UncertaintyMethod method = realized ? options.uncertainty : UncertaintyMethod::kGrids;
 
   // Grids and seeds of the study.
   std::vector<Scene> grid_scenes = {scene};
   if (method == UncertaintyMethod::kGrids) {
     GridSize fine{static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_x)),
                   static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_y))};
-    grid_scenes.push_back(SceneOnGrid(scene, fine, 0,
+    grid_scenes.push_back(SceneOnGrid(scene, fine, model, nullptr,
                                       "the finer grid (" + Num(options.grid_refinement) +
                                           " x the scene's, " +
                                           GridText(fine.cells_x, fine.cells_y) + " cells)"));
@@ -437,18 +397,19 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   summary.t_ref_s = scene.time.t_ref_s;
   summary.eps_threshold = scene.bubble.eps_threshold;
   for (const Scene& gs : grid_scenes) summary.grids.push_back({gs.grid.cells_x, gs.grid.cells_y});
+  const std::string kind = model.realization_kind();
   if (method == UncertaintyMethod::kRealizations) {
     summary.method_description =
-        std::to_string(n_seeds) + " packing realizations (seeds " + std::to_string(seeds.front()) +
-        ".." + std::to_string(seeds.back()) +
+        std::to_string(n_seeds) + " " + kind + " realizations (seeds " +
+        std::to_string(seeds.front()) + ".." + std::to_string(seeds.back()) +
         ") on one grid; D = mean of the runs; uncertainty = sqrt(SE^2 + h^2) with SE = s/sqrt(n) "
         "the standard error of the mean (n = 2: |D1 - D2|/2) and h = max(dx, dy) = " +
         Cm(CellSize(scene)) + " cm the bubble-boundary bound of the grid";
   } else {
     const double r = CellSize(grid_scenes[0]) / CellSize(grid_scenes[1]);
     summary.method_description =
-        (particles ? "one packing (seed " + std::to_string(scene.seed) + ")"
-                   : "the " + scene.solver + " model (deterministic: no packing realizations)") +
+        (realized ? "one " + kind + " (seed " + std::to_string(scene.seed) + ")"
+                  : "the " + scene.solver + " model (deterministic: no realizations)") +
         " on the grids " + GridText(scene.grid.cells_x, scene.grid.cells_y) + " and " +
         GridText(grid_scenes[1].grid.cells_x, grid_scenes[1].grid.cells_y) + " (r = " + Num(r) +
         "); D = the finer grid's; uncertainty = sqrt(E^2 + h^2) with E = |D_fine - D_coarse|/(r - "
@@ -460,53 +421,34 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   summary.laws.resize(laws.size());
   for (std::size_t i = 0; i < laws.size(); ++i) summary.laws[i].law = laws[i];
   StudyProgress study(
-      progress, static_cast<int>(particles ? seeds.size() * (1 + grid_scenes.size() * laws.size())
-                                           : grid_scenes.size() * laws.size()));
-  if (!particles) {
-    for (const Scene& run_scene : grid_scenes) {
-      const std::string tag = GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
+      progress,
+      static_cast<int>(seeds.size() * ((realized ? 1 : 0) + grid_scenes.size() * laws.size())));
+  for (const std::uint64_t seed : seeds) {
+    // Prepared once per seed; every law and grid of that seed starts from it.
+    std::shared_ptr<const BedRealization> realization;
+    if (realized) {
+      Scene seeded = scene;
+      seeded.seed = seed;
+      SensitivityPacking info;
+      realization = Realize(model, seeded, Load(load_law, laws.front()),
+                            study.Unit("settle " + kind + " seed " + std::to_string(seed)), &info);
+      summary.packings.push_back(info);
+    }
+    for (const Scene& grid_scene : grid_scenes) {
+      Scene run_scene = grid_scene;
+      run_scene.seed = seed;
+      const std::string grid = GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
+      const std::string tag = realized ? "seed" + std::to_string(seed) + "_" + grid : grid;
       for (std::size_t i = 0; i < laws.size(); ++i) {
         const BedResult r = run_bed_model(run_scene, Load(load_law, laws[i]),
                                           RunOptions(options.run, run_scene, laws[i], tag),
-                                          study.Unit(laws[i] + " " + tag));
+                                          study.Unit(laws[i] + " " + tag), realization.get());
         SensitivityLawResult& lr = summary.laws[i];
-        lr.runs.push_back(MakeBedRun(r, run_scene));
+        lr.runs.push_back(MakeRun(r, run_scene, realized ? seed : 0));
         lr.wall_s += r.wall_s;
         if (lr.runs.size() == 1) {
           lr.umf_m_s = r.metrics.umf_m_s;
           lr.background_m_s = r.metrics.background_m_s;
-          lr.background_mode = r.background_mode;
-          lr.has_snapshot = r.has_snapshot;
-          if (r.has_snapshot) lr.snapshot = BedSnapshot(r);
-        }
-      }
-    }
-  }
-  for (std::size_t k = 0; particles && k < seeds.size(); ++k) {
-    Scene seeded = scene;
-    seeded.seed = seeds[k];
-    SensitivityPacking packing_info;
-    // Settled once per realization; every law and grid starts from this same packing.
-    const Particles packing =
-        SettlePacking(seeded, Load(load_law, laws.front()), DpmRunOptions(options.run),
-                      study.Unit("settle packing seed " + std::to_string(seeds[k])), &packing_info);
-    summary.packings.push_back(packing_info);
-    for (std::size_t g = 0; g < grid_scenes.size(); ++g) {
-      Scene run_scene = grid_scenes[g];
-      run_scene.seed = seeds[k];
-      const std::string tag = "seed" + std::to_string(seeds[k]) + "_" +
-                              GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
-      for (std::size_t i = 0; i < laws.size(); ++i) {
-        DpmSimulation sim(run_scene, Load(load_law, laws[i]),
-                          DpmRunOptions(RunOptions(options.run, run_scene, laws[i], tag)));
-        sim.Start(packing);
-        const DpmResult r = sim.Run(study.Unit(laws[i] + " " + tag));
-        SensitivityLawResult& lr = summary.laws[i];
-        lr.runs.push_back(MakeRun(r, run_scene));
-        lr.wall_s += r.wall_s;
-        if (lr.runs.size() == 1) {
-          lr.umf_m_s = r.umf_m_s;
-          lr.background_m_s = r.background_m_s;
           lr.background_mode = r.background_mode;
           lr.has_snapshot = r.has_snapshot;
           if (r.has_snapshot) lr.snapshot = r.snapshot;
@@ -575,26 +517,32 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   std::string why;
   if (!options.IsValid(&why)) Fail(why);
   if (!load_law) Fail("run_work_precision: no law loader given");
-  const bool particles = scene.solver == "dpm";
-  if (!particles && !options.contact_steps.empty())
-    Fail(
-        "WorkPrecisionOptions.contact_steps: DEM contact steps apply to the dpm model only (this "
-        "scene's solver is \"" +
-        scene.solver + "\"): sweep grids alone");
+  const BedModel& model = find_bed_model(scene.solver);
+  const TimeResolution resolution = model.time_resolution();
+  for (double v : options.time_resolutions) {
+    if (resolution.whole_number && v != std::floor(v))
+      Fail("WorkPrecisionOptions.time_resolutions: " + resolution.name + " = " + Num(v) +
+           " is not a whole number (" + resolution.description + ", " + resolution.range + ")");
+  }
+  const bool realized = !model.realization_kind().empty();
   const std::vector<GridSize> grids =
       options.grids.empty() ? std::vector<GridSize>{{scene.grid.cells_x, scene.grid.cells_y}}
                             : options.grids;
-  const std::vector<int> steps = options.contact_steps.empty()
-                                     ? std::vector<int>{scene.time.contact_steps}
-                                     : options.contact_steps;
+  // The scene's own value goes through WithTimeResolution too, so that it alone sets the step
+  // (DPM: the scene's dem_dt_s is dropped for t_c / contact_steps) in every row alike.
+  const std::vector<double> steps = options.time_resolutions.empty()
+                                        ? std::vector<double>{model.time_resolution_of(scene)}
+                                        : options.time_resolutions;
 
   // Every configuration is checked (and the law's U_mf and gas steps) before the first run.
   std::vector<Scene> configs;
+  std::vector<double> config_steps;
   for (const GridSize& g : grids) {
-    for (int cs : steps) {
-      configs.push_back(SceneOnGrid(
-          scene, g, cs,
-          "grid " + GridText(g.cells_x, g.cells_y) + " with contact_steps " + std::to_string(cs)));
+    const std::string grid = "grid " + GridText(g.cells_x, g.cells_y);
+    for (const double& v : steps) {
+      configs.push_back(
+          SceneOnGrid(scene, g, model, &v, grid + " with " + resolution.name + " " + Num(v)));
+      config_steps.push_back(v);
     }
   }
   {
@@ -606,48 +554,44 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   result.scene = scene.name;
   result.scene_hash = scene.hash();
   result.law = options.law;
-  result.seed = scene.seed;
+  result.seed = realized ? scene.seed : 0;
+  result.time_resolution_name = resolution.name;
+  result.finer_time_is_larger = resolution.larger_is_finer;
   result.t_ref_s = scene.time.t_ref_s;
-  StudyProgress study(progress, (particles ? 1 : 0) + static_cast<int>(configs.size()));
-  Particles packing;
-  if (particles) {
-    SensitivityPacking packing_info;
-    // One packing, settled with the scene's own DEM settings, for every configuration.
-    packing = SettlePacking(scene, Load(load_law, options.law), DpmRunOptions(options.run),
-                            study.Unit("settle packing seed " + std::to_string(scene.seed)),
-                            &packing_info);
-    result.settle_wall_s = packing_info.settle_wall_s;
-  } else {
-    result.seed = 0;
+  StudyProgress study(progress, (realized ? 1 : 0) + static_cast<int>(configs.size()));
+  std::shared_ptr<const BedRealization> realization;
+  if (realized) {
+    SensitivityPacking info;
+    // One realization, prepared with the scene's own settings, for every configuration.
+    realization = Realize(
+        model, scene, Load(load_law, options.law),
+        study.Unit("settle " + model.realization_kind() + " seed " + std::to_string(scene.seed)),
+        &info);
+    result.settle_wall_s = info.settle_wall_s;
   }
-  for (const Scene& c : configs) {
-    if (!particles) {
-      const std::string tag = GridText(c.grid.cells_x, c.grid.cells_y);
-      const BedResult r = run_bed_model(c, Load(load_law, options.law),
-                                        RunOptions(options.run, c, options.law, tag),
-                                        study.Unit(options.law + " " + tag));
-      result.rows.push_back(RowOf(MakeBedRun(r, c), c.time.contact_steps));
-      result.umf_m_s = r.metrics.umf_m_s;
-      result.background_m_s = r.metrics.background_m_s;
-      continue;
-    }
+  for (std::size_t k = 0; k < configs.size(); ++k) {
+    const Scene& c = configs[k];
     const std::string tag =
-        GridText(c.grid.cells_x, c.grid.cells_y) + "_cs" + std::to_string(c.time.contact_steps);
-    DpmSimulation sim(c, Load(load_law, options.law),
-                      DpmRunOptions(RunOptions(options.run, c, options.law, tag)));
-    sim.Start(packing);
-    const DpmResult r = sim.Run(study.Unit(options.law + " " + tag));
-    result.rows.push_back(RowOf(MakeRun(r, c), c.time.contact_steps));
-    result.umf_m_s = r.umf_m_s;
-    result.background_m_s = r.background_m_s;
+        GridText(c.grid.cells_x, c.grid.cells_y) + "_" + resolution.name + Num(config_steps[k]);
+    const BedResult r =
+        run_bed_model(c, Load(load_law, options.law), RunOptions(options.run, c, options.law, tag),
+                      study.Unit(options.law + " " + tag), realization.get());
+    result.rows.push_back(RowOf(MakeRun(r, c, result.seed), config_steps[k]));
+    result.umf_m_s = r.metrics.umf_m_s;
+    result.background_m_s = r.metrics.background_m_s;
   }
 
-  // Reference: Richardson over the three finest grids at the finest DEM step, else the finest
-  // configuration (most cells, then most contact steps).
-  const int finest_steps = *std::max_element(steps.begin(), steps.end());
+  // Reference: Richardson over the three finest grids at the finest time step, else the finest
+  // configuration (most cells, then the finest time step).
+  const auto finer_time = [&](double a, double b) {
+    return resolution.larger_is_finer ? a > b : a < b;
+  };
+  double finest_steps = config_steps.front();
+  for (double v : config_steps)
+    if (finer_time(v, finest_steps)) finest_steps = v;
   std::vector<const WorkPrecisionRow*> at_finest_steps;
   for (const auto& row : result.rows)
-    if (row.contact_steps == finest_steps) at_finest_steps.push_back(&row);
+    if (row.time_resolution == finest_steps) at_finest_steps.push_back(&row);
   std::sort(at_finest_steps.begin(), at_finest_steps.end(),
             [](const WorkPrecisionRow* a, const WorkPrecisionRow* b) {
               return a->cell_size_m > b->cell_size_m;  // coarse to fine
@@ -690,7 +634,8 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
       const auto& b = result.rows[finest];
       const long cells_a = static_cast<long>(a.cells_x) * a.cells_y,
                  cells_b = static_cast<long>(b.cells_x) * b.cells_y;
-      if (cells_a > cells_b || (cells_a == cells_b && a.contact_steps > b.contact_steps))
+      if (cells_a > cells_b ||
+          (cells_a == cells_b && finer_time(a.time_resolution, b.time_resolution)))
         finest = k;
     }
     result.rows[finest].is_reference = true;
@@ -721,9 +666,10 @@ std::string WorkPrecisionResult::FullReport() const {
   std::ostringstream s;
   s << BriefReport();
   for (const WorkPrecisionRow& r : rows) {
-    s << "  grid " << GridText(r.cells_x, r.cells_y) << ", contact_steps " << r.contact_steps
-      << ": D " << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none"))
-      << ", error " << (std::isnan(r.error_m) ? std::string("(reference)") : Cm(r.error_m) + " cm")
+    s << "  grid " << GridText(r.cells_x, r.cells_y) << ", " << time_resolution_name << " "
+      << Num(r.time_resolution) << ": D "
+      << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none")) << ", error "
+      << (std::isnan(r.error_m) ? std::string("(reference)") : Cm(r.error_m) + " cm")
       << ", cell bound " << Cm(r.cell_size_m) << " cm, " << r.gas_steps << " gas / " << r.dem_steps
       << " DEM steps, " << Num(r.wall_s, 3) << " s wall\n";
   }

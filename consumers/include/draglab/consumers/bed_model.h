@@ -4,11 +4,18 @@
 // BedResult: U_mf and the background flow, the bubble at t_ref and its time series, the
 // balances, the law's out-of-range count, the cost, and the model's own full result as JSON (what
 // consumer results store). Models are registered by key, the scene's `[scene] solver`; `scene
-// run` and `regress` dispatch through run_bed_model, so a new model (TFM, DBM) plugs in by
-// registering, and scene validation accepts exactly the registered keys.
+// run`, `sensitivity`, work-precision and `regress` dispatch through the registry, so a new model
+// (DBM) plugs in by registering, and scene validation accepts exactly the registered keys.
+//
+// Two hooks say what the studies (sensitivity.h) vary for a model:
+//  - a realization is the random state every law and grid of one seed starts from, prepared once
+//    per seed (DPM: a packing settled with scene.seed). A deterministic model has none
+//    (realization_kind() empty) and its uncertainty comes from grids only;
+//  - the time resolution is the one scene value that sets the model's time step, swept by the
+//    work-precision study beside the grid (DPM: DEM steps per contact time; TFM: the CFL number).
 //
 // Built in: "dpm" (dpm.h, CFD-DEM) and "tfm" (tfm.h, two-fluid with KTGF). Units SI. Thread-safety:
-// register before running.
+// register before running; a registered model is immutable and may run on several threads.
 #pragma once
 
 #include <cstdint>
@@ -47,20 +54,40 @@ struct BedResult {
   double wall_s = 0.0;
   int threads = 1;
   std::vector<std::string> output_files;
-  long steps = 0;          ///< Gas (DPM) or coupled (TFM) time steps.
-  double mean_dt_s = 0.0;  ///< Simulated time / steps.
-  /// The state at the sample nearest to t_ref (false: the run ended before it): the gas
-  /// fraction on the scene's grid and the bubble measured in it, for figures.
+  long steps = 0;                ///< Gas (DPM) or coupled (TFM) time steps.
+  double mean_dt_s = 0.0;        ///< Simulated time / steps.
+  std::int64_t inner_steps = 0;  ///< Steps inside the time steps (DPM: DEM steps); 0: none.
+  double inner_dt_s = 0.0;       ///< Their step (DPM: the DEM step).
+  std::int64_t void_fraction_clamps = 0;  ///< Cells whose gas fraction was clamped (DPM).
+  /// The state at the sample nearest to t_ref (false: the run ended before it), for figures.
   bool has_snapshot = false;
-  double snapshot_t_s = 0.0;  ///< After the jet start.
-  GridField2D snapshot_void_fraction;
-  BubbleMetrics snapshot_bubble;
+  BedSnapshot snapshot;
   std::string result_json;  ///< The model's full result (a JSON object with "solver": key).
   std::string brief;        ///< One-line report.
 };
 
 /// Progress: fraction in [0, 1] and a stage text.
 using BedProgress = std::function<void(double fraction, const std::string& stage)>;
+
+/// The random state a model's runs of one seed start from (see the file comment). Models derive
+/// from it to hold their state (the DPM: the settled particles); callers see what it reports.
+class BedRealization {
+ public:
+  virtual ~BedRealization() = default;
+  std::uint64_t seed = 0;       ///< The scene seed it was prepared with.
+  std::int64_t particles = 0;   ///< Particles in it (0 for a model without particles).
+  double bed_height_m = 0.0;    ///< Its bed height (DPM: the settled bed).
+  double prepare_wall_s = 0.0;  ///< What preparing it cost.
+};
+
+/// The scene value that sets a model's time step (see the file comment).
+struct TimeResolution {
+  std::string name;             ///< Its scene key and study column ("contact_steps", "cfl").
+  std::string description;      ///< What it is, one phrase.
+  std::string range;            ///< Allowed values, as the scene checks them ("[20, 1000]").
+  bool whole_number = false;    ///< Only integers are allowed.
+  bool larger_is_finer = true;  ///< Direction of refinement (CFL: smaller is finer).
+};
 
 /// A bed model. Run throws draglab::Error as the model documents (invalid scene: kInvalidArgument;
 /// a bed outside the law's validity box: kOutOfValidity; instability: with a diagnosis).
@@ -69,8 +96,28 @@ class BedModel {
   virtual ~BedModel() = default;
   virtual std::string key() const = 0;          ///< The `[scene] solver` value.
   virtual std::string description() const = 0;  ///< One line.
+
+  /// What a realization is ("packing"); empty: the model is deterministic and has none.
+  virtual std::string realization_kind() const { return ""; }
+  /// Prepares the realization of scene.seed, to be passed to Run for every law and grid of that
+  /// seed (`law` only for models whose preparation needs one). Throws Error(kInvalidArgument)
+  /// for a model without realizations.
+  virtual std::shared_ptr<const BedRealization> Realize(const Scene& scene,
+                                                        std::shared_ptr<const Law> law,
+                                                        const BedProgress& progress) const;
+
+  virtual TimeResolution time_resolution() const = 0;
+  /// The scene's value of time_resolution().name.
+  virtual double time_resolution_of(const Scene& scene) const = 0;
+  /// The scene with that value set (and whatever else must follow it); the caller validates.
+  virtual Scene WithTimeResolution(const Scene& scene, double value) const = 0;
+
+  /// One run. `start`: a realization of this model made by Realize with scene.seed (reused
+  /// across laws and grids); null: the run prepares its own. Throws Error(kInvalidArgument) for
+  /// a realization of another model or seed.
   virtual BedResult Run(const Scene& scene, std::shared_ptr<const Law> law,
-                        const BedRunOptions& options, const BedProgress& progress) const = 0;
+                        const BedRunOptions& options, const BedProgress& progress,
+                        const BedRealization* start = nullptr) const = 0;
 };
 
 /// Adds a model. Throws Error(kInvalidArgument) for an empty or already registered key.
@@ -79,10 +126,12 @@ void register_bed_model(std::unique_ptr<BedModel> model);
 std::vector<std::string> bed_model_keys();
 /// Throws Error(kInvalidArgument) naming the registered keys when `key` is not one.
 const BedModel& find_bed_model(const std::string& key);
-/// Runs `scene` with the model its `solver` names.
+/// Runs `scene` with the model its `solver` names (from `start`, if given: see BedModel::Run),
+/// after checking the options.
 BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
                         const BedRunOptions& options = BedRunOptions(),
-                        const BedProgress& progress = nullptr);
+                        const BedProgress& progress = nullptr,
+                        const BedRealization* start = nullptr);
 
 }  // namespace consumers
 }  // namespace draglab

@@ -87,5 +87,17 @@ struct BedSample {
   double pressure_drop_pa = 0.0;   ///< Width-averaged p(first cell centre) - p(outlet).
 };
 
+/// A bed model's state at one instant, for figures: the gas fraction on the scene's grid, the
+/// bubble measured in it and, for a particle model, the particles (empty for a continuum model,
+/// whose figure draws the solids fraction instead).
+struct BedSnapshot {
+  double t_s = 0.0;              ///< After jet start [s].
+  std::vector<double> x, y, z;   ///< Particle centres [m] (x width, y height, z depth).
+  std::vector<double> diameter;  ///< [m].
+  std::vector<int> layer;        ///< Initial layer, 0 (bottom) .. dpm.h kInitialLayers - 1.
+  GridField2D void_fraction;     ///< Gas fraction (x, height).
+  BubbleMetrics bubble;          ///< measure_bubble on void_fraction.
+};
+
 }  // namespace consumers
 }  // namespace draglab

@@ -58,15 +58,8 @@ using DpmSample = BedSample;
 /// bed, bottom = 0), as the experiment colours them so that mixing shows.
 constexpr int kInitialLayers = 6;
 
-/// The particles and the void fraction at one instant (figures and files).
-struct DpmSnapshot {
-  double t_s = 0.0;              ///< After jet start [s].
-  std::vector<double> x, y, z;   ///< Particle centres [m] (x width, y height, z depth).
-  std::vector<double> diameter;  ///< [m].
-  std::vector<int> layer;        ///< Initial layer, 0 (bottom) .. kInitialLayers - 1.
-  GridField2D void_fraction;     ///< Mapped gas fraction (x, height).
-  BubbleMetrics bubble;          ///< measure_bubble on void_fraction.
-};
+/// The particles and the mapped void fraction at one instant (figures and files).
+using DpmSnapshot = BedSnapshot;
 
 /// Per gas step coupling diagnostics (the last step).
 struct DpmStepDiagnostics {

@@ -1,35 +1,34 @@
 // draglab/consumers/sensitivity.h: how much a bed model's bubble depends on the drag law, each
 // law's bubble diameter with its numerical uncertainty (the seed's Fig. 4 and 5 studies), and the
-// work-precision study of one law (bubble diameter against grid size and DEM step, with run
-// times). The DPM (dpm.h) is described below; any other registered model (bed_model.h, e.g. the
-// two-fluid model) runs through run_bed_model, deterministic, so its uncertainty always comes
-// from two grids and its work-precision sweeps grids only.
+// work-precision study of one law (bubble diameter against grid size and time step, with run
+// times). Every registered bed model (bed_model.h) runs through the same code: its realization
+// and time-resolution hooks say what the studies vary.
 //
-// run_sensitivity runs one scene (scene.h, docs/scenes.md) per law with the coupled DPM (dpm.h)
-// and reports the bubble diameter D at t_ref with an uncertainty from one of two sources:
-//  - realizations (default): the packing is settled once per seed (scene.seed, scene.seed + 1,
-//    ...) and every law starts from that same packing; the statistical part is the standard
-//    error of the mean over the n realizations, s / sqrt(n) with s the sample standard deviation
-//    (for n = 2: |D1 - D2| / 2);
-//  - grids: one packing, the scene's grid and a grid refined by grid_refinement (1.5); the value
-//    is the finer grid's D and the statistical part the Richardson error estimate of the finer
-//    value for first-order convergence (the traced boundary of a bubble is O(h)):
-//    |D_fine - D_coarse| / (r - 1), r = h_coarse / h_fine.
+// run_sensitivity runs one scene (scene.h, docs/scenes.md) per law and reports the bubble
+// diameter D at t_ref with an uncertainty from one of two sources:
+//  - realizations (default, for a model that has them, e.g. the DPM's packings): the
+//    realization is prepared once per seed (scene.seed, scene.seed + 1, ...) and every law
+//    starts from it; the statistical part is the standard error of the mean over the n
+//    realizations, s / sqrt(n) with s the sample standard deviation (for n = 2: |D1 - D2| / 2);
+//  - grids (always, for a deterministic model): one realization, the scene's grid and a grid
+//    refined by grid_refinement (1.5); the value is the finer grid's D and the statistical part
+//    the Richardson error estimate of the finer value for first-order convergence (the traced
+//    boundary of a bubble is O(h)): |D_fine - D_coarse| / (r - 1), r = h_coarse / h_fine.
 // Either part is combined in quadrature with the discretisation bound of the bubble boundary,
 // h = max(dx, dy) of the (finest) grid used (bubble.h: |D - D_true| <~ one cell), which also
 // guards against two runs that agree by chance. The figures of draglab_fig4.py read the
-// snapshots (particles coloured by their initial layer, void fraction, bubble metrics) of the
-// first run of each law.
+// snapshots (the particles coloured by their initial layer, or the solids fraction; the void
+// fraction; the bubble metrics) of the first run of each law.
 //
-// run_work_precision runs one law on a list of grids x DEM contact steps from the same packing
-// (settled once with the scene's own DEM settings) and reports per configuration D at t_ref,
-// wall time, gas and DEM steps and the error against a reference: the Richardson extrapolation
-// of the three finest grids when they are refined by one common ratio and converge monotonically,
+// run_work_precision runs one law on a list of grids x values of the model's time resolution
+// (DPM: DEM contact steps; TFM: CFL number) from one realization, and reports per configuration D
+// at t_ref, wall time, steps and the error against a reference: the Richardson extrapolation of
+// the three finest grids when they are refined by one common ratio and converge monotonically,
 // else the finest configuration itself ("finest as reference", whose own error is then unknown).
 //
-// Units SI. Limits: what dpm.h says (one gas cell across the depth, monodisperse, central jet);
-// two realizations give a rough standard error (a t-interval with one degree of freedom would be
-// 12.7 times wider at 95 %); the grid estimate assumes first-order convergence.
+// Units SI. Limits: what the models say (dpm.h, tfm.h); two realizations give a rough standard
+// error (a t-interval with one degree of freedom would be 12.7 times wider at 95 %); the grid
+// estimate assumes first-order convergence.
 #pragma once
 
 #include <cstdint>
@@ -39,7 +38,6 @@
 #include <vector>
 
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/law.h"
 
@@ -53,8 +51,8 @@ using LawLoader = std::function<std::shared_ptr<const Law>(const std::string& re
 
 /// Where the numerical uncertainty of a law's bubble diameter comes from.
 enum class UncertaintyMethod {
-  kRealizations,  ///< Several packing realizations (seeds), same grid.
-  kGrids,         ///< One packing, the scene's grid and a finer one.
+  kRealizations,  ///< Several realizations (seeds), same grid; grids for a deterministic model.
+  kGrids,         ///< One realization, the scene's grid and a finer one.
 };
 const char* to_string(UncertaintyMethod method);
 /// "realizations" or "grids"; anything else is Error(kInvalidArgument) naming the choices.
@@ -73,7 +71,7 @@ std::vector<GridSize> parse_grid_list(const std::string& text, const std::string
 struct SensitivityOptions {
   std::vector<std::string> laws;  ///< "name@version", no duplicates; empty: the scene's [drag].
   UncertaintyMethod uncertainty = UncertaintyMethod::kRealizations;
-  /// kRealizations: packings with seeds scene.seed, scene.seed + 1, ...; [2, 32].
+  /// kRealizations: seeds scene.seed, scene.seed + 1, ...; [2, 32].
   int realizations = 2;
   /// kGrids: the finer grid has round(factor x cells) cells each way; (1, 4].
   double grid_refinement = 1.5;
@@ -83,9 +81,9 @@ struct SensitivityOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// One coupled run of one law.
+/// One run of one law.
 struct SensitivityRun {
-  std::uint64_t seed = 0;  ///< Packing realization.
+  std::uint64_t seed = 0;  ///< Realization (0 for a deterministic model).
   int cells_x = 0, cells_y = 0;
   double cell_size_m = 0.0;        ///< max(dx, dy): the boundary bound of this grid.
   double bubble_diameter_m = 0.0;  ///< D at t_ref; 0 when no bubble was found there.
@@ -94,17 +92,17 @@ struct SensitivityRun {
   /// to whole gas steps) ended before t_ref, so "no bubble" means "not measured".
   bool reached_t_ref = false;
   double background_m_s = 0.0;  ///< Background used (umf_packing: depends on the packing).
-  double wall_s = 0.0;          ///< Coupled run only (the packing's settling is reported apart).
-  long gas_steps = 0;
-  std::int64_t dem_steps = 0;
+  double wall_s = 0.0;          ///< The run only (preparing its realization is reported apart).
+  long gas_steps = 0;           ///< BedResult::steps.
+  std::int64_t dem_steps = 0;   ///< BedResult::inner_steps (DEM steps; 0 without particles).
   double gas_dt_s = 0.0, dem_dt_s = 0.0;
-  double momentum_mismatch = 0.0;            ///< dpm.h DpmResult::momentum_mismatch.
-  double max_relative_mass_imbalance = 0.0;  ///< dpm.h.
+  double momentum_mismatch = 0.0;            ///< BedResult::momentum_mismatch.
+  double max_relative_mass_imbalance = 0.0;  ///< Gas mass balance.
   std::int64_t void_fraction_clamps = 0;
   std::uint64_t drag_out_of_range = 0;  ///< Clamped/extrapolated drag evaluations.
-  /// The bubble time series of the run (dpm.h DpmSample): shows whether t_ref falls while the
-  /// bubble grows, holds or rains out.
-  std::vector<DpmSample> series;
+  /// The bubble time series of the run: shows whether t_ref falls while the bubble grows,
+  /// holds or rains out.
+  std::vector<BedSample> series;
 };
 
 /// D with its numerical uncertainty [m] (see the file comment for the two methods).
@@ -134,18 +132,18 @@ struct SensitivityLawResult {
   DiameterUncertainty diameter;
   int bubbles_found = 0;  ///< Runs that found a bubble at t_ref.
   double wall_s = 0.0;    ///< Sum of the runs' wall times.
-  /// The first run's state at t_ref (particles, initial layers, void fraction, bubble), for the
-  /// figure; has_snapshot is false if the run ended before t_ref.
+  /// The first run's state at t_ref (particles and their initial layers for a particle model,
+  /// void fraction, bubble), for the figure; has_snapshot is false if the run ended before t_ref.
   bool has_snapshot = false;
-  DpmSnapshot snapshot;
+  BedSnapshot snapshot;
 };
 
-/// One settled packing (shared by every law of its realization).
+/// One realization (DPM: a settled packing), shared by every law and grid of its seed.
 struct SensitivityPacking {
   std::uint64_t seed = 0;
   std::int64_t particles = 0;
   double settled_bed_height_m = 0.0;
-  double settle_wall_s = 0.0;
+  double settle_wall_s = 0.0;  ///< What preparing it cost.
 };
 
 /// Result of run_sensitivity.
@@ -153,45 +151,47 @@ struct SensitivitySummary {
   std::string scene;
   std::string scene_hash;
   UncertaintyMethod method = UncertaintyMethod::kRealizations;
-  std::string method_description;  ///< How the uncertainty was formed, in words.
-  double t_ref_s = 0.0;            ///< After jet start.
-  double eps_threshold = 0.0;      ///< Bubble criterion.
-  std::vector<GridSize> grids;     ///< Grids run (one, or coarse and fine).
-  std::vector<SensitivityPacking> packings;
-  std::vector<SensitivityLawResult> laws;  ///< In the order asked.
-  double wall_s = 0.0;                     ///< Everything, settling included.
+  std::string method_description;            ///< How the uncertainty was formed, in words.
+  double t_ref_s = 0.0;                      ///< After jet start.
+  double eps_threshold = 0.0;                ///< Bubble criterion.
+  std::vector<GridSize> grids;               ///< Grids run (one, or coarse and fine).
+  std::vector<SensitivityPacking> packings;  ///< Realizations prepared (none: deterministic).
+  std::vector<SensitivityLawResult> laws;    ///< In the order asked.
+  double wall_s = 0.0;                       ///< Everything, settling included.
   /// One line per law: D = mean +- uncertainty.
   std::string BriefReport() const;
   /// BriefReport plus the method, every run's D, steps and wall time, the packings.
   std::string FullReport() const;
 };
 
-/// Progress: fraction of the whole study in [0, 1] and the current unit (a settling or a run),
+/// Progress: fraction of the whole study in [0, 1] and the current unit (a realization or a run),
 /// "LABEL (k of N)", constant while that unit runs.
 using SensitivityProgress = std::function<void(double fraction, const std::string& stage)>;
 
 /// Runs every law of the scene (or options.laws) as described in the file comment. All laws are
 /// loaded and every grid and law checked (U_mf, time steps) before the first run, so bad input
 /// fails fast. Throws Error(kInvalidArgument) for invalid options or a finer grid the scene
-/// cannot take, the loader's errors (unknown law), and the DPM run's diagnoses.
+/// cannot take, the loader's errors (unknown law), and the model's diagnoses.
 SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law,
                                    const SensitivityOptions& options,
                                    const SensitivityProgress& progress = nullptr);
 
 /// Controls of run_work_precision.
 struct WorkPrecisionOptions {
-  std::string law;                 ///< One "name@version"; required.
-  std::vector<GridSize> grids;     ///< Empty: the scene's grid. No duplicates.
-  std::vector<int> contact_steps;  ///< DEM steps per contact time, [20, 1000]; empty: scene's.
-  BedRunOptions run;               ///< Run controls every model takes.
+  std::string law;              ///< One "name@version"; required.
+  std::vector<GridSize> grids;  ///< Empty: the scene's grid. No duplicates.
+  /// Values of the model's time resolution (BedModel::time_resolution: DPM contact_steps, TFM
+  /// cfl), each within the range the scene allows; no duplicates; empty: the scene's.
+  std::vector<double> time_resolutions;
+  BedRunOptions run;  ///< Run controls every model takes.
   bool IsValid(std::string* error) const;
 };
 
 /// One configuration of the work-precision study.
 struct WorkPrecisionRow {
   int cells_x = 0, cells_y = 0;
-  int contact_steps = 0;
-  double cell_size_m = 0.0;  ///< max(dx, dy): the bubble boundary bound of this grid.
+  double time_resolution = 0.0;  ///< Value of WorkPrecisionResult::time_resolution_name.
+  double cell_size_m = 0.0;      ///< max(dx, dy): the bubble boundary bound of this grid.
   double bubble_diameter_m = 0.0;
   bool bubble_found = false;
   bool reached_t_ref = false;  ///< As SensitivityRun::reached_t_ref.
@@ -199,7 +199,7 @@ struct WorkPrecisionRow {
   /// reference" (its error is not known).
   double error_m = 0.0;
   bool is_reference = false;
-  double wall_s = 0.0;  ///< Coupled run (settling excluded: one packing for all rows).
+  double wall_s = 0.0;  ///< The run (its realization excluded: one for all rows).
   long gas_steps = 0;
   std::int64_t dem_steps = 0;
   double gas_dt_s = 0.0, dem_dt_s = 0.0;
@@ -223,25 +223,27 @@ struct WorkPrecisionResult {
   std::string scene;
   std::string scene_hash;
   std::string law;
-  std::uint64_t seed = 0;
+  std::uint64_t seed = 0;            ///< The realization's (0: a deterministic model).
+  std::string time_resolution_name;  ///< The model's ("contact_steps", "cfl").
+  bool finer_time_is_larger = true;  ///< Whether a larger value is the finer step.
   double umf_m_s = 0.0, background_m_s = 0.0;
   double t_ref_s = 0.0;
   /// "richardson" (observed order and extrapolated D below) or "finest as reference".
   std::string reference_method;
   double reference_diameter_m = 0.0;
-  double observed_order = 0.0;  ///< Richardson only; 0 otherwise.
-  std::string reference_note;   ///< Why Richardson was not possible, when it was not.
-  double settle_wall_s = 0.0;
-  std::vector<WorkPrecisionRow> rows;  ///< Grids in the order given, contact steps inside.
+  double observed_order = 0.0;         ///< Richardson only; 0 otherwise.
+  std::string reference_note;          ///< Why Richardson was not possible, when it was not.
+  double settle_wall_s = 0.0;          ///< Preparing the realization.
+  std::vector<WorkPrecisionRow> rows;  ///< Grids in the order given, time resolutions inside.
   double wall_s = 0.0;
   std::string BriefReport() const;  ///< The reference and the range of errors and times.
   std::string FullReport() const;   ///< BriefReport plus the table.
 };
 
-/// Runs the study (every grid with every contact_steps value; the scene's dem_dt_s is set to 0
-/// so that contact_steps sets the DEM step). Throws Error(kInvalidArgument) for invalid options
-/// or a configuration the scene cannot take (grid finer than a particle, gas step), the loader's
-/// errors, and the DPM run's diagnoses.
+/// Runs the study (every grid with every time-resolution value, set by the model's
+/// WithTimeResolution). Throws Error(kInvalidArgument) for invalid options or a configuration the
+/// scene cannot take (grid finer than a particle, gas step, a time resolution out of range), the
+/// loader's errors, and the model's diagnoses.
 WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load_law,
                                        const WorkPrecisionOptions& options,
                                        const SensitivityProgress& progress = nullptr);
