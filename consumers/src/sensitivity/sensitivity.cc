@@ -555,6 +555,7 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   result.scene_hash = scene.hash();
   result.law = options.law;
   result.seed = realized ? scene.seed : 0;
+  result.realization_kind = model.realization_kind();
   result.time_resolution_name = resolution.name;
   result.finer_time_is_larger = resolution.larger_is_finer;
   result.t_ref_s = scene.time.t_ref_s;
@@ -652,12 +653,14 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
 
 std::string WorkPrecisionResult::BriefReport() const {
   std::ostringstream s;
-  s << "Work-precision of " << law << " on scene " << scene << " (seed " << seed
-    << "): D at t_ref = " << Num(t_ref_s) << " s; reference " << reference_method
+  s << "Work-precision of " << law << " on scene " << scene;
+  if (!realization_kind.empty()) s << " (" << realization_kind << " seed " << seed << ")";
+  s << ": D at t_ref = " << Num(t_ref_s) << " s; reference " << reference_method
     << " D = " << Cm(reference_diameter_m) << " cm";
   if (reference_method == "richardson") s << " (observed order " << Num(observed_order, 3) << ")";
-  s << "; " << rows.size() << " configurations, settling " << Num(settle_wall_s, 3) << " s, total "
-    << Num(wall_s, 3) << " s wall\n";
+  s << "; " << rows.size() << " configurations, ";
+  if (!realization_kind.empty()) s << realization_kind << " " << Num(settle_wall_s, 3) << " s, ";
+  s << "total " << Num(wall_s, 3) << " s wall\n";
   if (!reference_note.empty()) s << "  " << reference_note << "\n";
   return s.str();
 }

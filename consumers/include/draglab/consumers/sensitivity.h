@@ -224,6 +224,7 @@ struct WorkPrecisionResult {
   std::string scene_hash;
   std::string law;
   std::uint64_t seed = 0;            ///< The realization's (0: a deterministic model).
+  std::string realization_kind;      ///< The model's ("packing"); empty: deterministic.
   std::string time_resolution_name;  ///< The model's ("contact_steps", "cfl").
   bool finer_time_is_larger = true;  ///< Whether a larger value is the finer step.
   double umf_m_s = 0.0, background_m_s = 0.0;
