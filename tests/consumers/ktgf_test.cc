@@ -18,7 +18,9 @@
 //     and the dilute part is a quarter of mu there) and makes the dilute viscosity
 //     proportional to phi; the
 //     Johnson-Jackson pressure and the Schaeffer viscosity follow their formulas (the latter
-//     capped); dP/dphi matches a finite difference of P.
+//     capped); dP/dphi matches a finite difference of P; OpenFOAM's JohnsonJackson viscosity
+//     (v1912 frictionalStressModels/JohnsonJackson: nu = 0.5 s P_f/rho sin(angle) in a stress
+//     alpha rho nu) is phi 0.5 s P_f sin(angle) at any shear rate.
 // (5) Local-equilibrium theta (the algebraic option) in simple shear at rate G (D':D' = G^2/2,
 //     div v = 0) with the Gidaspow book forms of (2): mu = M sqrt(theta), gamma = Q theta^1.5
 //     and a drag sink s theta give Q x^2 + s x - M G^2 = 0 for x = sqrt(theta), solved here by
@@ -186,6 +188,28 @@ TEST(Ktgf, JohnsonJacksonSchaefferFriction) {
                      k.Evaluate(0.58 - h, th, 0, rate).pressure_pa) /
                     (2.0 * h);
   EXPECT_NEAR(k.Evaluate(0.58, th, 0, rate).pressure_derivative_pa, fd, 1e-5 * fd);
+}
+
+TEST(Ktgf, JohnsonJacksonOpenFoamFrictionViscosityIgnoresTheShearRate) {
+  KtgfOptions o;
+  o.friction = FrictionModel::kJohnsonJacksonOpenFoam;
+  o.friction_max_viscosity_pa_s = 5000.0;
+  const KtgfClosures k(o, kD, kRho);
+  const double phi = 0.6;
+  const double pf = 0.05 * std::pow(phi - 0.5, 2) / std::pow(0.64 - phi, 5);
+  const double mu_f = phi * 0.5 * pf * std::sin(28.5 * kPi / 180.0);
+  for (double rate : {1e-9, 1.0, 200.0}) {
+    const KtgfCoefficients c = k.Evaluate(phi, 0.0, 0.0, rate);
+    EXPECT_NEAR(c.frictional_pressure_pa, pf, 1e-12 * pf);
+    EXPECT_NEAR(c.frictional_viscosity_pa_s, mu_f, 1e-12 * mu_f) << rate;
+  }
+  o.friction_max_viscosity_pa_s = 10.0;
+  EXPECT_DOUBLE_EQ(KtgfClosures(o, kD, kRho).Evaluate(phi, 0.0, 0.0, 1.0).frictional_viscosity_pa_s,
+                   10.0)
+      << "capped";
+  FrictionModel parsed = FrictionModel::kNone;
+  EXPECT_TRUE(parse_friction_model("johnson_jackson_openfoam", &parsed));
+  EXPECT_EQ(parsed, FrictionModel::kJohnsonJacksonOpenFoam);
 }
 
 TEST(Ktgf, EquilibriumThetaInSimpleShearMatchesTheClosedForm) {

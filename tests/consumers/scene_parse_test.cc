@@ -126,17 +126,26 @@ TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
   EXPECT_EQ(s.tfm.solids_walls, "free_slip");
   EXPECT_EQ(s.tfm.fraction_scheme, "upwind");
   EXPECT_EQ(s.tfm.granular_temperature, "transport");
+  EXPECT_EQ(s.tfm.solids_viscosity, "explicit");
   EXPECT_DOUBLE_EQ(s.tfm.friction_max_viscosity_pa_s, 10.0);
   const Scene options =
-      parse_scene(edit(base, "tfm", "closures",
+      parse_scene(edit(edit(base, "tfm", "friction", "friction = \"johnson_jackson_openfoam\""),
+                       "tfm", "closures",
                        "closures = \"nieuwland\"\nsolids_walls = \"no_slip\"\nfraction_scheme = "
                        "\"van_leer\"\ngranular_temperature = \"algebraic\"\n"
-                       "friction_max_viscosity_pa_s = 100.0"),
+                       "friction_max_viscosity_pa_s = 100.0\nsolids_viscosity = "
+                       "\"point_implicit\""),
                   "edited.toml");
   EXPECT_EQ(options.tfm.solids_walls, "no_slip");
   EXPECT_EQ(options.tfm.fraction_scheme, "van_leer");
   EXPECT_EQ(options.tfm.granular_temperature, "algebraic");
   EXPECT_DOUBLE_EQ(options.tfm.friction_max_viscosity_pa_s, 100.0);
+  EXPECT_EQ(options.tfm.solids_viscosity, "point_implicit");
+  EXPECT_EQ(options.tfm.friction, "johnson_jackson_openfoam");
+  expect_bad(edit(base, "tfm", "closures", "solids_viscosity = \"implicit\""),
+             {"[tfm] solids_viscosity", "point_implicit"});
+  expect_bad(edit(base, "tfm", "friction", "friction = \"coulomb\""),
+             {"[tfm] friction", "johnson_jackson_openfoam"});
   expect_bad(edit(base, "tfm", "closures", "solids_walls = \"sticky\""),
              {"[tfm] solids_walls", "no_slip"});
   expect_bad(edit(base, "tfm", "closures", "fraction_scheme = \"quick\""),

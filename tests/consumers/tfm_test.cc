@@ -243,6 +243,78 @@ TEST_F(TfmTest, SedimentingColumnWithFrictionRestsOnItsContactPressure) {
   EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
 }
 
+// Point-implicit solids viscosity (SolidsViscosity::kPointImplicit), for frictional
+// viscosities whose explicit limit would set the step. Set-up: the friction column of the test
+// above with the Schaeffer cap raised from 10 to 1000 Pa s, settling for 2 s. References:
+// (1) the same analytic contact-pressure balance (the bed at rest does not depend on how the
+// viscous term is integrated), within the same 1e-3; (2) the run's steps are not set by the
+// viscous limit, and its mean step is more than 10 x the explicit limit of its own final state
+// (which the explicit scheme would have had to take); (3) solids conserved to round-off.
+TEST_F(TfmTest, PointImplicitViscosityLetsAFrictionalBedRestAtTheExplicitLimitsMultiple) {
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.particle_diameter_m = 5e-4;
+  o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
+  o.ktgf.friction_max_viscosity_pa_s = 1000.0;
+  o.initial_solids = 0.3;
+  o.initial_bed_height_m = 0.12;
+  o.initial_theta_m2_s2 = 1e-4;
+  o.solids_viscosity = SolidsViscosity::kPointImplicit;
+  TfmSimulation tfm(o, law("ergun@1"));
+  tfm.AdvanceTo(2.0);
+  const TfmDiagnostics& dg = tfm.diagnostics();
+  const KtgfOptions& k = o.ktgf;
+  auto residual = [&](double phi) {
+    const double pf = k.friction_fr_pa * std::pow(phi - k.friction_min_solids, k.friction_n) /
+                      std::pow(std::max(k.packing_limit - phi, k.friction_delta), k.friction_p);
+    return pf - (kRhoS - kRhoG) * kG * (0.036 - 0.5 * phi * tfm.dz());
+  };
+  double lo = k.friction_min_solids, hi = k.packing_limit;
+  for (int n = 0; n < 100; ++n) (residual(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+  EXPECT_LT(dg.max_solids_fraction, k.packing_limit);
+  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), 0.5 * (lo + hi), 1e-3) << dg.BriefReport();
+  EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
+  EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
+  EXPECT_EQ(dg.steps_by_limit[static_cast<int>(TfmStepLimit::kSolidsViscosity)], 0);
+  EXPECT_GT(dg.implicit_viscosity_faces, 0);
+
+  TfmOptions explicit_options = o;
+  explicit_options.solids_viscosity = SolidsViscosity::kExplicit;
+  TfmSimulation explicit_at_end(explicit_options, law("ergun@1"));
+  explicit_at_end.SetState(tfm.solids_fraction(), tfm.theta());
+  TfmStepLimit why = TfmStepLimit::kMaximum;
+  const double explicit_dt = explicit_at_end.StableTimeStep(&why);
+  const double mean_dt = tfm.time() / static_cast<double>(dg.steps);
+  std::printf("point-implicit: %ld steps, mean dt %.3g s; explicit limit at the end %.3g s (%s)\n",
+              dg.steps, mean_dt, explicit_dt, to_string(why));
+  EXPECT_EQ(why, TfmStepLimit::kSolidsViscosity);
+  EXPECT_GT(mean_dt, 10.0 * explicit_dt);
+}
+
+// Where the explicit step is stable, the point-implicit scheme is the explicit one: a suspension
+// of phi = 0.3 filling the column (no free surface, so every face has the inertia of its cells)
+// settles for 5 ms at a fixed step of a quarter of the explicit limit; both runs give the same
+// fields to the last bit and no face is taken implicitly.
+TEST_F(TfmTest, PointImplicitViscosityIsTheExplicitSchemeWhereThatIsStable) {
+  TfmOptions o = column(8, 40, 0.04, 0.2);
+  o.particle_diameter_m = 5e-4;
+  o.initial_solids = 0.3;
+  o.initial_bed_height_m = 0.2;
+  o.initial_theta_m2_s2 = 1e-2;
+  o.solids_walls = WallSlip::kNoSlip;
+  TfmSimulation probe(o, law("ergun@1"));
+  o.fixed_dt_s = 0.25 * probe.StableTimeStep();
+  o.dt_max_s = std::max(o.dt_max_s, o.fixed_dt_s);
+  TfmSimulation explicit_run(o, law("ergun@1"));
+  o.solids_viscosity = SolidsViscosity::kPointImplicit;
+  TfmSimulation implicit_run(o, law("ergun@1"));
+  explicit_run.AdvanceTo(0.005);
+  implicit_run.AdvanceTo(0.005);
+  EXPECT_EQ(implicit_run.diagnostics().implicit_viscosity_faces, 0);
+  EXPECT_TRUE((explicit_run.solids_w() == implicit_run.solids_w()).all());
+  EXPECT_TRUE((explicit_run.solids_u() == implicit_run.solids_u()).all());
+  EXPECT_TRUE((explicit_run.solids_fraction() == implicit_run.solids_fraction()).all());
+}
+
 // Solids wall condition: the sedimenting column of the test above, 8 cells wide, settling for
 // 0.1 s with theta0 = 1e-2 m^2/s^2 (a kinetic viscosity of ~0.1 Pa s). References: with free
 // slip nothing varies across the width, so every column settles alike (to round-off); with no

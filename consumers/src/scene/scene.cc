@@ -247,6 +247,10 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.tfm.fraction_scheme = as_text(n, f, at);
                  }},
+                {"solids_viscosity",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.tfm.solids_viscosity = as_text(n, f, at);
+                 }},
                 {"granular_temperature",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.tfm.granular_temperature = as_text(n, f, at);
@@ -319,7 +323,8 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
   }
   if (!parse_friction_model(s.tfm.friction, &k.friction)) {
     return fail(error, "[tfm] friction = '" + s.tfm.friction +
-                           "' is not one of none, johnson_jackson_schaeffer");
+                           "' is not one of none, johnson_jackson_schaeffer, "
+                           "johnson_jackson_openfoam");
   }
   // A key whose value names one of two choices.
   auto either = [error](const std::string& value, const char* field, const char* a, const char* b) {
@@ -329,6 +334,7 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
   };
   if (!either(s.tfm.solids_walls, "solids_walls", "free_slip", "no_slip") ||
       !either(s.tfm.fraction_scheme, "fraction_scheme", "upwind", "van_leer") ||
+      !either(s.tfm.solids_viscosity, "solids_viscosity", "explicit", "point_implicit") ||
       !either(s.tfm.granular_temperature, "granular_temperature", "transport", "algebraic")) {
     return false;
   }

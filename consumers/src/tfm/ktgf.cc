@@ -45,7 +45,15 @@ const char* to_string(RadialDistribution radial) {
   return "ma_ahmadi";
 }
 const char* to_string(FrictionModel friction) {
-  return friction == FrictionModel::kJohnsonJacksonSchaeffer ? "johnson_jackson_schaeffer" : "none";
+  switch (friction) {
+    case FrictionModel::kJohnsonJacksonSchaeffer:
+      return "johnson_jackson_schaeffer";
+    case FrictionModel::kJohnsonJacksonOpenFoam:
+      return "johnson_jackson_openfoam";
+    case FrictionModel::kNone:
+      break;
+  }
+  return "none";
 }
 bool parse_closure_set(const std::string& name, KtgfClosureSet* out) {
   for (auto v : {KtgfClosureSet::kNieuwland, KtgfClosureSet::kGidaspow}) {
@@ -61,7 +69,8 @@ bool parse_radial_distribution(const std::string& name, RadialDistribution* out)
   return false;
 }
 bool parse_friction_model(const std::string& name, FrictionModel* out) {
-  for (auto v : {FrictionModel::kNone, FrictionModel::kJohnsonJacksonSchaeffer}) {
+  for (auto v : {FrictionModel::kNone, FrictionModel::kJohnsonJacksonSchaeffer,
+                 FrictionModel::kJohnsonJacksonOpenFoam}) {
     if (name == to_string(v)) return *out = v, true;
   }
   return false;
@@ -78,7 +87,7 @@ bool KtgfOptions::IsValid(std::string* error) const {
   if (!(std::isfinite(knudsen_length_m) && knudsen_length_m >= 0.0 && knudsen_length_m < 10.0))
     return bad(error,
                "[tfm] knudsen_length_m = " + fmt(knudsen_length_m) + " is outside [0, 10) m");
-  if (friction == FrictionModel::kJohnsonJacksonSchaeffer) {
+  if (friction != FrictionModel::kNone) {
     if (!open_range(friction_min_solids, 0.0, packing_limit))
       return bad(error, "[tfm] friction_min_solids = " + fmt(friction_min_solids) +
                             " is outside (0, packing_limit = " + fmt(packing_limit) + ")");
@@ -171,7 +180,12 @@ KtgfCoefficients KtgfClosures::Evaluate(double phi, double theta, double div_v,
   c.dissipation_rate_coefficient = base * ((4.0 / d_) * sqrt_theta_pi - (nieuwland ? div_v : 0.0));
   if (c.frictional_pressure_pa > 0.0) {
     const double sin_angle = std::sin(opt_.friction_angle_deg * kPi / 180.0);
-    const double mu_f = c.frictional_pressure_pa * sin_angle / (2.0 * std::max(shear_rate, 1e-30));
+    // OpenFOAM's model: its 0.5 s time scale stands where Schaeffer has 1 / (2 sqrt(I_2D)).
+    constexpr double kOpenFoamFrictionTime = 0.5;  // [s]
+    const double mu_f =
+        opt_.friction == FrictionModel::kJohnsonJacksonOpenFoam
+            ? phi * kOpenFoamFrictionTime * c.frictional_pressure_pa * sin_angle
+            : c.frictional_pressure_pa * sin_angle / (2.0 * std::max(shear_rate, 1e-30));
     c.frictional_viscosity_pa_s = std::min(mu_f, opt_.friction_max_viscosity_pa_s);
     c.shear_viscosity_pa_s += c.frictional_viscosity_pa_s;
   }

@@ -364,7 +364,8 @@ double TfmSimulation::Impl::StableStep(const CellClosures& c, TfmStepLimit* limi
       {std::min(gas_rate > 0.0 ? o.cfl / gas_rate : inf, gas_viscous), TfmStepLimit::kGasCfl},
       {solids_rate > 0.0 ? o.cfl / solids_rate : inf, TfmStepLimit::kSolidsCfl},
       {wave > 0.0 ? o.cfl * h / wave : inf, TfmStepLimit::kPressureWave},
-      {nu > 0.0 ? 0.25 / (nu * inv_h2) : inf, TfmStepLimit::kSolidsViscosity},
+      {nu > 0.0 && o.solids_viscosity == SolidsViscosity::kExplicit ? 0.25 / (nu * inv_h2) : inf,
+       TfmStepLimit::kSolidsViscosity},
       {o.dt_max_s, TfmStepLimit::kMaximum}};
   Candidate best = candidates[4];
   for (const Candidate& k : candidates)
@@ -565,6 +566,25 @@ double TfmSimulation::StepCapped(double dt_cap) {
     f.c_g = f.eps / (a_g + beta_f);
   };
 
+  // Point-implicit solids viscosity (SolidsViscosity): a face's self-coefficient in the explicit
+  // viscous term is at most 4 M (1/dx^2 + 1/dz^2), M the largest 2 mu + lambda of the cells its
+  // stencil touches. Where a_s is below that bound, (a_s + D) v_new = (a_s + D) v + S(v) with
+  // D = bound - a_s keeps the most oscillatory mode's amplification >= -1 (stable at any step);
+  // elsewhere D = 0 and the term is the explicit one.
+  const bool point_implicit = o.solids_viscosity == SolidsViscosity::kPointImplicit;
+  const double inv_h2 = 1.0 / (dx * dx) + 1.0 / (dz * dz);
+  long implicit_faces = 0;
+  auto implicit_viscosity = [&](int i0, int i1, int j0, int j1, double a_s) {
+    if (!point_implicit) return 0.0;
+    double largest = 0.0;
+    for (int b = std::max(j0, 0); b <= std::min(j1, nz - 1); ++b)
+      for (int a = std::max(i0, 0); a <= std::min(i1, nx - 1); ++a)
+        largest = std::max(largest, 2.0 * c.mu(a, b) + c.lambda(a, b));
+    const double d = std::max(0.0, 4.0 * largest * inv_h2 - a_s);
+    if (d > 0.0) ++implicit_faces;
+    return d;
+  };
+
   // ---- momentum predictors on the x-faces ----
   std::vector<Face> fx(static_cast<std::size_t>((nx + 1) * nz));
   auto fx_at = [&](int i, int j) -> Face& {
@@ -588,7 +608,8 @@ double TfmSimulation::StepCapped(double dt_cap) {
       const double adv_s = vc * upwind(vc, vc, m.us(i - 1, j), m.us(i + 1, j), dx) +
                            wsc * upwind(wsc, vc, us_at(i, j - 1), us_at(i, j + 1), dz);
       const double stress = (sxx(i, j) - sxx(i - 1, j)) / dx + (sxz(i, j + 1) - sxz(i, j)) / dz;
-      const double a_s = pm * rho_s / dt;
+      const double a_s0 = pm * rho_s / dt;
+      const double a_s = a_s0 + implicit_viscosity(i - 1, i, j - 1, j + 1, a_s0);
       const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress;
       Face& f = fx_at(i, j);
       f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
@@ -628,7 +649,8 @@ double TfmSimulation::StepCapped(double dt_cap) {
       const double adv_s = vc * upwind(vc, vc, m.ws(i, j - 1), m.ws(i, j + 1), dz) +
                            usc * upwind(usc, vc, ws_at(i - 1, j), ws_at(i + 1, j), dx);
       const double stress = (szz(i, j) - szz(i, j - 1)) / dz + (sxz(i + 1, j) - sxz(i, j)) / dx;
-      const double a_s = pm * rho_s / dt;
+      const double a_s0 = pm * rho_s / dt;
+      const double a_s = a_s0 + implicit_viscosity(i - 1, i + 1, j - 1, j, a_s0);
       const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress + pm * rho_s * g_z;
       Face& f = fz_at(i, j);
       f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
@@ -920,6 +942,7 @@ double TfmSimulation::StepCapped(double dt_cap) {
   dg.max_solids_fraction = std::max(dg.max_solids_fraction, phi_new_max);
   dg.max_theta_m2_s2 = std::max(dg.max_theta_m2_s2, theta_new.maxCoeff());
   dg.flux_limited_faces += limited;
+  dg.implicit_viscosity_faces += implicit_faces;
   dg.positivity_limited_cells += positivity_limited;
   dg.packing_limited_cells += packing_limited;
   dg.max_wave_speed_m_s = std::max(

@@ -27,9 +27,15 @@
 // The functions with a packing limit are singular there; g0 is evaluated at
 // min(phi, phi_max - g0_margin) (as OpenFOAM caps it), so it stays finite while the two-fluid
 // model's flux limiter keeps phi <= phi_max.
-// Friction (kJohnsonJacksonSchaeffer, off by default): Johnson & Jackson 1987 pressure
+// Friction (off by default): Johnson & Jackson 1987 pressure
 //      P_f = Fr (phi - phi_min)^n / max(phi_max - phi, delta)^p  for phi > phi_min,
-// and Schaeffer 1987 viscosity mu_f = P_f sin(angle) / (2 sqrt(I_2D)), capped at mu_f_max.
+// with, for kJohnsonJacksonSchaeffer, Schaeffer's 1987 viscosity
+//      mu_f = P_f sin(angle) / (2 sqrt(I_2D)),
+// or, for kJohnsonJacksonOpenFoam, the viscosity of OpenFOAM's JohnsonJackson frictional stress
+// model (v1912: kinematic nu_f = 0.5 s P_f / rho_s sin(angle), in a stress alpha rho_s nu_f):
+//      mu_f = phi (0.5 s) P_f sin(angle),
+// which does not depend on the shear rate (so benchmarks against OpenFOAM can use its closure);
+// either capped at mu_f_max.
 //
 // Units SI. Limits: monodisperse, dense-gas (Enskog) kinetic theory, no gas-phase effect on the
 // transport coefficients (the -3 beta theta sink of Eq. 15 lives in the TFM).
@@ -42,7 +48,7 @@ namespace consumers {
 
 enum class KtgfClosureSet { kNieuwland, kGidaspow };
 enum class RadialDistribution { kMaAhmadi, kCarnahanStarling, kSinclairJackson, kLunSavage };
-enum class FrictionModel { kNone, kJohnsonJacksonSchaeffer };
+enum class FrictionModel { kNone, kJohnsonJacksonSchaeffer, kJohnsonJacksonOpenFoam };
 
 const char* to_string(KtgfClosureSet set);
 const char* to_string(RadialDistribution radial);

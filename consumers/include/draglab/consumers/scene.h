@@ -127,7 +127,7 @@ struct SceneTfm {
   std::string radial_distribution = "ma_ahmadi";
   double restitution = -1.0;    ///< Particle-particle e, (0, 1]; -1: [particles] restitution.
   double packing_limit = 0.64;  ///< phi_max, (1 - eps_mf, 0.74].
-  std::string friction = "johnson_jackson_schaeffer";  ///< Or "none".
+  std::string friction = "johnson_jackson_schaeffer";  ///< Or "johnson_jackson_openfoam", "none".
   double friction_min_solids = 0.5;           ///< Johnson-Jackson phi_min, (0, packing_limit).
   double friction_angle_deg = 28.5;           ///< (0, 90).
   double friction_delta = 0.02;               ///< Johnson-Jackson delta (the gap clip), (0, 0.1].
@@ -138,6 +138,7 @@ struct SceneTfm {
   double dt_max_s = 5e-4;                     ///< (0, 0.1].
   std::string solids_walls = "free_slip";     ///< Or "no_slip": the solids' wall condition.
   std::string fraction_scheme = "upwind";     ///< Or "van_leer": face solids fractions.
+  std::string solids_viscosity = "explicit";  ///< Or "point_implicit" (tfm.h).
   std::string granular_temperature = "transport";  ///< Or "algebraic" (local equilibrium).
 };
 

@@ -48,6 +48,15 @@ namespace consumers {
 /// extrema and walls).
 enum class FractionScheme { kUpwind, kVanLeer };
 
+/// How the solids viscous stress enters the momentum predictor: explicitly (the step is bounded
+/// by the viscous stability limit, dt <= 0.25 phi rho_s / ((2 mu + lambda) (1/dx^2 + 1/dz^2)))
+/// or point-implicitly, for viscosities (frictional, near packing) that would make that limit
+/// the smallest: where a face's explicit term would be unstable at the step, the face's own
+/// velocity in its viscous term is taken at the new time level with the smallest coefficient
+/// that makes the update stable; elsewhere the term stays explicit and the results are the
+/// explicit scheme's.
+enum class SolidsViscosity { kExplicit, kPointImplicit };
+
 /// How the granular temperature is found: transported (Eq. 15 with convection and conduction)
 /// or in local equilibrium each step (KtgfClosures::EquilibriumTheta; cheaper, no memory).
 enum class GranularTemperature { kTransport, kAlgebraic };
@@ -76,6 +85,7 @@ struct TfmOptions {
   /// or no slip (v = 0 on the wall, the wall shear from the solids viscosity).
   WallSlip solids_walls = WallSlip::kFreeSlip;
   FractionScheme fraction_scheme = FractionScheme::kUpwind;
+  SolidsViscosity solids_viscosity = SolidsViscosity::kExplicit;
   GranularTemperature granular_temperature = GranularTemperature::kTransport;
   /// With the algebraic theta: cells below this solids fraction get theta = 0. Local
   /// equilibrium needs collisions to relax theta faster than the flow changes it; in a dilute
@@ -116,7 +126,9 @@ struct TfmDiagnostics {
   long flux_limited_faces = 0;        ///< Faces whose solids flux the bounds limited.
   long positivity_limited_cells = 0;  ///< Cell-steps whose outflow was cut to their content.
   long packing_limited_cells = 0;     ///< Cell-steps whose inflow was cut at the packing limit.
-  double max_wave_speed_m_s = 0.0;    ///< sqrt(dP_s/dphi / rho_s), max over cells and steps.
+  /// Face-steps whose solids viscous term was taken point-implicitly (SolidsViscosity).
+  long implicit_viscosity_faces = 0;
+  double max_wave_speed_m_s = 0.0;  ///< sqrt(dP_s/dphi / rho_s), max over cells and steps.
   double poisson_residual = 0.0;
   std::string BriefReport() const;
 };
