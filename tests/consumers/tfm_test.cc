@@ -290,6 +290,78 @@ TEST_F(TfmTest, PointImplicitViscosityLetsAFrictionalBedRestAtTheExplicitLimitsM
   EXPECT_GT(mean_dt, 10.0 * explicit_dt);
 }
 
+// Implicit solids pressure (SolidsPressure::kImplicit). Set-up: the friction column above,
+// with the point-implicit viscosity too, so that only the granular pressure wave could bound an
+// explicit step. References: (1) the analytic contact-pressure balance as above, within 1e-3,
+// and phi never above the limit; (2) no step was set by the pressure wave, and the mean step is
+// more than 5 x the explicit pressure-wave limit of the run's own final state; (3) solids
+// conserved to round-off.
+TEST_F(TfmTest, ImplicitSolidsPressureLetsAFrictionalBedRestBeyondTheWaveLimit) {
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.particle_diameter_m = 5e-4;
+  o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
+  o.initial_solids = 0.3;
+  o.initial_bed_height_m = 0.12;
+  o.initial_theta_m2_s2 = 1e-4;
+  o.solids_viscosity = SolidsViscosity::kPointImplicit;
+  o.solids_pressure = SolidsPressure::kImplicit;
+  o.dt_max_s = 5e-3;  // so that the flow, not this cap, sets the step once the bed rests
+  TfmSimulation tfm(o, law("ergun@1"));
+  tfm.AdvanceTo(2.0);
+  const TfmDiagnostics& dg = tfm.diagnostics();
+  const KtgfOptions& k = o.ktgf;
+  auto residual = [&](double phi) {
+    const double pf = k.friction_fr_pa * std::pow(phi - k.friction_min_solids, k.friction_n) /
+                      std::pow(std::max(k.packing_limit - phi, k.friction_delta), k.friction_p);
+    return pf - (kRhoS - kRhoG) * kG * (0.036 - 0.5 * phi * tfm.dz());
+  };
+  double lo = k.friction_min_solids, hi = k.packing_limit;
+  for (int n = 0; n < 100; ++n) (residual(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+  EXPECT_LE(dg.max_solids_fraction, k.packing_limit + 1e-12);
+  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), 0.5 * (lo + hi), 1e-3) << dg.BriefReport();
+  EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
+  EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
+  EXPECT_EQ(dg.steps_by_limit[static_cast<int>(TfmStepLimit::kPressureWave)], 0);
+  EXPECT_GT(dg.max_pressure_correction, 0.0);
+
+  TfmOptions explicit_options = o;
+  explicit_options.solids_pressure = SolidsPressure::kExplicit;
+  TfmSimulation explicit_at_end(explicit_options, law("ergun@1"));
+  explicit_at_end.SetState(tfm.solids_fraction(), tfm.theta());
+  TfmStepLimit why = TfmStepLimit::kMaximum;
+  const double explicit_dt = explicit_at_end.StableTimeStep(&why);
+  const double mean_dt = tfm.time() / static_cast<double>(dg.steps);
+  std::printf("implicit pressure: %ld steps, mean dt %.3g s; explicit limit at the end %.3g s (%s)\n",
+              dg.steps, mean_dt, explicit_dt, to_string(why));
+  EXPECT_EQ(why, TfmStepLimit::kPressureWave);
+  EXPECT_GT(mean_dt, 5.0 * explicit_dt);
+}
+
+// The implicit solids pressure keeps the sedimenting column of
+// SedimentingColumnReachesThePackingLimitWithoutOvershoot (no friction) within the packing
+// limit, conserves both phases to round-off and settles it to the same height (the solids volume
+// over the limit, within two cells).
+TEST_F(TfmTest, ImplicitSolidsPressureSettlesAColumnToThePackingLimit) {
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.particle_diameter_m = 5e-4;
+  o.initial_solids = 0.3;
+  o.initial_bed_height_m = 0.12;
+  o.initial_theta_m2_s2 = 1e-4;
+  o.solids_pressure = SolidsPressure::kImplicit;
+  TfmSimulation tfm(o, law("ergun@1"));
+  tfm.AdvanceTo(1.5);
+  const TfmDiagnostics& dg = tfm.diagnostics();
+  const double limit = o.ktgf.packing_limit;
+  EXPECT_LE(dg.max_solids_fraction, limit + 1e-12) << dg.BriefReport();
+  EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
+  EXPECT_LT(std::abs(dg.gas_mass_imbalance_kg), 1e-12);
+  double top = 0.0;
+  for (int j = 0; j < 40; ++j)
+    if (tfm.solids_fraction().col(j).mean() > 1e-3) top = (j + 1) * tfm.dz();
+  EXPECT_NEAR(top, 0.3 * 0.12 / limit, 2.0 * tfm.dz());
+  EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
+}
+
 // Where the explicit step is stable, the point-implicit scheme is the explicit one: a suspension
 // of phi = 0.3 filling the column (no free surface, so every face has the inertia of its cells)
 // settles for 5 ms at a fixed step of a quarter of the explicit limit; both runs give the same

@@ -49,6 +49,8 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
       s.tfm.fraction_scheme == "van_leer" ? FractionScheme::kVanLeer : FractionScheme::kUpwind;
   o.solids_viscosity = s.tfm.solids_viscosity == "point_implicit" ? SolidsViscosity::kPointImplicit
                                                                   : SolidsViscosity::kExplicit;
+  o.solids_pressure =
+      s.tfm.solids_pressure == "implicit" ? SolidsPressure::kImplicit : SolidsPressure::kExplicit;
   o.granular_temperature = s.tfm.granular_temperature == "algebraic"
                                ? GranularTemperature::kAlgebraic
                                : GranularTemperature::kTransport;
@@ -265,6 +267,8 @@ class TfmBedModel : public BedModel {
            o.fraction_scheme == FractionScheme::kVanLeer ? "van_leer" : "upwind"},
           {"solids_viscosity",
            o.solids_viscosity == SolidsViscosity::kPointImplicit ? "point_implicit" : "explicit"},
+          {"solids_pressure",
+           o.solids_pressure == SolidsPressure::kImplicit ? "implicit" : "explicit"},
           {"solids_walls", o.solids_walls == WallSlip::kNoSlip ? "no_slip" : "free_slip"},
           {"cfl", o.cfl},
           {"dt_max_s", o.dt_max_s}}},
@@ -277,6 +281,7 @@ class TfmBedModel : public BedModel {
         {"max_theta_m2_s2", dg.max_theta_m2_s2},
         {"flux_limited_faces", dg.flux_limited_faces},
         {"implicit_viscosity_faces", dg.implicit_viscosity_faces},
+        {"max_pressure_correction", dg.max_pressure_correction},
         {"positivity_limited_cells", dg.positivity_limited_cells},
         {"packing_limited_cells", dg.packing_limited_cells},
         {"relative_solids_mass_change", solids_change},

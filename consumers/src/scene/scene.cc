@@ -251,6 +251,10 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.tfm.solids_viscosity = as_text(n, f, at);
                  }},
+                {"solids_pressure",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.tfm.solids_pressure = as_text(n, f, at);
+                 }},
                 {"granular_temperature",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.tfm.granular_temperature = as_text(n, f, at);
@@ -335,6 +339,7 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
   if (!either(s.tfm.solids_walls, "solids_walls", "free_slip", "no_slip") ||
       !either(s.tfm.fraction_scheme, "fraction_scheme", "upwind", "van_leer") ||
       !either(s.tfm.solids_viscosity, "solids_viscosity", "explicit", "point_implicit") ||
+      !either(s.tfm.solids_pressure, "solids_pressure", "explicit", "implicit") ||
       !either(s.tfm.granular_temperature, "granular_temperature", "transport", "algebraic")) {
     return false;
   }

@@ -150,6 +150,9 @@ struct TfmSimulation::Impl {
   // Granular energy matrix: its pattern is fixed (every neighbour entered), analysed once.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> energy_solver;
   bool energy_ordered = false;
+  // Implicit solids pressure increment (SolidsPressure::kImplicit): fixed pattern, analysed once.
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> pressure_increment_solver;
+  bool pressure_increment_ordered = false;
   TfmDiagnostics diag;
 
   CellClosures Closures(const TfmOptions& o) const;
@@ -363,7 +366,8 @@ double TfmSimulation::Impl::StableStep(const CellClosures& c, TfmStepLimit* limi
   const Candidate candidates[] = {
       {std::min(gas_rate > 0.0 ? o.cfl / gas_rate : inf, gas_viscous), TfmStepLimit::kGasCfl},
       {solids_rate > 0.0 ? o.cfl / solids_rate : inf, TfmStepLimit::kSolidsCfl},
-      {wave > 0.0 ? o.cfl * h / wave : inf, TfmStepLimit::kPressureWave},
+      {wave > 0.0 && o.solids_pressure == SolidsPressure::kExplicit ? o.cfl * h / wave : inf,
+       TfmStepLimit::kPressureWave},
       {nu > 0.0 && o.solids_viscosity == SolidsViscosity::kExplicit ? 0.25 / (nu * inv_h2) : inf,
        TfmStepLimit::kSolidsViscosity},
       {o.dt_max_s, TfmStepLimit::kMaximum}};
@@ -497,6 +501,9 @@ double TfmSimulation::StepCapped(double dt_cap) {
   struct Face {
     double u_hat = 0.0, v_hat = 0.0, c_g = 0.0, c_s = 0.0, eps = 1.0, phi = 0.0;
     double phi_flux = 0.0;  // the donor cell's phi: the solids fraction the face transports
+    // Solids velocity per unit solids force [m/s per N/m^3] with the mixture flux held:
+    // a_s dv + beta (dv - du) = f with du = -(phi/eps) dv gives dv = f / (a_s + beta / eps).
+    double solids_response = 0.0;
   };
   auto eliminate = [&](double eps_f, double phi_f, double beta_f, double rhs_g, double rhs_s,
                        double a_g, double a_s) {
@@ -617,6 +624,7 @@ double TfmSimulation::StepCapped(double dt_cap) {
       f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, i >= 2 ? phi(i - 2, j) : none,
                          phi(i - 1, j), phi(i, j), i + 1 < nx ? phi(i + 1, j) : none, pf);
       constrain(f, phi(i - 1, j), phi(i, j), a_g, bf, rhs_g, old_gradient);
+      f.solids_response = f.c_s != 0.0 ? 1.0 / (a_s + bf / ef) : 0.0;
     }
 
   // ---- momentum predictors on the z-faces (interior and the outlet) ----
@@ -658,6 +666,7 @@ double TfmSimulation::StepCapped(double dt_cap) {
       f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, j >= 2 ? phi(i, j - 2) : none,
                          phi(i, j - 1), phi(i, j), j + 1 < nz ? phi(i, j + 1) : none, pf);
       constrain(f, phi(i, j - 1), phi(i, j), a_g, bf, rhs_g, old_gradient);
+      f.solids_response = f.c_s != 0.0 ? 1.0 / (a_s + bf / ef) : 0.0;
     }
 
   // ---- mixture pressure equation: div(eps u + phi v) = 0 ----
@@ -734,6 +743,96 @@ double TfmSimulation::StepCapped(double dt_cap) {
   for (int i = 0; i < nx; ++i) {
     mix_z(i, 0) = w_in[static_cast<std::size_t>(i)] * dx;
     mix_z(i, nz) = eps(i, nz - 1) * m.wg(i, nz) * dx;
+  }
+  if (o.solids_pressure == SolidsPressure::kImplicit) {
+    // Implicit granular pressure increment: with psi = P'(phi) (phi_new - phi) in the cells and
+    // the face flux correction dF = -g (psi_R - psi_L), g = phi_d R A_t / h_n (R the face's
+    // solids response), phi_new - phi = b - dt/V sum_out dF with b the explicit update, so
+    //   psi / P' + dt/V sum_nb g (psi - psi_nb) = b,
+    // symmetric positive definite. Cells without solids pressure (P' = 0 or below
+    // residual_solids) keep psi = 0 (their own update stays explicit); faces whose solids are
+    // held (g = 0) are walls to it.
+    const int cells = nx * nz;
+    auto id = [nx](int i, int j) { return i + nx * j; };
+    auto active = [&](int i, int j) {
+      return phi(i, j) >= phi_res && c.pressure_derivative(i, j) > 0.0;
+    };
+    Array g_x = Array::Zero(nx + 1, nz), g_z = Array::Zero(nx, nz + 1);
+    for (int j = 0; j < nz; ++j)
+      for (int i = 1; i < nx; ++i)
+        g_x(i, j) = fx_at(i, j).phi_flux * fx_at(i, j).solids_response * dz / dx;
+    for (int j = 1; j < nz; ++j)
+      for (int i = 0; i < nx; ++i)
+        g_z(i, j) = fz_at(i, j).phi_flux * fz_at(i, j).solids_response * dx / dz;
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(cells);
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(static_cast<std::size_t>(5 * cells));
+    const double s = dt / volume;
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const int k = id(i, j);
+        // Every coupling is entered (zero where inactive) so the pattern never changes.
+        const bool on = active(i, j);
+        const struct {
+          int ni, nj;
+          double g;
+        } nbs[4] = {{i + 1, j, i + 1 < nx ? g_x(i + 1, j) : 0.0},
+                    {i - 1, j, i > 0 ? g_x(i, j) : 0.0},
+                    {i, j + 1, j + 1 < nz ? g_z(i, j + 1) : 0.0},
+                    {i, j - 1, j > 0 ? g_z(i, j) : 0.0}};
+        double diag = on ? 1.0 / c.pressure_derivative(i, j) : 1.0;
+        for (const auto& nb : nbs) {
+          if (nb.ni < 0 || nb.ni >= nx || nb.nj < 0 || nb.nj >= nz) continue;
+          const bool couple = on && active(nb.ni, nb.nj);
+          triplets.emplace_back(k, id(nb.ni, nb.nj), couple ? -s * nb.g : 0.0);
+          if (on) diag += s * nb.g;  // an inactive neighbour holds psi = 0
+        }
+        triplets.emplace_back(k, k, diag);
+        if (on) {
+          b(k) = -dt * (fs_x(i + 1, j) - fs_x(i, j) + fs_z(i, j + 1) - fs_z(i, j)) / volume;
+        }
+      }
+    Eigen::SparseMatrix<double> a(cells, cells);
+    a.setFromTriplets(triplets.begin(), triplets.end());
+    if (!m.pressure_increment_ordered) {
+      m.pressure_increment_solver.analyzePattern(a);
+      m.pressure_increment_ordered = true;
+    }
+    m.pressure_increment_solver.factorize(a);
+    if (m.pressure_increment_solver.info() != Eigen::Success)
+      Bad(at +
+          "the implicit solids-pressure matrix could not be factorised; remedy: "
+          "solids_pressure = \"explicit\"");
+    const Eigen::VectorXd psi = m.pressure_increment_solver.solve(b);
+    if (!psi.allFinite())
+      Bad(at + "the implicit solids-pressure increment is not finite; remedy: lower cfl");
+    auto psi_at = [&](int i, int j) { return active(i, j) ? psi(id(i, j)) : 0.0; };
+    double largest = 0.0;
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nx; ++i)
+        if (active(i, j))
+          largest = std::max(largest,
+                             std::abs(psi(id(i, j)) / c.pressure_derivative(i, j) - b(id(i, j))));
+    m.diag.max_pressure_correction = std::max(m.diag.max_pressure_correction, largest);
+    // The corrected fluxes; the gas takes the difference on each face (mixture flux held).
+    for (int j = 0; j < nz; ++j)
+      for (int i = 1; i < nx; ++i) {
+        const double df = -g_x(i, j) * (psi_at(i, j) - psi_at(i - 1, j));
+        if (df == 0.0) continue;
+        const double up = fx_at(i, j).phi_flux;
+        fs_x(i, j) += df;
+        m.us(i, j) += df / (up * dz);
+        m.ug(i, j) -= df / ((1.0 - up) * dz);
+      }
+    for (int j = 1; j < nz; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const double df = -g_z(i, j) * (psi_at(i, j) - psi_at(i, j - 1));
+        if (df == 0.0) continue;
+        const double up = fz_at(i, j).phi_flux;
+        fs_z(i, j) += df;
+        m.ws(i, j) += df / (up * dx);
+        m.wg(i, j) -= df / ((1.0 - up) * dx);
+      }
   }
   Array limited_x = Array::Zero(nx + 1, nz), limited_z = Array::Zero(nx, nz + 1);
   // Net solids outflow of cell (i, j) over the step and its parts [m^2 per unit depth].

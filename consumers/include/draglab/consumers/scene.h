@@ -139,6 +139,7 @@ struct SceneTfm {
   std::string solids_walls = "free_slip";     ///< Or "no_slip": the solids' wall condition.
   std::string fraction_scheme = "upwind";     ///< Or "van_leer": face solids fractions.
   std::string solids_viscosity = "explicit";  ///< Or "point_implicit" (tfm.h).
+  std::string solids_pressure = "explicit";   ///< Or "implicit" (tfm.h).
   std::string granular_temperature = "transport";  ///< Or "algebraic" (local equilibrium).
 };
 

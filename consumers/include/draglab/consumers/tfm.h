@@ -57,6 +57,16 @@ enum class FractionScheme { kUpwind, kVanLeer };
 /// explicit scheme's.
 enum class SolidsViscosity { kExplicit, kPointImplicit };
 
+/// How the granular pressure enters: explicitly (in the momentum predictor at the old solids
+/// fraction; the step is bounded by the granular pressure wave, dt <= CFL h / c) or implicitly:
+/// the predictor keeps the old pressure and, after the projection, the solids fluxes are
+/// corrected by the pressure increment P'(phi) (phi_new - phi_old) at the new fractions, one
+/// symmetric positive definite solve per step, with the mixture flux held (the gas takes the
+/// difference on each face). Stable at any step for the pressure wave (the step is not bounded
+/// by it); near packing, where P' is large, the correction spreads the compression over the
+/// neighbouring cells at once.
+enum class SolidsPressure { kExplicit, kImplicit };
+
 /// How the granular temperature is found: transported (Eq. 15 with convection and conduction)
 /// or in local equilibrium each step (KtgfClosures::EquilibriumTheta; cheaper, no memory).
 enum class GranularTemperature { kTransport, kAlgebraic };
@@ -86,6 +96,7 @@ struct TfmOptions {
   WallSlip solids_walls = WallSlip::kFreeSlip;
   FractionScheme fraction_scheme = FractionScheme::kUpwind;
   SolidsViscosity solids_viscosity = SolidsViscosity::kExplicit;
+  SolidsPressure solids_pressure = SolidsPressure::kExplicit;
   GranularTemperature granular_temperature = GranularTemperature::kTransport;
   /// With the algebraic theta: cells below this solids fraction get theta = 0. Local
   /// equilibrium needs collisions to relax theta faster than the flow changes it; in a dilute
@@ -128,6 +139,8 @@ struct TfmDiagnostics {
   long packing_limited_cells = 0;     ///< Cell-steps whose inflow was cut at the packing limit.
   /// Face-steps whose solids viscous term was taken point-implicitly (SolidsViscosity).
   long implicit_viscosity_faces = 0;
+  /// Largest |phi correction| of the implicit solids pressure in a step (SolidsPressure).
+  double max_pressure_correction = 0.0;
   double max_wave_speed_m_s = 0.0;  ///< sqrt(dP_s/dphi / rho_s), max over cells and steps.
   double poisson_residual = 0.0;
   std::string BriefReport() const;
