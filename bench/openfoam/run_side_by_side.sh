@@ -40,8 +40,12 @@
 # and numpy, and a draglab build:
 #   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release && cmake --build build --target draglab
 #
+# The time averages come with standard errors from 8 consecutive blocks of the window (each
+# 0.5 s for 2:6, longer than a slug's period, so the block means are close to independent),
+# and each difference with its size in combined standard errors.
+#
 # Usage: bench/openfoam/run_side_by_side.sh [--build-dir DIR] [--out DIR] [--end-time S]
-#          [--repeat R] [--quick]
+#          [--repeat R] [--quick] [--results-window A:B] [--analyse-only]
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -58,6 +62,8 @@ usage: bench/openfoam/run_side_by_side.sh [options]
   --quick           smoke check: short runs, one repetition
   --results-window A:B  also compare the time-averaged bed over [A, B] s: one more run of
                     each (OpenFOAM 2 ranks, draglab) to B with fields every 0.05 s, untimed
+  --analyse-only    run nothing: recompute the tables from the runs already in --out (give
+                    the --end-time and --results-window they were made with)
 EOF
 }
 fail_usage() {
@@ -66,7 +72,7 @@ fail_usage() {
   exit 2
 }
 
-build_dir="$root/build" out="" end_time="" repeat="" quick=0 window=""
+build_dir="$root/build" out="" end_time="" repeat="" quick=0 window="" analyse_only=0
 while [ "$#" -gt 0 ]; do
   case "$1" in
     --build-dir) build_dir="${2:?}"; shift 2 ;;
@@ -75,6 +81,7 @@ while [ "$#" -gt 0 ]; do
     --repeat) repeat="${2:?}"; shift 2 ;;
     --quick) quick=1; shift ;;
     --results-window) window="${2:?}"; shift 2 ;;
+    --analyse-only) analyse_only=1; shift ;;
     -h|--help) usage; exit 0 ;;
     *) fail_usage "unknown option '$1'" ;;
   esac
@@ -94,6 +101,9 @@ if [ -n "$window" ]; then
     "$window_from" "$window_to" 2>/dev/null ||
     fail_usage "--results-window $window must satisfy 0 <= A < B <= 20 s"
 fi
+if [ "$analyse_only" -eq 1 ]; then
+  [ -f "$out/times.txt" ] || fail_usage "--analyse-only: no $out/times.txt (run the benchmark first)"
+else
 draglab="$build_dir/cli/draglab"
 [ -x "$draglab" ] || fail_usage "no $draglab: build draglab first (see the header)"
 for tool in twoPhaseEulerFoam blockMesh setFields decomposePar mpirun; do
@@ -216,6 +226,8 @@ if [ -n "$window" ]; then
     { echo "run_side_by_side: draglab's window run failed, see $out/draglab_window.err" >&2; exit 1; }
 fi
 
+fi  # --analyse-only
+
 "$python3_bin" - "$out" "$end_time" "$(nproc)" "$window_from" "$window_to" <<'PY'
 import glob, json, os, re, statistics, sys
 import h5py, numpy as np
@@ -263,25 +275,48 @@ if window:
         txt = open(path).read()
         mm = re.search(r"internalField\s+nonuniform\s+List<scalar>\s*(\d+)\s*\((.*?)\)\s*;", txt, re.S)
         return np.array(mm.group(2).split(), float).reshape(nz, nx).mean(axis=1)
-    of_samples = [of_profile(d + "/alpha.particles")
-                  for d in glob.glob(out + "/openfoam_window/[0-9]*")
-                  if window[0] - 1e-9 <= float(os.path.basename(d)) <= window[1] + 1e-9
-                  and os.path.exists(d + "/alpha.particles")]
-    dl_samples = []
+    # In time order (the blocks of the standard errors are consecutive).
+    of_dirs = sorted((float(os.path.basename(d)), d)
+                     for d in glob.glob(out + "/openfoam_window/[0-9]*")
+                     if window[0] - 1e-9 <= float(os.path.basename(d)) <= window[1] + 1e-9
+                     and os.path.exists(d + "/alpha.particles"))
+    of_samples = [of_profile(d + "/alpha.particles") for _, d in of_dirs]
+    dl_timed = []
     with h5py.File(glob.glob(out + "/draglab_window/*.h5")[0], "r") as f:
         for k in f:
             if k.startswith("t") and window[0] - 1e-9 <= f[k].attrs["time_s"] <= window[1] + 1e-9:
-                dl_samples.append(f[k]["phi"][0].mean(axis=1))
+                dl_timed.append((float(f[k].attrs["time_s"]), f[k]["phi"][0].mean(axis=1)))
+    dl_samples = [p for _, p in sorted(dl_timed, key=lambda x: x[0])]
     def summary(samples):
+        # Standard errors from 8 consecutive blocks: each block's mean (and the height of its
+        # mean profile), s / sqrt(8).
         mean = np.mean(samples, axis=0)
-        c = [float((z * p).sum() / p.sum()) for p in samples]
+        c = np.array([float((z * p).sum() / p.sum()) for p in samples])
+        low = np.array([float(p[:80].mean()) for p in samples])
+        blocks = np.array_split(np.arange(len(samples)), 8)
+        def se(values):
+            return float(np.std(values, ddof=1) / np.sqrt(len(values)))
         return mean, {"samples": len(samples), "bed_height_m": height(mean),
-                      "centroid_m": float(np.mean(c)), "centroid_sd_m": float(np.std(c)),
-                      "mean_solids_fraction_0_to_0.4_m": float(mean[:80].mean())}
+                      "bed_height_se_m": se([height(np.mean([samples[k] for k in b], axis=0))
+                                             for b in blocks]),
+                      "centroid_m": float(c.mean()), "centroid_sd_m": float(np.std(c)),
+                      "centroid_se_m": se([c[b].mean() for b in blocks]),
+                      "mean_solids_fraction_0_to_0.4_m": float(low.mean()),
+                      "mean_solids_fraction_0_to_0.4_m_se": se([low[b].mean() for b in blocks])}
     of_mean, of_sum = summary(of_samples)
     dl_mean, dl_sum = summary(dl_samples)
     result["window_s"] = list(window)
+    def sigmas(key, se_key):
+        d = dl_sum[key] - of_sum[key]
+        return {"difference": d, "combined_se": float(np.hypot(dl_sum[se_key], of_sum[se_key])),
+                "sigmas": float(abs(d) / max(np.hypot(dl_sum[se_key], of_sum[se_key]), 1e-300))}
     result["time_averaged"] = {"openfoam": of_sum, "draglab": dl_sum,
+                               "differences": {
+                                   "centroid_m": sigmas("centroid_m", "centroid_se_m"),
+                                   "mean_solids_fraction_0_to_0.4_m": sigmas(
+                                       "mean_solids_fraction_0_to_0.4_m",
+                                       "mean_solids_fraction_0_to_0.4_m_se"),
+                                   "bed_height_m": sigmas("bed_height_m", "bed_height_se_m")},
                                "profile_mean_abs_difference_0_to_0.8_m":
                                    float(np.abs(of_mean[:160] - dl_mean[:160]).mean()),
                                "profiles_every_5_cm": [[round(float(z[j]), 4), round(float(of_mean[j]), 4),
@@ -313,6 +348,12 @@ if window:
                      ta["openfoam"]["mean_solids_fraction_0_to_0.4_m"],
                      ta["draglab"]["mean_solids_fraction_0_to_0.4_m"],
                      ta["profile_mean_abs_difference_0_to_0.8_m"]))
+    for key, label, unit in (("centroid_m", "solids centroid", "m"),
+                             ("mean_solids_fraction_0_to_0.4_m", "mean alpha_p 0-0.4 m", ""),
+                             ("bed_height_m", "bed height", "m")):
+        d = ta["differences"][key]
+        lines.append("  draglab - OpenFOAM, %s: %+.3f %s +- %.3f (block standard errors, 8 blocks), "
+                     "%.1f sigma" % (label, d["difference"], unit, d["combined_se"], d["sigmas"]))
 with open(out + "/results.txt", "w") as f:
     f.write("\n".join(lines) + "\n")
 with open(out + "/results.json", "w") as f:

@@ -331,8 +331,9 @@ TEST_F(TfmTest, ImplicitSolidsPressureLetsAFrictionalBedRestBeyondTheWaveLimit) 
   TfmStepLimit why = TfmStepLimit::kMaximum;
   const double explicit_dt = explicit_at_end.StableTimeStep(&why);
   const double mean_dt = tfm.time() / static_cast<double>(dg.steps);
-  std::printf("implicit pressure: %ld steps, mean dt %.3g s; explicit limit at the end %.3g s (%s)\n",
-              dg.steps, mean_dt, explicit_dt, to_string(why));
+  std::printf(
+      "implicit pressure: %ld steps, mean dt %.3g s; explicit limit at the end %.3g s (%s)\n",
+      dg.steps, mean_dt, explicit_dt, to_string(why));
   EXPECT_EQ(why, TfmStepLimit::kPressureWave);
   EXPECT_GT(mean_dt, 5.0 * explicit_dt);
 }

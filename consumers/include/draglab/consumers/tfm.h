@@ -12,7 +12,9 @@
 // with beta = Law::beta(eps, mu_g, rho_g, |u - v|, d) (interstitial slip, the draglab
 // convention), P_s, tau_s (shear and bulk viscosity), kappa and gamma from ktgf.h.
 //
-// Numerics (docs/tfm.md): first order in time; explicit upwind advection and explicit stresses;
+// Numerics (docs/tfm.md): first order in time; explicit upwind advection and explicit stresses
+// (the solids viscosity optionally point-implicit, SolidsViscosity; the granular pressure
+// optionally implicit, SolidsPressure);
 // the interphase drag by partial elimination (the 2 x 2 face system of both momentum equations
 // is solved exactly, so any beta is stable); one pressure equation for the mixture volume flux
 // (div(eps u + phi v) = 0, mac_pressure.h); phi transported with the projected solids flux
@@ -20,15 +22,15 @@
 // difference to the gas on the same face (both phases stay conserved to round-off); theta with
 // its conduction and sinks (dissipation, drag, expansion) implicit, an M-matrix solve, so it
 // cannot become negative. The time step adapts to the smallest of the CFL limit of both phases,
-// the granular pressure wave speed sqrt(dP_s/dphi / rho_s), the explicit solids viscosity and
-// dt_max; every step records which one set it. Below residual_solids the solids carry no
-// stress and no theta; the kinetic transport coefficients are Knudsen-limited to the cell size
-// (ktgf.h knudsen_length_m).
+// the granular pressure wave speed sqrt(dP_s/dphi / rho_s) (explicit pressure), the solids
+// viscosity (explicit viscosity) and dt_max; every step records which one set it. Below
+// residual_solids the solids carry no stress and no theta; the kinetic transport coefficients
+// are Knudsen-limited to the cell size (ktgf.h knudsen_length_m).
 // The run stops with a diagnosis (Error naming the limit and a remedy) on a non-finite field,
 // a negative theta, phi outside [0, packing_limit] or a time step below dt_min.
 //
 // Units SI. Limits: laminar gas; one cell across the depth (no front/back wall friction);
-// monodisperse solids; free-slip solids walls; frictional stress optional (ktgf.h).
+// monodisperse solids; free-slip or no-slip solids walls; frictional stress optional (ktgf.h).
 #pragma once
 
 #include <Eigen/Core>
