@@ -129,6 +129,8 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
                        {"leakage_bubble_diameter_m", r.leakage_bubble_diameter_m}});
   }
   const auto& first = derived.front();
+  const consumers::BedModelSettings model_settings =
+      consumers::find_bed_model(scene.solver).Settings(scene);
   if (ctx.json) {
     nlohmann::json out = {{"scene", scene.name},
                           {"scene_hash", scene.hash()},
@@ -141,10 +143,7 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
                           {"jet_area_rate_m2_s", first.jet_area_rate_m2_s},
                           {"background", consumers::to_string(scene.distributor.mode)},
                           {"laws", per_law}};
-    if (scene.solver == "dpm") {  // the contact model matters to the DEM only
-      out["contact_time_s"] = first.contact_time_s;
-      out["recommended_dem_dt_s"] = first.recommended_dem_dt_s;
-    }
+    for (const auto& [key, value] : model_settings.numbers) out[key] = value;
     ctx.print_json(out);
     return;
   }
@@ -155,19 +154,7 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
       first.particle_count, format_number(scene.particles.diameter_m),
       format_number(first.bed_height_mf_m, 4), scene.eps_mf, format_number(first.archimedes, 4),
       format_number(first.particle_response_s, 3));
-  if (scene.solver == "dpm") {
-    std::cout << fmt::format("  contact time t_c = {} s -> DEM step {} s (t_c/{})\n",
-                             format_number(first.contact_time_s, 3),
-                             format_number(first.recommended_dem_dt_s, 3),
-                             scene.time.contact_steps);
-  } else if (scene.solver == "tfm") {
-    std::cout << fmt::format(
-        "  two-fluid: {} closures, g0 {}, e = {}, packing limit {}, friction {}; adaptive step "
-        "(CFL {}, at most {} s)\n",
-        scene.tfm.closures, scene.tfm.radial_distribution,
-        scene.tfm.restitution == -1.0 ? scene.particles.restitution : scene.tfm.restitution,
-        scene.tfm.packing_limit, scene.tfm.friction, scene.tfm.cfl, scene.tfm.dt_max_s);
-  }
+  std::cout << "  " << model_settings.line << "\n";
   std::cout << fmt::format(
       "  jet q = {} m^2/s through {} m at {} m/s; background: {}\n",
       format_number(first.jet_area_rate_m2_s, 3), format_number(scene.jet.slot_width_m),

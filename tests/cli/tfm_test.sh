@@ -24,6 +24,14 @@ print(c.execute("SELECT count(*) FROM consumer_results").fetchone()[0])
 
 check "scene check" 0 "$draglab" --db "$db" scene check "$scene"
 ok "check names the two-fluid model" grep -q "solver tfm" "$work/out"
+ok "check reports the model's own settings" grep -q "two-fluid: .* closures, .*solids pressure explicit" "$work/out"
+check "scene check --json" 0 "$draglab" --db "$db" scene check "$scene" --json
+pycheck "check JSON: the TFM's step control, no DEM contact time" '
+import json, sys
+r = json.load(open(sys.argv[1] + "/out"))
+assert r["solver"] == "tfm" and r["cfl"] > 0 and r["dt_max_s"] > 0, r
+assert "contact_time_s" not in r, r
+'
 # The shipped two-fluid scenes, the OpenFOAM benchmark's included, stay valid.
 for shipped in "$src/data/scenes/tfm_bubble.toml" "$src/data/scenes/tfm_kuipers_jet.toml" \
                "$src/bench/openfoam/fluidised_bed.toml"; do

@@ -62,6 +62,7 @@ class EchoModel : public BedModel {
  public:
   std::string key() const override { return "echo_test"; }
   std::string description() const override { return "test model"; }
+  BedModelSettings Settings(const Scene&) const override { return {"echo", {{"x", 1.0}}}; }
   TimeResolution time_resolution() const override {
     return {"steps", "test steps", "[1, 10]", true, true};
   }

@@ -3,6 +3,7 @@
 // settled with the scene's seed; its time resolution the DEM steps per contact time.
 #include <chrono>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -15,6 +16,13 @@ namespace draglab {
 namespace consumers {
 namespace {
 
+std::string Num(double x) {
+  std::ostringstream s;
+  s.precision(3);
+  s << x;
+  return s.str();
+}
+
 /// A settled packing of one seed.
 class DpmPacking : public BedRealization {
  public:
@@ -26,6 +34,17 @@ class DpmBedModel : public BedModel {
   std::string key() const override { return "dpm"; }
   std::string description() const override {
     return "CFD-DEM: soft-sphere particles in a volume-averaged gas (dpm.h)";
+  }
+
+  BedModelSettings Settings(const Scene& scene) const override {
+    // The contact model matters to the DEM only.
+    const double t_c = contact_time_s(scene.particles);
+    const double dem_dt = t_c / scene.time.contact_steps;
+    BedModelSettings s;
+    s.line = "contact time t_c = " + Num(t_c) + " s -> DEM step " + Num(dem_dt) + " s (t_c/" +
+             std::to_string(scene.time.contact_steps) + ")";
+    s.numbers = {{"contact_time_s", t_c}, {"recommended_dem_dt_s", dem_dt}};
+    return s;
   }
 
   std::string realization_kind() const override { return "packing"; }

@@ -93,6 +93,21 @@ class TfmBedModel : public BedModel {
   std::string description() const override {
     return "two-fluid model with the kinetic theory of granular flow (tfm.h)";
   }
+  BedModelSettings Settings(const Scene& scene) const override {
+    const KtgfOptions k = internal::scene_ktgf_options(scene);
+    BedModelSettings s;
+    s.line = "two-fluid: " + scene.tfm.closures + " closures, g0 " + scene.tfm.radial_distribution +
+             ", e = " + Num(k.restitution) + ", packing limit " + Num(k.packing_limit) +
+             ", friction " + scene.tfm.friction + "; solids pressure " + scene.tfm.solids_pressure +
+             ", viscosity " + scene.tfm.solids_viscosity + "; adaptive step (CFL " +
+             Num(scene.tfm.cfl) + ", at most " + Num(scene.tfm.dt_max_s) + " s)";
+    s.numbers = {{"cfl", scene.tfm.cfl},
+                 {"dt_max_s", scene.tfm.dt_max_s},
+                 {"packing_limit", k.packing_limit},
+                 {"restitution", k.restitution}};
+    return s;
+  }
+
   TimeResolution time_resolution() const override {
     return {"cfl",
             "Courant number of the coupled step (the step is also bounded by [tfm] dt_max_s and "

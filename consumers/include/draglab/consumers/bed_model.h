@@ -22,6 +22,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "draglab/consumers/bubble.h"
@@ -89,6 +90,13 @@ struct TimeResolution {
   bool larger_is_finer = true;  ///< Direction of refinement (CFL: smaller is finer).
 };
 
+/// What `scene check` reports of a model's own settings: one line for people and named numbers
+/// for the JSON output.
+struct BedModelSettings {
+  std::string line;
+  std::vector<std::pair<std::string, double>> numbers;
+};
+
 /// A bed model. Run throws draglab::Error as the model documents (invalid scene: kInvalidArgument;
 /// a bed outside the law's validity box: kOutOfValidity; instability: with a diagnosis).
 class BedModel {
@@ -96,6 +104,9 @@ class BedModel {
   virtual ~BedModel() = default;
   virtual std::string key() const = 0;          ///< The `[scene] solver` value.
   virtual std::string description() const = 0;  ///< One line.
+  /// The scene's settings that only this model reads (DPM: the contact time and DEM step; TFM:
+  /// closures and step control), for `scene check`.
+  virtual BedModelSettings Settings(const Scene& scene) const = 0;
 
   /// What a realization is ("packing"); empty: the model is deterministic and has none.
   virtual std::string realization_kind() const { return ""; }
