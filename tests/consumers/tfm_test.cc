@@ -81,6 +81,30 @@ class TfmTest : public ::testing::Test {
     o.initial_bed_height_m = 0.0;
     return o;
   }
+  /// The sedimenting column with Johnson-Jackson friction: 4 x 40 cells of 1 x 5 mm, 500 um
+  /// glass at phi = 0.3 up to 0.12 m (0.036 m of solids), theta0 = 1e-4 m^2/s^2.
+  static TfmOptions friction_column() {
+    TfmOptions o = column(4, 40, 0.04, 0.2);
+    o.particle_diameter_m = 5e-4;
+    o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
+    o.initial_solids = 0.3;
+    o.initial_bed_height_m = 0.12;
+    o.initial_theta_m2_s2 = 1e-4;
+    return o;
+  }
+  /// The bottom cell's phi of that column at rest: its frictional pressure carries the buoyant
+  /// weight of the solids above its centre, Fr (phi - phi_min)^n / max(phi_max - phi, delta)^p
+  /// = (rho_s - rho_g) g (0.036 m - phi dz / 2), solved by bisection.
+  static double contact_balance_phi(const KtgfOptions& k, double dz) {
+    auto residual = [&](double phi) {
+      const double pf = k.friction_fr_pa * std::pow(phi - k.friction_min_solids, k.friction_n) /
+                        std::pow(std::max(k.packing_limit - phi, k.friction_delta), k.friction_p);
+      return pf - (kRhoS - kRhoG) * kG * (0.036 - 0.5 * phi * dz);
+    };
+    double lo = k.friction_min_solids, hi = k.packing_limit;
+    for (int n = 0; n < 100; ++n) (residual(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+    return 0.5 * (lo + hi);
+  }
   static std::string path_;
   static std::unique_ptr<Database> db_;
 };
@@ -220,25 +244,14 @@ TEST_F(TfmTest, SedimentingColumnReachesThePackingLimitWithoutOvershoot) {
 // solved here by bisection (V_s/A = 0.036 m of solids); within 1e-3 in phi (the gas drag of
 // the last settling motion). phi stays below the limit at every step.
 TEST_F(TfmTest, SedimentingColumnWithFrictionRestsOnItsContactPressure) {
-  TfmOptions o = column(4, 40, 0.04, 0.2);
-  o.particle_diameter_m = 5e-4;
-  o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
-  o.initial_solids = 0.3;
-  o.initial_bed_height_m = 0.12;
-  o.initial_theta_m2_s2 = 1e-4;
+  TfmOptions o = friction_column();
   TfmSimulation tfm(o, law("ergun@1"));
   tfm.AdvanceTo(2.0);
   const double max_phi = tfm.diagnostics().max_solids_fraction;
   const KtgfOptions& k = o.ktgf;
-  auto residual = [&](double phi) {
-    const double pf = k.friction_fr_pa * std::pow(phi - k.friction_min_solids, k.friction_n) /
-                      std::pow(std::max(k.packing_limit - phi, k.friction_delta), k.friction_p);
-    return pf - (kRhoS - kRhoG) * kG * (0.036 - 0.5 * phi * tfm.dz());
-  };
-  double lo = k.friction_min_solids, hi = k.packing_limit;
-  for (int n = 0; n < 100; ++n) (residual(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+  const double balance = contact_balance_phi(k, tfm.dz());
   EXPECT_LT(max_phi, k.packing_limit);
-  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), 0.5 * (lo + hi), 1e-3)
+  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), balance, 1e-3)
       << tfm.diagnostics().BriefReport();
   EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
 }
@@ -251,27 +264,16 @@ TEST_F(TfmTest, SedimentingColumnWithFrictionRestsOnItsContactPressure) {
 // viscous limit, and its mean step is more than 10 x the explicit limit of its own final state
 // (which the explicit scheme would have had to take); (3) solids conserved to round-off.
 TEST_F(TfmTest, PointImplicitViscosityLetsAFrictionalBedRestAtTheExplicitLimitsMultiple) {
-  TfmOptions o = column(4, 40, 0.04, 0.2);
-  o.particle_diameter_m = 5e-4;
-  o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
+  TfmOptions o = friction_column();
   o.ktgf.friction_max_viscosity_pa_s = 1000.0;
-  o.initial_solids = 0.3;
-  o.initial_bed_height_m = 0.12;
-  o.initial_theta_m2_s2 = 1e-4;
   o.solids_viscosity = SolidsViscosity::kPointImplicit;
   TfmSimulation tfm(o, law("ergun@1"));
   tfm.AdvanceTo(2.0);
   const TfmDiagnostics& dg = tfm.diagnostics();
   const KtgfOptions& k = o.ktgf;
-  auto residual = [&](double phi) {
-    const double pf = k.friction_fr_pa * std::pow(phi - k.friction_min_solids, k.friction_n) /
-                      std::pow(std::max(k.packing_limit - phi, k.friction_delta), k.friction_p);
-    return pf - (kRhoS - kRhoG) * kG * (0.036 - 0.5 * phi * tfm.dz());
-  };
-  double lo = k.friction_min_solids, hi = k.packing_limit;
-  for (int n = 0; n < 100; ++n) (residual(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+  const double balance = contact_balance_phi(k, tfm.dz());
   EXPECT_LT(dg.max_solids_fraction, k.packing_limit);
-  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), 0.5 * (lo + hi), 1e-3) << dg.BriefReport();
+  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), balance, 1e-3) << dg.BriefReport();
   EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
   EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
   EXPECT_EQ(dg.steps_by_limit[static_cast<int>(TfmStepLimit::kSolidsViscosity)], 0);
@@ -297,12 +299,7 @@ TEST_F(TfmTest, PointImplicitViscosityLetsAFrictionalBedRestAtTheExplicitLimitsM
 // more than 5 x the explicit pressure-wave limit of the run's own final state; (3) solids
 // conserved to round-off.
 TEST_F(TfmTest, ImplicitSolidsPressureLetsAFrictionalBedRestBeyondTheWaveLimit) {
-  TfmOptions o = column(4, 40, 0.04, 0.2);
-  o.particle_diameter_m = 5e-4;
-  o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
-  o.initial_solids = 0.3;
-  o.initial_bed_height_m = 0.12;
-  o.initial_theta_m2_s2 = 1e-4;
+  TfmOptions o = friction_column();
   o.solids_viscosity = SolidsViscosity::kPointImplicit;
   o.solids_pressure = SolidsPressure::kImplicit;
   o.dt_max_s = 5e-3;  // so that the flow, not this cap, sets the step once the bed rests
@@ -310,15 +307,9 @@ TEST_F(TfmTest, ImplicitSolidsPressureLetsAFrictionalBedRestBeyondTheWaveLimit) 
   tfm.AdvanceTo(2.0);
   const TfmDiagnostics& dg = tfm.diagnostics();
   const KtgfOptions& k = o.ktgf;
-  auto residual = [&](double phi) {
-    const double pf = k.friction_fr_pa * std::pow(phi - k.friction_min_solids, k.friction_n) /
-                      std::pow(std::max(k.packing_limit - phi, k.friction_delta), k.friction_p);
-    return pf - (kRhoS - kRhoG) * kG * (0.036 - 0.5 * phi * tfm.dz());
-  };
-  double lo = k.friction_min_solids, hi = k.packing_limit;
-  for (int n = 0; n < 100; ++n) (residual(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+  const double balance = contact_balance_phi(k, tfm.dz());
   EXPECT_LE(dg.max_solids_fraction, k.packing_limit + 1e-12);
-  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), 0.5 * (lo + hi), 1e-3) << dg.BriefReport();
+  EXPECT_NEAR(tfm.solids_fraction().col(0).mean(), balance, 1e-3) << dg.BriefReport();
   EXPECT_LT(MaxSolidsSpeed(tfm), 1e-3);
   EXPECT_NEAR(dg.solids_mass_kg, dg.initial_solids_mass_kg, 1e-12 * dg.initial_solids_mass_kg);
   EXPECT_EQ(dg.steps_by_limit[static_cast<int>(TfmStepLimit::kPressureWave)], 0);

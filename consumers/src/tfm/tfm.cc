@@ -139,6 +139,26 @@ std::string TfmDiagnostics::BriefReport() const {
   return s.str();
 }
 
+namespace {
+
+/// An LDLT of matrices that share one sparsity pattern: the ordering is analysed on the first
+/// factorisation only.
+struct CachedLdlt {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+  bool ordered = false;
+  /// False if the factorisation failed.
+  bool Factorize(const Eigen::SparseMatrix<double>& a) {
+    if (!ordered) {
+      ldlt.analyzePattern(a);
+      ordered = true;
+    }
+    ldlt.factorize(a);
+    return ldlt.info() == Eigen::Success;
+  }
+};
+
+}  // namespace
+
 struct TfmSimulation::Impl {
   int nx = 0, nz = 0;
   double dx = 0.0, dz = 0.0, depth = 0.0;
@@ -148,11 +168,9 @@ struct TfmSimulation::Impl {
   std::unique_ptr<MacPressureSolver> pressure;
   std::unique_ptr<KtgfClosures> ktgf;
   // Granular energy matrix: its pattern is fixed (every neighbour entered), analysed once.
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> energy_solver;
-  bool energy_ordered = false;
+  CachedLdlt energy_solver;
   // Implicit solids pressure increment (SolidsPressure::kImplicit): fixed pattern, analysed once.
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> pressure_increment_solver;
-  bool pressure_increment_ordered = false;
+  CachedLdlt pressure_increment_solver;
   TfmDiagnostics diag;
 
   CellClosures Closures(const TfmOptions& o) const;
@@ -794,16 +812,11 @@ double TfmSimulation::StepCapped(double dt_cap) {
       }
     Eigen::SparseMatrix<double> a(cells, cells);
     a.setFromTriplets(triplets.begin(), triplets.end());
-    if (!m.pressure_increment_ordered) {
-      m.pressure_increment_solver.analyzePattern(a);
-      m.pressure_increment_ordered = true;
-    }
-    m.pressure_increment_solver.factorize(a);
-    if (m.pressure_increment_solver.info() != Eigen::Success)
+    if (!m.pressure_increment_solver.Factorize(a))
       Bad(at +
           "the implicit solids-pressure matrix could not be factorised; remedy: "
           "solids_pressure = \"explicit\"");
-    const Eigen::VectorXd psi = m.pressure_increment_solver.solve(b);
+    const Eigen::VectorXd psi = m.pressure_increment_solver.ldlt.solve(b);
     if (!psi.allFinite())
       Bad(at + "the implicit solids-pressure increment is not finite; remedy: lower cfl");
     auto psi_at = [&](int i, int j) { return active(i, j) ? psi(id(i, j)) : 0.0; };
@@ -975,14 +988,9 @@ double TfmSimulation::StepCapped(double dt_cap) {
       }
     Eigen::SparseMatrix<double> energy(cells, cells);
     energy.setFromTriplets(triplets.begin(), triplets.end());
-    if (!m.energy_ordered) {
-      m.energy_solver.analyzePattern(energy);
-      m.energy_ordered = true;
-    }
-    m.energy_solver.factorize(energy);
-    if (m.energy_solver.info() != Eigen::Success)
+    if (!m.energy_solver.Factorize(energy))
       Bad(at + "the granular temperature equation could not be factorised; remedy: lower cfl");
-    const Eigen::VectorXd theta_vector = m.energy_solver.solve(energy_rhs);
+    const Eigen::VectorXd theta_vector = m.energy_solver.ldlt.solve(energy_rhs);
     Array theta_new = Eigen::Map<const Array>(theta_vector.data(), nx, nz);
     const double theta_min = theta_new.minCoeff();
     if (!theta_new.allFinite()) Bad(at + "non-finite granular temperature; remedy: lower cfl");
