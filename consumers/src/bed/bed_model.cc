@@ -33,6 +33,7 @@ Registry& registry() {
     auto* made = new Registry;
     add(*made, internal::make_dpm_bed_model());
     add(*made, internal::make_tfm_bed_model());
+    add(*made, internal::make_dbm_bed_model());
     return made;
   }();
   return *r;

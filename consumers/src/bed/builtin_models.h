@@ -12,6 +12,7 @@ namespace internal {
 
 std::unique_ptr<BedModel> make_dpm_bed_model();
 std::unique_ptr<BedModel> make_tfm_bed_model();
+std::unique_ptr<BedModel> make_dbm_bed_model();
 
 }  // namespace internal
 }  // namespace consumers

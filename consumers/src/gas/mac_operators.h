@@ -1,8 +1,10 @@
-// MAC (staggered-grid) operators of the gas momentum equation shared by the bed models (the
-// DPM's GasPhase, the TFM, later the DBM): the advective acceleration u.grad u (first-order
-// upwind) and the viscous force div(eps mu grad u) on one x- or z-face, with the ghost values of
-// the boundary conditions. Each model assembles its own predictor from them (its time level,
-// its drag coupling, its body forces) and shares the pressure equation (mac_pressure.h).
+// MAC (staggered-grid) operators of the momentum equations shared by the bed models (the DPM's
+// GasPhase, the TFM, the DBM's emulsion): the advective acceleration u.grad u (first-order
+// upwind) and the viscous force div(eps mu grad u) on one face, with the ghost values of the
+// boundary conditions. Each model assembles its own predictor from them (its time level, its
+// drag coupling, its body forces) and shares the pressure equation (mac_pressure.h).
+// MacGasOperators is the 2-D (x, z) form of the pseudo-2D models; MacOperators3D the 3-D form,
+// which with one cell across the depth and free-slip depth walls gives the same terms (tested).
 //
 // Layout (gas_phase.h): u(i, j) on x-faces, (nx + 1) x nz; w(i, j) on z-faces, nx x (nz + 1);
 // eps(i, j) at the cell centres, nx x nz. Ghost values: the tangential u below the bottom plate
@@ -13,6 +15,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 
 namespace draglab {
 namespace consumers {
@@ -110,6 +113,121 @@ class MacGasOperators {
   int nx_, nz_;
   double dx_, dz_, mu_;
   bool noslip_, periodic_;
+};
+
+/// The 3-D form on the layout of mac_pressure.h: axis 0 = x (width), 1 = z (up), 2 = y (depth);
+/// cell (a0, a1, a2) at a0 + n0 (a1 + n1 a2); the faces normal to axis c have n_c + 1 entries
+/// along c. Boundaries: the x and y walls are no-slip or free-slip each (ghost -v or +v of the
+/// tangential component), the bottom is a no-slip wall (no flow through it), the top an outlet
+/// (tangential velocity and the normal velocity above the top face continued). The faces on the
+/// walls are not evaluated; the top face is.
+class MacOperators3D {
+ public:
+  /// velocity[c]: the face velocities normal to axis c; eps: cell values. They must outlive
+  /// the operators. n: cells per axis; h: cell size per axis [m].
+  MacOperators3D(const std::array<const Eigen::VectorXd*, 3>& velocity, const Eigen::VectorXd& eps,
+                 const std::array<int, 3>& n, const std::array<double, 3>& h, double mu,
+                 bool x_walls_noslip, bool y_walls_noslip)
+      : v_(velocity), eps_(eps), n_(n), h_(h), mu_(mu) {
+    wall_sign_[0] = x_walls_noslip ? -1.0 : 1.0;
+    wall_sign_[2] = y_walls_noslip ? -1.0 : 1.0;
+  }
+
+  /// Index of the face normal to axis c at position p.
+  int FaceIndex(int c, const std::array<int, 3>& p) const {
+    const int n0 = n_[0] + (c == 0), n1 = n_[1] + (c == 1);
+    return p[0] + n0 * (p[1] + n1 * p[2]);
+  }
+  int CellIndex(int a0, int a1, int a2) const { return a0 + n_[0] * (a1 + n_[1] * a2); }
+
+  /// The terms on the face normal to axis c at p (an interior face, or the top face for c = 1).
+  FaceMomentumTerms Face(int c, const std::array<int, 3>& p) const {
+    FaceMomentumTerms t;
+    const double vc = V(c, p);
+    for (int d = 0; d < 3; ++d) {
+      const double h = h_[d];
+      std::array<int, 3> up = p, dn = p;
+      ++up[d];
+      --dn[d];
+      const double v_up = V(c, up), v_dn = V(c, dn);
+      const double a = d == c ? vc : Advecting(c, d, p);
+      t.advection += a * (a > 0 ? (vc - v_dn) / h : (v_up - vc) / h);
+      double e_up, e_dn;
+      if (d == c) {
+        e_up = Eps(p, c, d, 0);
+        e_dn = Eps(p, c, d, -1);
+      } else {
+        e_up = EdgeEps(p, c, d, 1);
+        e_dn = EdgeEps(p, c, d, 0);
+      }
+      t.viscous += (e_up * (v_up - vc) - e_dn * (vc - v_dn)) / (h * h);
+    }
+    t.viscous *= mu_;
+    return t;
+  }
+
+ private:
+  /// Face velocity of component c at p with the boundary ghosts.
+  double V(int c, std::array<int, 3> p) const {
+    double sign = 1.0;
+    for (int a = 0; a < 3; ++a) {
+      const int last = n_[a] - (a == c ? 0 : 1);
+      if (p[a] > last) {
+        // Above the top (a = 1): continued. Beyond a side wall: the wall's ghost.
+        if (a != 1 && a != c) sign *= wall_sign_[a];
+        p[a] = last;
+      } else if (p[a] < 0) {
+        // Below the bottom plate: no slip; beyond a side wall: the wall's ghost.
+        if (a != c) sign *= a == 1 ? -1.0 : wall_sign_[a];
+        p[a] = 0;
+      }
+    }
+    return sign * (*v_[c])(FaceIndex(c, p));
+  }
+  /// The velocity of component d (!= c) at the face (c, p): the mean of the four d-faces around.
+  double Advecting(int c, int d, const std::array<int, 3>& p) const {
+    double sum = 0.0;
+    for (int s = -1; s <= 0; ++s) {
+      for (int e = 0; e <= 1; ++e) {
+        std::array<int, 3> q = p;
+        q[c] = std::clamp(p[c] + s, 0, n_[c] - 1);
+        q[d] = p[d] + e;
+        sum += (*v_[d])(FaceIndex(d, q));
+      }
+    }
+    return 0.25 * sum;
+  }
+  double CellEps(std::array<int, 3> q) const {
+    for (int a = 0; a < 3; ++a) q[a] = std::clamp(q[a], 0, n_[a] - 1);
+    return eps_(CellIndex(q[0], q[1], q[2]));
+  }
+  /// eps of the cell along the face's own axis: offset 0 above the face, -1 below.
+  double Eps(const std::array<int, 3>& p, int c, int, int offset) const {
+    std::array<int, 3> q = p;
+    q[c] += offset;
+    return CellEps(q);
+  }
+  /// eps on the edge between the face (c, p) and its neighbour along d (side 1: +d, 0: -d): the
+  /// mean of the four cells around the edge.
+  double EdgeEps(const std::array<int, 3>& p, int c, int d, int side) const {
+    double sum = 0.0;
+    for (int s = -1; s <= 0; ++s) {
+      for (int e = -1; e <= 0; ++e) {
+        std::array<int, 3> q = p;
+        q[c] = p[c] + s;
+        q[d] = p[d] + side + e;
+        sum += CellEps(q);
+      }
+    }
+    return 0.25 * sum;
+  }
+
+  std::array<const Eigen::VectorXd*, 3> v_;
+  const Eigen::VectorXd& eps_;
+  std::array<int, 3> n_;
+  std::array<double, 3> h_;
+  double mu_;
+  std::array<double, 3> wall_sign_{-1.0, -1.0, -1.0};
 };
 
 }  // namespace internal

@@ -1,5 +1,6 @@
 // The particle <-> cell kernel shared by the bed models that carry Lagrangian objects on the
-// gas grid (the DPM's particles, later the DBM's bubbles): a bilinear tent on the cell centres.
+// gas grid (the DPM's particles, the DBM's bubbles): a bilinear (2-D) or trilinear (3-D, the
+// layout of mac_pressure.h) tent on the cell centres.
 // Weight that would fall outside the grid is folded into the boundary cell, so a deposited
 // quantity is conserved exactly (the mapped solids volume is the particles' volume) and the
 // field stays continuous as an object crosses cell faces. Interpolation is the transpose of the
@@ -49,6 +50,51 @@ inline double Interpolate(const Eigen::ArrayXXd& field, const Tent& t) {
   double v = 0.0;
   for (int a = 0; a < 2; ++a)
     for (int b = 0; b < 2; ++b) v += field(t.i[a], t.j[b]) * t.wx[a] * t.wz[b];
+  return v;
+}
+
+/// The 3-D tent: two cells per axis around a point (x across the width, y across the depth, z
+/// up) and their weights; the cell (i, j, k) is i + nx (j + nz k), j up, k across the depth.
+struct Tent3 {
+  int i[2], j[2], k[2];
+  double wx[2], wz[2], wy[2];
+  int Cell(int a, int b, int c, int nx, int nz) const { return i[a] + nx * (j[b] + nz * k[c]); }
+  double Weight(int a, int b, int c) const { return wx[a] * wz[b] * wy[c]; }
+};
+
+/// The tent of the point (x, y, z) on an nx x ny x nz grid of cells dx x dy x dz.
+inline Tent3 TentAt3(double x, double y, double z, double dx, double dy, double dz, int nx, int ny,
+                     int nz) {
+  const Tent a = TentAt(x, z, dx, dz, nx, nz);
+  Tent3 t;
+  for (int s = 0; s < 2; ++s) {
+    t.i[s] = a.i[s];
+    t.j[s] = a.j[s];
+    t.wx[s] = a.wx[s];
+    t.wz[s] = a.wz[s];
+  }
+  const double sy = y / dy - 0.5, fy = std::floor(sy);
+  const int k0 = static_cast<int>(fy);
+  t.wy[1] = sy - fy;
+  t.wy[0] = 1.0 - t.wy[1];
+  t.k[0] = std::clamp(k0, 0, ny - 1);
+  t.k[1] = std::clamp(k0 + 1, 0, ny - 1);
+  return t;
+}
+
+/// Adds `amount` to the cells of the 3-D tent (a flat field in the layout above), by weight.
+inline void Deposit3(Eigen::VectorXd& field, const Tent3& t, double amount, int nx, int nz) {
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) field(t.Cell(a, b, c, nx, nz)) += amount * t.Weight(a, b, c);
+}
+
+/// The field at the 3-D tent's point (the transpose of Deposit3).
+inline double Interpolate3(const Eigen::VectorXd& field, const Tent3& t, int nx, int nz) {
+  double v = 0.0;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) v += field(t.Cell(a, b, c, nx, nz)) * t.Weight(a, b, c);
   return v;
 }
 

@@ -192,6 +192,13 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                    if (v < 1 || v > 100000)
                      bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100000]");
                    s.grid.cells_y = static_cast<int>(v);
+                 }},
+                {"cells_z",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   const std::int64_t v = as_integer(n, f, at);
+                   if (v < 1 || v > 100000)
+                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100000]");
+                   s.grid.cells_z = static_cast<int>(v);
                  }}}},
               {"bubble",
                {num("eps_threshold", [](S& s) -> double& { return s.bubble.eps_threshold; }),
@@ -259,6 +266,49 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.tfm.granular_temperature = as_text(n, f, at);
                  }}}},
+              {"dbm",
+               {num("superficial_velocity_m_s",
+                    [](S& s) -> double& { return s.dbm.superficial_velocity_m_s; }),
+                num("emulsion_density_kg_m3",
+                    [](S& s) -> double& { return s.dbm.emulsion_density_kg_m3; }),
+                num("emulsion_viscosity_pa_s",
+                    [](S& s) -> double& { return s.dbm.emulsion_viscosity_pa_s; }),
+                num("bubble_density_kg_m3",
+                    [](S& s) -> double& { return s.dbm.bubble_density_kg_m3; }),
+                num("bubble_diameter_m", [](S& s) -> double& { return s.dbm.bubble_diameter_m; }),
+                {"nozzles_per_side",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   const std::int64_t v = as_integer(n, f, at);
+                   if (v < 1 || v > 100)
+                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100]");
+                   s.dbm.nozzles_per_side = static_cast<int>(v);
+                 }},
+                num("nozzle_pitch_m", [](S& s) -> double& { return s.dbm.nozzle_pitch_m; }),
+                num("virtual_mass_coefficient",
+                    [](S& s) -> double& { return s.dbm.virtual_mass_coefficient; }),
+                {"lift", [](S& s, const toml::node& n, const std::string& f,
+                            const std::string& at) { s.dbm.lift = as_bool(n, f, at); }},
+                num("lift_coefficient", [](S& s) -> double& { return s.dbm.lift_coefficient; }),
+                {"coalescence",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.dbm.coalescence = as_bool(n, f, at);
+                 }},
+                num("film_drainage_s", [](S& s) -> double& { return s.dbm.film_drainage_s; }),
+                num("dt_s", [](S& s) -> double& { return s.dbm.dt_s; }),
+                num("injection_ramp_s", [](S& s) -> double& { return s.dbm.injection_ramp_s; }),
+                {"walls", [](S& s, const toml::node& n, const std::string& f,
+                             const std::string& at) { s.dbm.walls = as_text(n, f, at); }},
+                num("average_from_s", [](S& s) -> double& { return s.dbm.average_from_s; }),
+                num("sample_interval_s", [](S& s) -> double& { return s.dbm.sample_interval_s; }),
+                {"size_heights_m",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.dbm.size_heights_m.clear();
+                   const toml::array* a = n.as_array();
+                   if (!a) bad(at + ": " + f + " must be an array of heights in m");
+                   for (std::size_t i = 0; i < a->size(); ++i)
+                     s.dbm.size_heights_m.push_back(
+                         as_number(*a->get(i), f + "[" + std::to_string(i) + "]", at));
+                 }}}},
               {"drag",
                {{"laws",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
@@ -299,6 +349,87 @@ KtgfOptions scene_ktgf_options(const Scene& s) {
 }  // namespace internal
 
 namespace {
+
+/// The [dbm] table: required by solver = "dbm", refused by the others; the DBM in turn refuses the
+/// tables of the jet-driven models and a particle inventory (its emulsion fills the column).
+bool dbm_is_valid(const Scene& s, std::string* error) {
+  const bool dbm = s.solver == "dbm";
+  if (!dbm) {
+    if (s.dbm.present)
+      return fail(error, "[dbm] is read only with solver = \"dbm\" (this scene's solver is \"" +
+                             s.solver + "\"): remove the table or change the solver");
+    if (s.grid.cells_z != 1)
+      return fail(error, "[grid] cells_z = " + std::to_string(s.grid.cells_z) +
+                             ": the pseudo-2D models have one cell across the depth (cells_z = 1); "
+                             "only the DBM's emulsion grid is 3-D");
+    return true;
+  }
+  if (!s.dbm.present)
+    return fail(error,
+                "[dbm] table is missing: solver = \"dbm\" needs it (superficial_velocity_m_s, "
+                "emulsion and bubble properties, nozzles; docs/scenes.md)");
+  for (const char* table : {"jet", "distributor", "bubble", "dem", "tfm"}) {
+    if (std::find(s.tables.begin(), s.tables.end(), table) != s.tables.end())
+      return fail(error, std::string("[") + table +
+                             "] is not read by solver = \"dbm\" (its bubbles come from the [dbm] "
+                             "nozzles): remove the table");
+  }
+  if (s.particles.count != 0 || s.particles.bed_height_mf_m != 0.0)
+    return fail(error,
+                "[particles] count / bed_height_mf_m: the DBM's emulsion fills the column (its "
+                "surface is [geometry] height_m); remove them");
+  const SceneDbm& d = s.dbm;
+  const double column = std::min(s.geometry.width_m, s.geometry.depth_m);
+  if (!in_range(d.superficial_velocity_m_s, 0.0, 10.0, true, false,
+                "[dbm] superficial_velocity_m_s", "m/s", error) ||
+      !in_range(d.bubble_density_kg_m3, 0.0, 20000.0, true, false, "[dbm] bubble_density_kg_m3",
+                "kg/m^3", error) ||
+      !in_range(d.emulsion_density_kg_m3, d.bubble_density_kg_m3, 20000.0, true, false,
+                "[dbm] emulsion_density_kg_m3", "kg/m^3 (above bubble_density_kg_m3)", error) ||
+      !in_range(d.emulsion_viscosity_pa_s, 0.0, 1000.0, true, false,
+                "[dbm] emulsion_viscosity_pa_s", "Pa s", error) ||
+      !in_range(d.bubble_diameter_m, 0.0, column, false, true, "[dbm] bubble_diameter_m",
+                "m (0: Davidson-Harrison; below the column's width and depth)", error) ||
+      !in_range(d.nozzle_pitch_m, 0.0, column, true, false, "[dbm] nozzle_pitch_m", "m", error) ||
+      !in_range(d.virtual_mass_coefficient, 0.0, 10.0, false, false,
+                "[dbm] virtual_mass_coefficient", "", error) ||
+      !in_range(d.lift_coefficient, -1.0, 1.0, false, false, "[dbm] lift_coefficient", "", error) ||
+      !in_range(d.film_drainage_s, 0.0, 10.0, false, false, "[dbm] film_drainage_s", "s", error) ||
+      !in_range(d.dt_s, 0.0, 1.0, true, false, "[dbm] dt_s", "s (and the stability limit)",
+                error) ||
+      !in_range(s.time.duration_s, 0.0, 1e5, true, false, "[time] duration_s", "s", error) ||
+      !in_range(d.injection_ramp_s, 0.0, s.time.duration_s, false, true, "[dbm] injection_ramp_s",
+                "s [0, duration_s)", error) ||
+      !in_range(d.average_from_s, 0.0, s.time.duration_s, false, true, "[dbm] average_from_s",
+                "s [0, duration_s)", error) ||
+      !in_range(d.sample_interval_s, 0.0, s.time.duration_s, true, false, "[dbm] sample_interval_s",
+                "s (0, duration_s]", error)) {
+    return false;
+  }
+  if (d.walls != "no_slip" && d.walls != "free_slip")
+    return fail(error, "[dbm] walls = '" + d.walls + "' is not one of no_slip, free_slip");
+  const double span = (d.nozzles_per_side - 1) * d.nozzle_pitch_m;
+  if (span + std::max(d.bubble_diameter_m, 0.0) >= column)
+    return fail(error, "[dbm] nozzles_per_side = " + std::to_string(d.nozzles_per_side) +
+                           " at nozzle_pitch_m = " + fmt(d.nozzle_pitch_m) + " span " + fmt(span) +
+                           " m: with the bubbles they do not fit the " + fmt(column) + " m bottom");
+  if (d.bubble_diameter_m > 0.0 && d.nozzles_per_side > 1 && d.nozzle_pitch_m < d.bubble_diameter_m)
+    return fail(error, "[dbm] nozzle_pitch_m = " + fmt(d.nozzle_pitch_m) +
+                           " m is below bubble_diameter_m = " + fmt(d.bubble_diameter_m) +
+                           " m: the bubbles of neighbouring nozzles would overlap");
+  if (d.size_heights_m.empty())
+    return fail(error, "[dbm] size_heights_m is empty (give the heights of the size report)");
+  for (double h : d.size_heights_m) {
+    if (!in_range(h, 0.0, s.geometry.height_m, true, true, "[dbm] size_heights_m",
+                  "m (inside the bed)", error))
+      return false;
+  }
+  if (s.time.duration_s / d.dt_s > 1e9)
+    return fail(error, "[dbm] dt_s = " + fmt(d.dt_s) + " s would take more than 1e9 steps");
+  if (s.grid.cells_x < 2 || s.grid.cells_y < 2)
+    return fail(error, "[grid] cells_x and cells_y must be >= 2 for the DBM's emulsion");
+  return true;
+}
 
 /// The [tfm] table: required by solver = "tfm", refused by the others; ranges via ktgf.h.
 bool tfm_is_valid(const Scene& s, std::string* error) {
@@ -406,6 +537,8 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
     const toml::table* table = section_node.as_table();
     if (!table) bad(where(origin, section_node) + ": '" + section + "' must be a [section]");
     if (section == "tfm") s.tfm.present = true;
+    if (section == "dbm") s.dbm.present = true;
+    s.tables.push_back(section);
     if (section == "dem") {
       s.dem_table = true;
       for (const auto& key : kDemKeys) {
@@ -504,98 +637,102 @@ bool Scene::IsValid(std::string* error) const {
                 error)) {
     return false;
   }
-  const bool has_count = particles.count > 0;
-  const bool has_height = particles.bed_height_mf_m != 0.0;
-  if (has_count == has_height) {
-    return fail(error, "[particles] give exactly one of count and bed_height_mf_m");
-  }
-  if (has_height && !in_range(particles.bed_height_mf_m, 0.0, geometry.height_m, true, false,
-                              "[particles] bed_height_mf_m", "m (the box height)", error)) {
-    return false;
-  }
-  if (has_count && particles.count > 10000000) {
-    return fail(error, "[particles] count = " + std::to_string(particles.count) +
-                           " is outside [1, 10000000]");
-  }
-  const double h_mf = bed_height_mf_m();
-  if (h_mf > geometry.height_m) {
-    return fail(error, "[particles] count = " + std::to_string(particles.count) + " makes a bed " +
-                           fmt(h_mf) + " m high at eps_mf = " + fmt(eps_mf) +
-                           ": it does not fit the box ([geometry] height_m = " +
-                           fmt(geometry.height_m) + " m)");
-  }
-  if (h_mf < d) {
-    return fail(error, "[particles] the bed at eps_mf is " + fmt(h_mf) +
-                           " m high, less than one particle diameter (give more particles)");
-  }
-  // Distributor.
-  if (distributor.mode != BackgroundMode::kFixed) {
-    if (!in_range(distributor.umf_factor, 0.0, 10.0, false, false, "[distributor] umf_factor", "",
+  if (!dbm_is_valid(*this, error)) return false;
+  if (solver != "dbm") {
+    const bool has_count = particles.count > 0;
+    const bool has_height = particles.bed_height_mf_m != 0.0;
+    if (has_count == has_height) {
+      return fail(error, "[particles] give exactly one of count and bed_height_mf_m");
+    }
+    if (has_height && !in_range(particles.bed_height_mf_m, 0.0, geometry.height_m, true, false,
+                                "[particles] bed_height_mf_m", "m (the box height)", error)) {
+      return false;
+    }
+    if (has_count && particles.count > 10000000) {
+      return fail(error, "[particles] count = " + std::to_string(particles.count) +
+                             " is outside [1, 10000000]");
+    }
+    const double h_mf = bed_height_mf_m();
+    if (h_mf > geometry.height_m) {
+      return fail(error, "[particles] count = " + std::to_string(particles.count) +
+                             " makes a bed " + fmt(h_mf) + " m high at eps_mf = " + fmt(eps_mf) +
+                             ": it does not fit the box ([geometry] height_m = " +
+                             fmt(geometry.height_m) + " m)");
+    }
+    if (h_mf < d) {
+      return fail(error, "[particles] the bed at eps_mf is " + fmt(h_mf) +
+                             " m high, less than one particle diameter (give more particles)");
+    }
+    // Distributor.
+    if (distributor.mode != BackgroundMode::kFixed) {
+      if (!in_range(distributor.umf_factor, 0.0, 10.0, false, false, "[distributor] umf_factor", "",
+                    error)) {
+        return false;
+      }
+    } else if (!in_range(distributor.velocity_m_s, 0.0, 100.0, true, false,
+                         "[distributor] velocity_m_s", "m/s (background = \"fixed\")", error)) {
+      return false;
+    }
+    // Jet.
+    if (!in_range(jet.slot_width_m, 0.0, geometry.width_m, true, false, "[jet] slot_width_m",
+                  "m (0 < slot <= the bed width)", error) ||
+        !in_range(jet.velocity_m_s, 0.0, 300.0, false, false, "[jet] velocity_m_s",
+                  "m/s (incompressible gas: Mach < 0.9)", error) ||
+        !in_range(jet.start_s, 0.0, 1e4, false, false, "[jet] start_s", "s", error) ||
+        !in_range(jet.duration_s, 0.0, 1e4, false, false, "[jet] duration_s", "s", error) ||
+        !in_range(jet.ramp_s, 0.0, 1.0, false, false, "[jet] ramp_s", "s", error)) {
+      return false;
+    }
+    if (jet.center_m != -1.0) {  // -1: the default, the bed's centre line
+      const double half = 0.5 * jet.slot_width_m;
+      if (!in_range(jet.center_m, half, geometry.width_m - half, false, false, "[jet] center_m",
+                    "m (the slot must lie inside the bottom)", error)) {
+        return false;
+      }
+    }
+    // Times.
+    if (!in_range(time.duration_s, 0.0, 1e4, true, false, "[time] duration_s", "s", error) ||
+        !in_range(time.t_ref_s, 0.0, 1e4, false, false, "[time] t_ref_s", "s", error) ||
+        !in_range(time.settle_s, 0.0, 1e4, false, false, dem_at("[time]") + " settle_s", "s",
+                  error) ||
+        !in_range(time.dem_dt_s, 0.0, 1.0, false, false, dem_at("[time]") + " dem_dt_s",
+                  "s (0 = auto)", error) ||
+        !in_range(time.gas_dt_s, 0.0, 1.0, false, false, "[time] gas_dt_s", "s (0 = auto)",
                   error)) {
       return false;
     }
-  } else if (!in_range(distributor.velocity_m_s, 0.0, 100.0, true, false,
-                       "[distributor] velocity_m_s", "m/s (background = \"fixed\")", error)) {
-    return false;
-  }
-  // Jet.
-  if (!in_range(jet.slot_width_m, 0.0, geometry.width_m, true, false, "[jet] slot_width_m",
-                "m (0 < slot <= the bed width)", error) ||
-      !in_range(jet.velocity_m_s, 0.0, 300.0, false, false, "[jet] velocity_m_s",
-                "m/s (incompressible gas: Mach < 0.9)", error) ||
-      !in_range(jet.start_s, 0.0, 1e4, false, false, "[jet] start_s", "s", error) ||
-      !in_range(jet.duration_s, 0.0, 1e4, false, false, "[jet] duration_s", "s", error) ||
-      !in_range(jet.ramp_s, 0.0, 1.0, false, false, "[jet] ramp_s", "s", error)) {
-    return false;
-  }
-  if (jet.center_m != -1.0) {  // -1: the default, the bed's centre line
-    const double half = 0.5 * jet.slot_width_m;
-    if (!in_range(jet.center_m, half, geometry.width_m - half, false, false, "[jet] center_m",
-                  "m (the slot must lie inside the bottom)", error)) {
-      return false;
+    if (time.contact_steps < 20 || time.contact_steps > 1000) {
+      return fail(error, dem_at("[time]") + " contact_steps = " +
+                             std::to_string(time.contact_steps) + " is outside [20, 1000]");
     }
-  }
-  // Times.
-  if (!in_range(time.duration_s, 0.0, 1e4, true, false, "[time] duration_s", "s", error) ||
-      !in_range(time.t_ref_s, 0.0, 1e4, false, false, "[time] t_ref_s", "s", error) ||
-      !in_range(time.settle_s, 0.0, 1e4, false, false, dem_at("[time]") + " settle_s", "s",
-                error) ||
-      !in_range(time.dem_dt_s, 0.0, 1.0, false, false, dem_at("[time]") + " dem_dt_s",
-                "s (0 = auto)", error) ||
-      !in_range(time.gas_dt_s, 0.0, 1.0, false, false, "[time] gas_dt_s", "s (0 = auto)", error)) {
-    return false;
-  }
-  if (time.contact_steps < 20 || time.contact_steps > 1000) {
-    return fail(error, dem_at("[time]") + " contact_steps = " + std::to_string(time.contact_steps) +
-                           " is outside [20, 1000]");
-  }
-  if (jet.start_s + time.t_ref_s > time.duration_s * (1.0 + 1e-12)) {
-    return fail(error, "[time] t_ref_s = " + fmt(time.t_ref_s) + " after the jet start " +
-                           fmt(jet.start_s) + " s is beyond [time] duration_s = " +
-                           fmt(time.duration_s) + " s (t_ref_s <= duration_s - jet.start_s)");
-  }
-  // A positive step so small that the run could never finish is a typo, not a choice.
-  constexpr double kMaxSteps = 1e9;
-  if (time.gas_dt_s > 0.0 && time.duration_s / time.gas_dt_s > kMaxSteps) {
-    return fail(error, "[time] gas_dt_s = " + fmt(time.gas_dt_s) + " s would take " +
-                           fmt(time.duration_s / time.gas_dt_s) +
-                           " gas steps for duration_s (more than 1e9): use 0 = auto, or a step "
-                           ">= duration_s / 1e9 = " +
-                           fmt(time.duration_s / kMaxSteps) + " s");
-  }
-  if (time.dem_dt_s > 0.0 && (time.settle_s + time.duration_s) / time.dem_dt_s > kMaxSteps) {
-    return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) + " s would take " +
-                           fmt((time.settle_s + time.duration_s) / time.dem_dt_s) +
-                           " DEM steps for settle_s + duration_s (more than 1e9): use 0 = auto, "
-                           "or a step >= (settle_s + duration_s) / 1e9 = " +
-                           fmt((time.settle_s + time.duration_s) / kMaxSteps) + " s");
-  }
-  if (time.dem_dt_s > 0.0) {
-    const double limit = contact_time_s(particles) / 20.0;
-    if (time.dem_dt_s > limit) {
-      return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) +
-                             " s is above the stability limit t_c/20 = " + fmt(limit) +
-                             " s of the contact model (use 0 = auto, or a smaller step)");
+    if (jet.start_s + time.t_ref_s > time.duration_s * (1.0 + 1e-12)) {
+      return fail(error, "[time] t_ref_s = " + fmt(time.t_ref_s) + " after the jet start " +
+                             fmt(jet.start_s) + " s is beyond [time] duration_s = " +
+                             fmt(time.duration_s) + " s (t_ref_s <= duration_s - jet.start_s)");
+    }
+    // A positive step so small that the run could never finish is a typo, not a choice.
+    constexpr double kMaxSteps = 1e9;
+    if (time.gas_dt_s > 0.0 && time.duration_s / time.gas_dt_s > kMaxSteps) {
+      return fail(error, "[time] gas_dt_s = " + fmt(time.gas_dt_s) + " s would take " +
+                             fmt(time.duration_s / time.gas_dt_s) +
+                             " gas steps for duration_s (more than 1e9): use 0 = auto, or a step "
+                             ">= duration_s / 1e9 = " +
+                             fmt(time.duration_s / kMaxSteps) + " s");
+    }
+    if (time.dem_dt_s > 0.0 && (time.settle_s + time.duration_s) / time.dem_dt_s > kMaxSteps) {
+      return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) + " s would take " +
+                             fmt((time.settle_s + time.duration_s) / time.dem_dt_s) +
+                             " DEM steps for settle_s + duration_s (more than 1e9): use 0 = auto, "
+                             "or a step >= (settle_s + duration_s) / 1e9 = " +
+                             fmt((time.settle_s + time.duration_s) / kMaxSteps) + " s");
+    }
+    if (time.dem_dt_s > 0.0) {
+      const double limit = contact_time_s(particles) / 20.0;
+      if (time.dem_dt_s > limit) {
+        return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) +
+                               " s is above the stability limit t_c/20 = " + fmt(limit) +
+                               " s of the contact model (use 0 = auto, or a smaller step)");
+      }
     }
   }
   // Grid: the void fraction needs cells at least one particle wide.
@@ -614,10 +751,10 @@ bool Scene::IsValid(std::string* error) const {
             " cells_x and height/d = " + std::to_string(static_cast<int>(geometry.height_m / d)) +
             " cells_y");
   }
-  if (!in_range(bubble.eps_threshold, eps_mf, 1.0, true, true, "[bubble] eps_threshold",
-                "(eps_mf, 1)", error) ||
-      !in_range(bubble.sample_interval_s, 0.0, time.duration_s, true, false,
-                "[bubble] sample_interval_s", "s (0, duration_s]", error) ||
+  if ((solver != "dbm" && !in_range(bubble.eps_threshold, eps_mf, 1.0, true, true,
+                                    "[bubble] eps_threshold", "(eps_mf, 1)", error)) ||
+      (solver != "dbm" && !in_range(bubble.sample_interval_s, 0.0, time.duration_s, true, false,
+                                    "[bubble] sample_interval_s", "s (0, duration_s]", error)) ||
       !in_range(outputs.interval_s, 0.0, time.duration_s, false, false, "[outputs] interval_s",
                 "s [0, duration_s]", error)) {
     return false;
@@ -665,6 +802,7 @@ std::int64_t Scene::particle_count() const {
 }
 
 double Scene::bed_height_mf_m() const {
+  if (solver == "dbm") return geometry.height_m;
   if (particles.count <= 0) return particles.bed_height_mf_m;
   return static_cast<double>(particles.count) * particle_volume_m3() /
          ((1.0 - eps_mf) * geometry.width_m * geometry.depth_m);

@@ -14,8 +14,10 @@
 //  - the time resolution is the one scene value that sets the model's time step, swept by the
 //    work-precision study beside the grid (DPM: DEM steps per contact time; TFM: the CFL number).
 //
-// Built in: "dpm" (dpm.h, CFD-DEM) and "tfm" (tfm.h, two-fluid with KTGF). Units SI. Thread-safety:
-// register before running; a registered model is immutable and may run on several threads.
+// Built in: "dpm" (dpm.h, CFD-DEM), "tfm" (tfm.h, two-fluid with KTGF) and "dbm" (dbm.h, discrete
+// bubbles in an emulsion; its realization is an injection seed, its time resolution dt_s). Units
+// SI. Thread-safety: register before running; a registered model is immutable and may run on
+// several threads.
 #pragma once
 
 #include <cstdint>
@@ -63,6 +65,10 @@ struct BedResult {
   /// The state at the sample nearest to t_ref (false: the run ended before it), for figures.
   bool has_snapshot = false;
   BedSnapshot snapshot;
+  /// The model's headline numbers, named with their unit, for the studies (DBM: hold-up, mean
+  /// bubble sizes at the report heights, circulation); empty for the jet-bubble models, whose
+  /// headline is the bubble in `metrics`.
+  std::vector<std::pair<std::string, double>> headline;
   std::string result_json;  ///< The model's full result (a JSON object with "solver": key).
   std::string brief;        ///< One-line report.
 };

@@ -99,10 +99,12 @@ struct SceneTime {
   double gas_dt_s = 0.0;    ///< Gas step, or 0: recommended_gas_dt_s (SceneDerived).
 };
 
-/// Gas grid: cells across the width and the height, one cell across the depth.
+/// Gas grid: cells across the width and the height, and across the depth (1 for the pseudo-2D
+/// models; the DBM's emulsion grid is 3-D).
 struct SceneGrid {
   int cells_x = 0;
   int cells_y = 0;
+  int cells_z = 1;
 };
 
 /// Bubble criterion: cells with eps_g above the threshold that are connected to the jet's bubble.
@@ -143,11 +145,36 @@ struct SceneTfm {
   std::string granular_temperature = "transport";  ///< Or "algebraic" (local equilibrium).
 };
 
+/// [dbm]: the discrete bubble model (read only with solver = "dbm", which requires the table;
+/// dbm.h, docs/dbm.md). The emulsion fills the column; its top is the bed surface.
+struct SceneDbm {
+  bool present = false;
+  double superficial_velocity_m_s = 0.1;  ///< u0, (0, 10]; bubbles carry (u0 - U_mf) A.
+  double emulsion_density_kg_m3 = 400.0;  ///< (bubble density, 20000].
+  double emulsion_viscosity_pa_s = 1.0;   ///< Apparent viscosity, (0, 1000].
+  double bubble_density_kg_m3 = 25.0;     ///< (0, emulsion density).
+  /// Injected size [m], (0, column); 0: Davidson-Harrison from each nozzle's flow.
+  double bubble_diameter_m = 0.04;
+  int nozzles_per_side = 7;     ///< A square of n x n nozzles centred on the bottom, [1, 100].
+  double nozzle_pitch_m = 0.1;  ///< Their spacing, > 0; the square must fit the bottom.
+  double virtual_mass_coefficient = 0.5;  ///< [0, 10].
+  bool lift = false;
+  double lift_coefficient = 0.5;  ///< [-1, 1], with lift = true.
+  bool coalescence = false;
+  double film_drainage_s = 0.0;    ///< [0, 10].
+  double dt_s = 2e-3;              ///< Fixed step, (0, the stability limit].
+  double injection_ramp_s = 0.0;   ///< Start-up ramp of the bubble flow, [0, duration_s).
+  std::string walls = "no_slip";   ///< Or "free_slip": the emulsion at the side walls.
+  double average_from_s = 10.0;    ///< Time averages from here, [0, duration_s).
+  double sample_interval_s = 0.1;  ///< Bubble samples, (0, duration_s].
+  std::vector<double> size_heights_m = {1.0, 2.0};  ///< Where mean sizes are reported.
+};
+
 /// A scene file, parsed. Built by parse_scene / load_scene; IsValid checks every range.
 struct Scene {
   std::string name;
   std::string description;
-  std::string solver = "dpm";  ///< A registered bed model: "dpm", "tfm" (bed_model.h).
+  std::string solver = "dpm";  ///< A registered bed model: "dpm", "tfm", "dbm" (bed_model.h).
   std::uint64_t seed = 1;      ///< Initial packing realization.
   SceneGeometry geometry;
   SceneParticles particles;
@@ -159,6 +186,9 @@ struct Scene {
   SceneBubble bubble;
   SceneOutputs outputs;
   SceneTfm tfm;
+  SceneDbm dbm;
+  /// The tables the file has (the DBM refuses those of the jet-driven models).
+  std::vector<std::string> tables;
   /// The file has a [dem] table (the DPM's contact and DEM-step keys there; older files keep
   /// them in [particles] and [time], which messages then name).
   bool dem_table = false;
@@ -180,7 +210,8 @@ struct Scene {
   double particle_mass_kg() const;
   /// Particle count: `count`, or (1 - eps_mf) W D H_mf / V_p rounded.
   std::int64_t particle_count() const;
-  /// Bed height at eps_mf: `bed_height_mf_m`, or N V_p / ((1 - eps_mf) W D).
+  /// Bed height at eps_mf: `bed_height_mf_m`, or N V_p / ((1 - eps_mf) W D); the DBM's bed
+  /// fills the column (height_m).
   double bed_height_mf_m() const;
   /// Slot centre [m] (jet.center_m, or width/2).
   double jet_center_m() const;

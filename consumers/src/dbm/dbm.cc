@@ -1,0 +1,730 @@
+// The discrete bubble model (draglab/consumers/dbm.h): emulsion on the 3-D MAC grid, bubbles,
+// injection, coalescence and the time averages.
+#include "draglab/consumers/dbm.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "draglab/consumers/mac_pressure.h"
+#include "draglab/drag_db/error.h"
+#include "gas/mac_operators.h"
+#include "gas/particle_kernel.h"
+#include "scene/scene_util.h"
+
+namespace draglab {
+namespace consumers {
+namespace {
+
+using scene_util::fmt;
+using Vec = Eigen::Vector3d;
+constexpr double kPi = 3.14159265358979323846;
+/// The emulsion fraction is kept above this where bubbles crowd (counted as clamps): the
+/// emulsion equations lose meaning as eps_e -> 0.
+constexpr double kMinEmulsionFraction = 0.4;
+/// Size bins of the bubble-size histogram: 1 cm, up to 1 m (the last bin takes larger ones).
+constexpr int kSizeBins = 100;
+
+[[noreturn]] void Bad(const std::string& message) {
+  throw Error(ErrorCode::kInvalidArgument, message);
+}
+
+bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+double SphereVolume(double d) { return kPi / 6.0 * d * d * d; }
+double SphereDiameter(double volume) { return std::cbrt(6.0 * volume / kPi); }
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+BubbleForceOptions ForceOptions(const DbmOptions& o) {
+  BubbleForceOptions f;
+  f.emulsion_density_kg_m3 = o.emulsion_density_kg_m3;
+  f.bubble_density_kg_m3 = o.bubble_density_kg_m3;
+  f.virtual_mass_coefficient = o.virtual_mass_coefficient;
+  f.gravity = Vec(0.0, 0.0, -o.gravity_m_s2);
+  return f;
+}
+
+}  // namespace
+
+std::vector<DbmNozzle> square_nozzle_array(int nozzles_per_side, double pitch_m, double width_m,
+                                           double depth_m) {
+  std::vector<DbmNozzle> out;
+  const double half = 0.5 * (nozzles_per_side - 1) * pitch_m;
+  for (int b = 0; b < nozzles_per_side; ++b) {
+    for (int a = 0; a < nozzles_per_side; ++a) {
+      out.push_back({0.5 * width_m - half + a * pitch_m, 0.5 * depth_m - half + b * pitch_m});
+    }
+  }
+  return out;
+}
+
+bool DbmOptions::IsValid(std::string* error) const {
+  auto positive = [&](double v, const char* name) {
+    return std::isfinite(v) && v > 0.0
+               ? true
+               : fail(error, std::string(name) + " must be > 0, got " + fmt(v));
+  };
+  if (!positive(width_m, "width_m") || !positive(depth_m, "depth_m") ||
+      !positive(height_m, "height_m") ||
+      !positive(emulsion_density_kg_m3, "emulsion_density_kg_m3") ||
+      !positive(emulsion_viscosity_pa_s, "emulsion_viscosity_pa_s") ||
+      !positive(gravity_m_s2, "gravity_m_s2") ||
+      !positive(bubble_density_kg_m3, "bubble_density_kg_m3") ||
+      !positive(bubble_diameter_m, "bubble_diameter_m") || !positive(dt_s, "dt_s") ||
+      !positive(sample_interval_s, "sample_interval_s") ||
+      !positive(cg_tolerance, "cg_tolerance")) {
+    return false;
+  }
+  if (nx < 2 || nz < 2 || ny < 1)
+    return fail(error, "cells: nx and nz must be >= 2 and ny >= 1, got " + std::to_string(nx) +
+                           ", " + std::to_string(nz) + ", " + std::to_string(ny));
+  if (!(bubble_density_kg_m3 < emulsion_density_kg_m3))
+    return fail(error, "bubble_density_kg_m3 = " + fmt(bubble_density_kg_m3) +
+                           " must be below the emulsion density " + fmt(emulsion_density_kg_m3) +
+                           " kg/m^3 (bubbles rise)");
+  if (!(virtual_mass_coefficient >= 0.0 && virtual_mass_coefficient <= 10.0))
+    return fail(
+        error, "virtual_mass_coefficient must be in [0, 10], got " + fmt(virtual_mass_coefficient));
+  if (lift && !(std::abs(lift_coefficient) <= 1.0))
+    return fail(error, "lift_coefficient must be in [-1, 1], got " + fmt(lift_coefficient));
+  if (!(bubble_gas_flow_m3_s >= 0.0 && std::isfinite(bubble_gas_flow_m3_s)))
+    return fail(error, "bubble_gas_flow_m3_s must be >= 0, got " + fmt(bubble_gas_flow_m3_s));
+  if (!(film_drainage_s >= 0.0 && film_drainage_s <= 10.0))
+    return fail(error, "film_drainage_s must be in [0, 10] s, got " + fmt(film_drainage_s));
+  if (!(average_from_s >= 0.0)) return fail(error, "average_from_s must be >= 0");
+  if (!(injection_ramp_s >= 0.0 && injection_ramp_s <= 1e4))
+    return fail(error, "injection_ramp_s must be in [0, 1e4] s, got " + fmt(injection_ramp_s));
+  const double column = std::min(width_m, depth_m);
+  if (!(bubble_diameter_m < column))
+    return fail(error, "bubble_diameter_m = " + fmt(bubble_diameter_m) +
+                           " m is not smaller than the column (" + fmt(column) +
+                           " m across): such a bubble is a slug, which the DBM's spheres do "
+                           "not represent");
+  if (bubble_gas_flow_m3_s > 0.0 && nozzles.empty())
+    return fail(error, "nozzles: a bubble gas flow needs at least one nozzle");
+  const double r = 0.5 * bubble_diameter_m;
+  for (std::size_t n = 0; n < nozzles.size(); ++n) {
+    const DbmNozzle& a = nozzles[n];
+    if (!(a.x_m >= r && a.x_m <= width_m - r && a.y_m >= r && a.y_m <= depth_m - r))
+      return fail(error, "nozzle " + std::to_string(n) + " at (" + fmt(a.x_m) + ", " + fmt(a.y_m) +
+                             ") m is closer than a bubble radius (" + fmt(r) + " m) to a wall");
+    for (std::size_t m = 0; m < n; ++m) {
+      const double gap = std::hypot(a.x_m - nozzles[m].x_m, a.y_m - nozzles[m].y_m);
+      if (gap < bubble_diameter_m)
+        return fail(error, "nozzles " + std::to_string(m) + " and " + std::to_string(n) + " are " +
+                               fmt(gap) + " m apart, less than the bubble diameter " +
+                               fmt(bubble_diameter_m) +
+                               " m: their bubbles would overlap (widen the nozzle pitch)");
+    }
+  }
+  return true;
+}
+
+double DbmOptions::StableTimeStep() const {
+  const double hx = width_m / nx, hy = depth_m / ny, hz = height_m / nz;
+  double inv_h2 = 1.0 / (hx * hx) + 1.0 / (hz * hz);
+  if (ny > 1) inv_h2 += 1.0 / (hy * hy);
+  const double viscous = emulsion_density_kg_m3 / (2.0 * emulsion_viscosity_pa_s * inv_h2);
+  const BubbleForceModel force(ForceOptions(*this));
+  const double u_br = davies_taylor_rise_velocity(bubble_diameter_m, gravity_m_s2);
+  const double relaxation = force.inertia_density() * bubble_diameter_m /
+                            (0.75 * force.drag_coefficient() * emulsion_density_kg_m3 * u_br);
+  return std::min(viscous, relaxation);
+}
+
+struct DbmSimulation::Impl {
+  std::array<int, 3> n{};     // cells per axis (0 x, 1 z, 2 y)
+  std::array<double, 3> h{};  // cell size per axis
+  int cells = 0;
+  double cell_volume = 0.0;
+  std::array<Eigen::VectorXd, 3> vel, vel_star;  // face velocities normal to each axis
+  Eigen::VectorXd eps_e, eps_e_new, eps_b, pressure;
+  // Cell-centred emulsion quantities the bubbles see, by physical component (x, y, z).
+  std::array<Eigen::VectorXd, 3> uc, uc_prev, grad_p, accel, curl, reaction;
+  bool have_prev = false;
+  std::unique_ptr<MacPressureSolver> solver;
+  std::vector<double> forming;  // gas in the bubble forming at each nozzle [m^3]
+  double nozzle_flow = 0.0;     // per nozzle [m^3/s]
+  std::uint64_t next_id = 1;
+  std::map<std::pair<std::uint64_t, std::uint64_t>, double> contact_since;
+  double next_sample = 0.0;
+  double top_outflow = 0.0;
+  int size_bins = kSizeBins;
+
+  static int AxisOf(int component) { return component == 0 ? 0 : (component == 1 ? 2 : 1); }
+  int Cell(int i, int j, int k) const { return i + n[0] * (j + n[1] * k); }
+  internal::Tent3 TentOf(const Vec& x) const {
+    return internal::TentAt3(x(0), x(1), x(2), h[0], h[2], h[1], n[0], n[2], n[1]);
+  }
+};
+
+DbmSimulation::DbmSimulation(const DbmOptions& options)
+    : opt_(options),
+      force_((
+          [&] {
+            std::string why;
+            if (!options.IsValid(&why)) Bad("dbm: " + why);
+          }(),
+          ForceOptions(options))),
+      impl_(std::make_unique<Impl>()) {
+  const double stable = opt_.StableTimeStep();
+  if (opt_.dt_s > stable * (1.0 + 1e-12))
+    Bad("dbm: dt_s = " + fmt(opt_.dt_s) + " s is above the stability limit " + fmt(stable) +
+        " s (the emulsion's explicit viscous limit and the bubbles' slip relaxation time); "
+        "remedy: dt_s <= " +
+        fmt(stable) + " s");
+  Impl& m = *impl_;
+  m.n = {opt_.nx, opt_.nz, opt_.ny};
+  m.h = {opt_.width_m / opt_.nx, opt_.height_m / opt_.nz, opt_.depth_m / opt_.ny};
+  m.cells = opt_.nx * opt_.ny * opt_.nz;
+  m.cell_volume = m.h[0] * m.h[1] * m.h[2];
+  for (int a = 0; a < 3; ++a) {
+    std::array<int, 3> f = m.n;
+    ++f[a];
+    m.vel[a] = Eigen::VectorXd::Zero(static_cast<long>(f[0]) * f[1] * f[2]);
+    m.vel_star[a] = m.vel[a];
+  }
+  for (auto* field : {&m.eps_e, &m.eps_e_new}) *field = Eigen::VectorXd::Ones(m.cells);
+  m.eps_b = Eigen::VectorXd::Zero(m.cells);
+  m.pressure = Eigen::VectorXd::Zero(m.cells);
+  for (auto* group : {&m.uc, &m.uc_prev, &m.grad_p, &m.accel, &m.curl, &m.reaction}) {
+    for (auto& field : *group) field = Eigen::VectorXd::Zero(m.cells);
+  }
+  MacPressureOptions po;
+  po.nx = opt_.nx;
+  po.nz = opt_.nz;
+  po.ny = opt_.ny;
+  po.dx = m.h[0];
+  po.dz = m.h[1];
+  po.dy = m.h[2];
+  po.solver = opt_.solver;
+  po.cg_tolerance = opt_.cg_tolerance;
+  po.cg_max_iterations = 20000;
+  m.solver = std::make_unique<MacPressureSolver>(po);
+
+  // Injection: a bubble forms at each nozzle from its share of the flow and is released when it
+  // holds V_b; the forming bubbles start from seeded random volumes (the nozzles' phases), gas
+  // counted as injected at t = 0.
+  if (opt_.bubble_gas_flow_m3_s > 0.0) {
+    m.nozzle_flow = opt_.bubble_gas_flow_m3_s / static_cast<double>(opt_.nozzles.size());
+    std::mt19937_64 rng(opt_.seed);
+    std::uniform_real_distribution<double> phase(0.0, SphereVolume(opt_.bubble_diameter_m));
+    for (std::size_t k = 0; k < opt_.nozzles.size(); ++k) {
+      m.forming.push_back(phase(rng));
+      diag_.gas_injected_m3 += m.forming.back();
+    }
+  }
+  m.next_sample = opt_.average_from_s;
+  avg_.w_cell = avg_.u_cell = avg_.v_cell = Eigen::VectorXd::Zero(m.cells);
+  avg_.bubble_fraction = Eigen::VectorXd::Zero(m.cells);
+  avg_.holdup_by_height = Eigen::VectorXd::Zero(opt_.nz);
+  avg_.diameter_sum_by_height = Eigen::VectorXd::Zero(opt_.nz);
+  avg_.count_by_height = Eigen::VectorXd::Zero(opt_.nz);
+  avg_.size_histogram = Eigen::MatrixXd::Zero(opt_.nz, m.size_bins);
+}
+
+DbmSimulation::~DbmSimulation() = default;
+
+std::uint64_t DbmSimulation::AddBubble(const Vec& x, const Vec& v, double diameter_m) {
+  if (!(diameter_m > 0.0 && diameter_m < std::min(opt_.width_m, opt_.depth_m)))
+    Bad("dbm: a bubble's diameter must be in (0, column width), got " + fmt(diameter_m));
+  DbmBubble b;
+  b.x = x;
+  b.v = v;
+  b.diameter_m = diameter_m;
+  b.volume_m3 = SphereVolume(diameter_m);
+  b.id = impl_->next_id++;
+  bubbles_.push_back(b);
+  diag_.max_bubble_diameter_m = std::max(diag_.max_bubble_diameter_m, diameter_m);
+  return b.id;
+}
+
+double DbmSimulation::gas_in_bubbles_m3() const {
+  double v = 0.0;
+  for (const DbmBubble& b : bubbles_) v += b.volume_m3;
+  return v;
+}
+
+double DbmSimulation::gas_forming_m3() const {
+  double v = 0.0;
+  for (double f : impl_->forming) v += f;
+  return v;
+}
+
+const Eigen::VectorXd& DbmSimulation::bubble_fraction() const { return impl_->eps_b; }
+const Eigen::VectorXd& DbmSimulation::dynamic_pressure() const { return impl_->pressure; }
+double DbmSimulation::top_outflow_m3_s() const { return impl_->top_outflow; }
+
+Eigen::VectorXd DbmSimulation::emulsion_velocity(int component) const {
+  const Impl& m = *impl_;
+  const int a = Impl::AxisOf(component);
+  Eigen::VectorXd out(m.cells);
+  for (int k = 0; k < m.n[2]; ++k) {
+    for (int j = 0; j < m.n[1]; ++j) {
+      for (int i = 0; i < m.n[0]; ++i) {
+        std::array<int, 3> p{i, j, k}, q{i, j, k};
+        ++q[a];
+        std::array<int, 3> f = m.n;
+        ++f[a];
+        auto face = [&](const std::array<int, 3>& r) { return r[0] + f[0] * (r[1] + f[1] * r[2]); };
+        out(m.Cell(i, j, k)) = 0.5 * (m.vel[a](face(p)) + m.vel[a](face(q)));
+      }
+    }
+  }
+  return out;
+}
+
+Eigen::Vector3d DbmSimulation::EmulsionVelocityAt(const Vec& x) const {
+  const Impl& m = *impl_;
+  const internal::Tent3 t = m.TentOf(x);
+  Vec u;
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::VectorXd field = emulsion_velocity(c);
+    u(c) = internal::Interpolate3(field, t, m.n[0], m.n[1]);
+  }
+  return u;
+}
+
+void DbmSimulation::AdvanceTo(double t_s) {
+  while (time_ < t_s - 1e-9 * opt_.dt_s) Step();
+}
+
+void DbmSimulation::Step() {
+  Impl& m = *impl_;
+  const double dt = opt_.dt_s;
+  const double t1 = time_ + dt;
+  const double rho_e = opt_.emulsion_density_kg_m3;
+  const double g = opt_.gravity_m_s2;
+  const int nx = m.n[0], nz = m.n[1], ny = m.n[2];
+  const auto bubbles_start = std::chrono::steady_clock::now();
+
+  // 1. What the bubbles see: cell-centred emulsion velocity, pressure gradient (less the
+  // hydrostatic head), material acceleration and (for lift) vorticity, by physical component.
+  for (int c = 0; c < 3; ++c) m.uc[c] = emulsion_velocity(c);
+  auto at = [&](const Eigen::VectorXd& f, int i, int j, int k) {
+    return f(m.Cell(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1), std::clamp(k, 0, ny - 1)));
+  };
+#pragma omp parallel for schedule(static)
+  for (int k = 0; k < ny; ++k) {
+    for (int j = 0; j < nz; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        const int cell = m.Cell(i, j, k);
+        const double p = m.pressure(cell);
+        // Face gradients (zero through walls, the outlet p = 0 half a cell above the top row),
+        // averaged to the centre.
+        auto face_grad = [&](int di, int dj, int dk, double hh, bool wall) {
+          if (wall) return 0.0;
+          return (at(m.pressure, i + di, j + dj, k + dk) - p) / hh;
+        };
+        const double gx =
+            0.5 * (face_grad(1, 0, 0, m.h[0], i == nx - 1) - face_grad(-1, 0, 0, m.h[0], i == 0));
+        const double gy =
+            0.5 * (face_grad(0, 0, 1, m.h[2], k == ny - 1) - face_grad(0, 0, -1, m.h[2], k == 0));
+        const double g_top =
+            j == nz - 1 ? (0.0 - p) / (0.5 * m.h[1]) : face_grad(0, 1, 0, m.h[1], false);
+        const double gz = 0.5 * (g_top - face_grad(0, -1, 0, m.h[1], j == 0));
+        m.grad_p[0](cell) = gx;
+        m.grad_p[1](cell) = gy;
+        m.grad_p[2](cell) = gz;
+        // Velocity gradients, central differences (one-sided at the boundaries).
+        auto d_dx = [&](const Eigen::VectorXd& f) {
+          const int a = std::max(i - 1, 0), b = std::min(i + 1, nx - 1);
+          return b > a ? (at(f, b, j, k) - at(f, a, j, k)) / ((b - a) * m.h[0]) : 0.0;
+        };
+        auto d_dy = [&](const Eigen::VectorXd& f) {
+          const int a = std::max(k - 1, 0), b = std::min(k + 1, ny - 1);
+          return b > a ? (at(f, i, j, b) - at(f, i, j, a)) / ((b - a) * m.h[2]) : 0.0;
+        };
+        auto d_dz = [&](const Eigen::VectorXd& f) {
+          const int a = std::max(j - 1, 0), b = std::min(j + 1, nz - 1);
+          return b > a ? (at(f, i, b, k) - at(f, i, a, k)) / ((b - a) * m.h[1]) : 0.0;
+        };
+        const Vec u(m.uc[0](cell), m.uc[1](cell), m.uc[2](cell));
+        for (int c = 0; c < 3; ++c) {
+          const double dudt = m.have_prev ? (m.uc[c](cell) - m.uc_prev[c](cell)) / dt : 0.0;
+          m.accel[c](cell) =
+              dudt + u(0) * d_dx(m.uc[c]) + u(1) * d_dy(m.uc[c]) + u(2) * d_dz(m.uc[c]);
+        }
+        if (opt_.lift) {
+          m.curl[0](cell) = d_dy(m.uc[2]) - d_dz(m.uc[1]);
+          m.curl[1](cell) = d_dz(m.uc[0]) - d_dx(m.uc[2]);
+          m.curl[2](cell) = d_dx(m.uc[1]) - d_dy(m.uc[0]);
+        }
+      }
+    }
+  }
+  for (int c = 0; c < 3; ++c) m.uc_prev[c] = m.uc[c];
+  m.have_prev = true;
+
+  // 2. Injection: the forming bubbles grow by the nozzle flow; a full one is released, leaving
+  // the nozzle at its rise velocity. The emulsion sees them grow (no impulsive displacement).
+  if (m.nozzle_flow > 0.0) {
+    const double d = opt_.bubble_diameter_m;
+    const double v_b = SphereVolume(d);
+    const double u_br = davies_taylor_rise_velocity(d, g);
+    // The start-up ramp: the flow rises linearly over injection_ramp_s (its mean over the step).
+    const double ramp = opt_.injection_ramp_s > 0.0
+                            ? std::min(1.0, (time_ + 0.5 * dt) / opt_.injection_ramp_s)
+                            : 1.0;
+    for (std::size_t k = 0; k < opt_.nozzles.size(); ++k) {
+      m.forming[k] += ramp * m.nozzle_flow * dt;
+      diag_.gas_injected_m3 += ramp * m.nozzle_flow * dt;
+      while (m.forming[k] >= v_b) {
+        AddBubble(Vec(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * d), Vec(0.0, 0.0, u_br), d);
+        diag_.bubbles_injected += 1;
+        m.forming[k] -= v_b;
+      }
+    }
+  }
+
+  // 3. Bubble motion (drag implicit) and the force each exerts on the emulsion.
+  const long nb = static_cast<long>(bubbles_.size());
+  std::vector<Vec> reaction(static_cast<std::size_t>(nb));
+  const Vec gravity(0.0, 0.0, -g);
+  const double rho_b = opt_.bubble_density_kg_m3;
+  const double c_vm = opt_.virtual_mass_coefficient;
+#pragma omp parallel for schedule(static)
+  for (long b = 0; b < nb; ++b) {
+    DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
+    const internal::Tent3 t = m.TentOf(bub.x);
+    Vec u, gp, acc;
+    for (int c = 0; c < 3; ++c) {
+      u(c) = internal::Interpolate3(m.uc[c], t, nx, nz);
+      gp(c) = internal::Interpolate3(m.grad_p[c], t, nx, nz);
+      acc(c) = internal::Interpolate3(m.accel[c], t, nx, nz);
+    }
+    gp(2) -= rho_e * g;  // the hydrostatic head: grad p = grad p' + rho_e g_vec
+    Vec gp_and_lift = gp;
+    if (opt_.lift) {
+      Vec w;
+      for (int c = 0; c < 3; ++c) w(c) = internal::Interpolate3(m.curl[c], t, nx, nz);
+      // F_L / V = -C_L rho_e (v - u) x curl u, folded into the pressure-gradient argument.
+      const Vec slip = bub.v - u;
+      gp_and_lift += opt_.lift_coefficient * rho_e * slip.cross(w);
+    }
+    const Vec v_new = force_.Step(bub.v, u, gp_and_lift, acc, bub.diameter_m, dt);
+    // What the emulsion exerted besides the pressure and gravity: drag, virtual mass, lift,
+    // less the virtual mass's emulsion-acceleration part C_VM rho_e V Du/Dt, which the emulsion
+    // carries as added inertia instead (explicitly it feeds the emulsion's own acceleration
+    // back with gain C_VM eps_b / eps_e, unstable in crowded cells).
+    reaction[static_cast<std::size_t>(b)] =
+        bub.volume_m3 * (rho_b * (v_new - bub.v) / dt - rho_b * gravity + gp - c_vm * rho_e * acc);
+    bub.v = v_new;
+    bub.x += dt * v_new;
+    // Walls: the centre stays a radius away; the normal velocity into a wall is dropped.
+    const double r = 0.5 * bub.diameter_m;
+    const double lo[3] = {r, r, r};
+    const double hi[3] = {opt_.width_m - r, opt_.depth_m - r, 1e300};
+    for (int c = 0; c < 3; ++c) {
+      if (bub.x(c) < lo[c]) {
+        bub.x(c) = lo[c];
+        bub.v(c) = std::max(bub.v(c), 0.0);
+      } else if (bub.x(c) > hi[c]) {
+        bub.x(c) = hi[c];
+        bub.v(c) = std::min(bub.v(c), 0.0);
+      }
+    }
+  }
+  diag_.bubble_steps += nb;
+  for (auto& f : m.reaction) f.setZero();
+  for (long b = 0; b < nb; ++b) {
+    const DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
+    const internal::Tent3 t = m.TentOf(bub.x);
+    for (int c = 0; c < 3; ++c)
+      internal::Deposit3(m.reaction[c], t,
+                         -reaction[static_cast<std::size_t>(b)](c) / m.cell_volume, nx, nz);
+  }
+
+  // 4. Bubbles leave at the bed surface.
+  {
+    std::size_t kept = 0;
+    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
+      if (bubbles_[b].x(2) >= opt_.height_m) {
+        diag_.bubbles_left += 1;
+        diag_.gas_left_m3 += bubbles_[b].volume_m3;
+      } else {
+        bubbles_[kept++] = bubbles_[b];
+      }
+    }
+    bubbles_.resize(kept);
+  }
+
+  // 5. Coalescence: touching pairs from cell lists, merged after the film-drainage time.
+  if (opt_.coalescence && bubbles_.size() > 1) {
+    double d_max = 0.0;
+    for (const DbmBubble& b : bubbles_) d_max = std::max(d_max, b.diameter_m);
+    const double L[3] = {opt_.width_m, opt_.depth_m, opt_.height_m * 1.01};
+    int nb3[3];
+    for (int c = 0; c < 3; ++c) nb3[c] = std::max(1, std::min(512, static_cast<int>(L[c] / d_max)));
+    auto bin_of = [&](const Vec& x, int c) {
+      return std::clamp(static_cast<int>(x(c) / L[c] * nb3[c]), 0, nb3[c] - 1);
+    };
+    const int bins = nb3[0] * nb3[1] * nb3[2];
+    std::vector<int> start(static_cast<std::size_t>(bins) + 1, 0), order(bubbles_.size());
+    std::vector<int> bin(bubbles_.size());
+    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
+      const Vec& x = bubbles_[b].x;
+      bin[b] = bin_of(x, 0) + nb3[0] * (bin_of(x, 1) + nb3[1] * bin_of(x, 2));
+      ++start[static_cast<std::size_t>(bin[b]) + 1];
+    }
+    for (int q = 0; q < bins; ++q) start[q + 1] += start[q];
+    {
+      std::vector<int> fill(start.begin(), start.end() - 1);
+      for (std::size_t b = 0; b < bubbles_.size(); ++b) order[fill[bin[b]]++] = static_cast<int>(b);
+    }
+    std::map<std::pair<std::uint64_t, std::uint64_t>, double> touching;
+    std::vector<std::pair<int, int>> ready;
+    for (std::size_t a = 0; a < bubbles_.size(); ++a) {
+      const Vec& xa = bubbles_[a].x;
+      const int b0 = bin_of(xa, 0), b1 = bin_of(xa, 1), b2 = bin_of(xa, 2);
+      for (int o2 = std::max(b2 - 1, 0); o2 <= std::min(b2 + 1, nb3[2] - 1); ++o2) {
+        for (int o1 = std::max(b1 - 1, 0); o1 <= std::min(b1 + 1, nb3[1] - 1); ++o1) {
+          for (int o0 = std::max(b0 - 1, 0); o0 <= std::min(b0 + 1, nb3[0] - 1); ++o0) {
+            const int q = o0 + nb3[0] * (o1 + nb3[1] * o2);
+            for (int s = start[q]; s < start[q + 1]; ++s) {
+              const int b = order[s];
+              if (b <= static_cast<int>(a)) continue;
+              const double reach = 0.5 * (bubbles_[a].diameter_m + bubbles_[b].diameter_m);
+              if ((bubbles_[b].x - xa).squaredNorm() >= reach * reach) continue;
+              const auto key = std::minmax(bubbles_[a].id, bubbles_[b].id);
+              const auto found = m.contact_since.find(key);
+              const double since = found == m.contact_since.end() ? t1 : found->second;
+              touching[key] = since;
+              if (t1 - since >= opt_.film_drainage_s - 1e-12)
+                ready.emplace_back(static_cast<int>(a), b);
+            }
+          }
+        }
+      }
+    }
+    m.contact_since = std::move(touching);
+    std::vector<char> gone(bubbles_.size(), 0);
+    for (const auto& [a, b] : ready) {
+      if (gone[a] || gone[b]) continue;  // each bubble merges at most once per step
+      DbmBubble& A = bubbles_[a];
+      const DbmBubble& B = bubbles_[b];
+      const double v = A.volume_m3 + B.volume_m3;
+      A.x = (A.volume_m3 * A.x + B.volume_m3 * B.x) / v;
+      A.v = (A.volume_m3 * A.v + B.volume_m3 * B.v) / v;
+      A.volume_m3 = v;
+      A.diameter_m = SphereDiameter(v);
+      gone[b] = 1;
+      // The merged bubble keeps A's id; its pending contacts restart.
+      diag_.coalescences += 1;
+      diag_.max_bubble_diameter_m = std::max(diag_.max_bubble_diameter_m, A.diameter_m);
+      if (A.diameter_m >= std::min(opt_.width_m, opt_.depth_m)) {
+        throw std::runtime_error(
+            "dbm: at t = " + fmt(t1) + " s coalescence made a bubble of " + fmt(A.diameter_m) +
+            " m, as wide as the column: the bed slugs, which spherical bubbles do not represent; "
+            "remedy: a wider column, a lower superficial velocity, or a film-drainage time");
+      }
+    }
+    std::size_t kept = 0;
+    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
+      if (!gone[b]) bubbles_[kept++] = bubbles_[b];
+    }
+    bubbles_.resize(kept);
+  }
+  diag_.bubble_wall_s += Seconds(bubbles_start);
+
+  // 6. The new bubble and emulsion fractions.
+  const auto emulsion_start = std::chrono::steady_clock::now();
+  m.eps_b.setZero();
+  for (const DbmBubble& b : bubbles_) {
+    // A bubble breaking through the surface displaces less emulsion as it leaves.
+    const double r = 0.5 * b.diameter_m;
+    const double inside = std::clamp((opt_.height_m - b.x(2)) / r, 0.0, 1.0);
+    internal::Deposit3(m.eps_b, m.TentOf(b.x), inside * b.volume_m3 / m.cell_volume, nx, nz);
+  }
+  for (std::size_t k = 0; k < m.forming.size(); ++k) {
+    const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
+    internal::Deposit3(m.eps_b, m.TentOf(at), m.forming[k] / m.cell_volume, nx, nz);
+  }
+  for (int c = 0; c < m.cells; ++c) {
+    diag_.max_bubble_fraction = std::max(diag_.max_bubble_fraction, m.eps_b(c));
+    double e = 1.0 - m.eps_b(c);
+    if (e < kMinEmulsionFraction) {
+      e = kMinEmulsionFraction;
+      diag_.fraction_clamps += 1;
+    }
+    m.eps_e_new(c) = e;
+  }
+
+  // 7. Emulsion predictor: advection and viscosity explicit, the bubbles' reaction as a source,
+  // the inertia (eps_e + C_VM eps_b) rho_e with the bubbles' added mass.
+  const std::array<const Eigen::VectorXd*, 3> vel{&m.vel[0], &m.vel[1], &m.vel[2]};
+  const internal::MacOperators3D ops(vel, m.eps_e, m.n, m.h, opt_.emulsion_viscosity_pa_s,
+                                     opt_.walls == WallSlip::kNoSlip,
+                                     opt_.depth_walls == WallSlip::kNoSlip);
+  auto face_index = [&](int a, int i, int j, int k) {
+    std::array<int, 3> f = m.n;
+    ++f[a];
+    return i + f[0] * (j + f[1] * k);
+  };
+  // The cells on the two sides of the face (a, p): p - e_a and p (clamped at the top face).
+  auto cell_below = [&](int a, std::array<int, 3> p) {
+    --p[a];
+    return m.Cell(p[0], p[1], p[2]);
+  };
+  auto cell_above = [&](int a, std::array<int, 3> p) {
+    p[a] = std::min(p[a], m.n[a] - 1);
+    return m.Cell(p[0], p[1], p[2]);
+  };
+  auto face_eps = [&](const Eigen::VectorXd& e, int a, const std::array<int, 3>& p) {
+    return 0.5 * (e(cell_below(a, p)) + e(cell_above(a, p)));
+  };
+  for (int a = 0; a < 3; ++a) {
+    const int component = Impl::AxisOf(a);  // the involution maps axes to components too
+    std::array<int, 3> f = m.n;
+    ++f[a];
+    Eigen::VectorXd& star = m.vel_star[a];
+    star.setZero();
+    // Evaluated faces: interior ones, and the top face for the vertical axis.
+    const int last = a == 1 ? f[a] - 1 : f[a] - 2;
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < f[2]; ++k) {
+      for (int j = 0; j < f[1]; ++j) {
+        for (int i = 0; i < f[0]; ++i) {
+          const std::array<int, 3> p{i, j, k};
+          if (p[a] < 1 || p[a] > last) continue;
+          const internal::FaceMomentumTerms terms = ops.Face(a, p);
+          const double e_f = face_eps(m.eps_e_new, a, p);
+          const double inertia = (e_f + c_vm * (1.0 - e_f)) * rho_e;
+          const double source = 0.5 * (m.reaction[component](cell_below(a, p)) +
+                                       m.reaction[component](cell_above(a, p)));
+          const int fi = face_index(a, i, j, k);
+          star(fi) = m.vel[a](fi) + dt * (-terms.advection + (terms.viscous + source) / inertia);
+        }
+      }
+    }
+  }
+
+  // 8. Projection: eps_e u = eps_e u* - eps_e a (dt / rho_e) grad p', a = eps_e / (eps_e +
+  // C_VM eps_b), continuity with storage.
+  std::array<Eigen::VectorXd, 3> coeff, eps_face;
+  for (int a = 0; a < 3; ++a) {
+    std::array<int, 3> f = m.n;
+    ++f[a];
+    coeff[a] = Eigen::VectorXd::Zero(m.vel[a].size());
+    eps_face[a] = Eigen::VectorXd::Zero(m.vel[a].size());
+    for (int k = 0; k < f[2]; ++k) {
+      for (int j = 0; j < f[1]; ++j) {
+        for (int i = 0; i < f[0]; ++i) {
+          const std::array<int, 3> p{i, j, k};
+          const bool wall = p[a] == 0 || (p[a] == f[a] - 1 && a != 1);
+          if (wall) continue;
+          const double e_f = face_eps(m.eps_e_new, a, p);
+          const int fi = face_index(a, i, j, k);
+          eps_face[a](fi) = e_f;
+          coeff[a](fi) = e_f * e_f / (e_f + c_vm * (1.0 - e_f)) * dt / rho_e;
+        }
+      }
+    }
+  }
+  const double area[3] = {m.h[1] * m.h[2], m.h[0] * m.h[2], m.h[0] * m.h[1]};
+  Eigen::VectorXd residual(m.cells);
+  for (int k = 0; k < ny; ++k) {
+    for (int j = 0; j < nz; ++j) {
+      for (int i = 0; i < nx; ++i) {
+        const int cell = m.Cell(i, j, k);
+        double net = m.cell_volume * (m.eps_e_new(cell) - m.eps_e(cell)) / dt;
+        for (int a = 0; a < 3; ++a) {
+          std::array<int, 3> lo{i, j, k}, hi{i, j, k};
+          ++hi[a];
+          const int flo = face_index(a, lo[0], lo[1], lo[2]);
+          const int fhi = face_index(a, hi[0], hi[1], hi[2]);
+          net += area[a] *
+                 (eps_face[a](fhi) * m.vel_star[a](fhi) - eps_face[a](flo) * m.vel_star[a](flo));
+        }
+        residual(cell) = net;
+      }
+    }
+  }
+  m.pressure = m.solver->Solve(coeff[0], coeff[2], coeff[1], residual, 0.0, m.pressure);
+  diag_.max_continuity_residual =
+      std::max(diag_.max_continuity_residual, m.solver->diagnostics().relative_residual);
+  diag_.max_cg_iterations = std::max(diag_.max_cg_iterations, m.solver->diagnostics().iterations);
+  double cfl = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    std::array<int, 3> f = m.n;
+    ++f[a];
+    for (int k = 0; k < f[2]; ++k) {
+      for (int j = 0; j < f[1]; ++j) {
+        for (int i = 0; i < f[0]; ++i) {
+          const std::array<int, 3> p{i, j, k};
+          const int fi = face_index(a, i, j, k);
+          if (coeff[a](fi) == 0.0) {
+            m.vel[a](fi) = 0.0;
+            continue;
+          }
+          const double p_up = p[a] < m.n[a] ? m.pressure(cell_above(a, p)) : 0.0;
+          const double hh = p[a] < m.n[a] ? m.h[a] : 0.5 * m.h[a];
+          const double grad = (p_up - m.pressure(cell_below(a, p))) / hh;
+          m.vel[a](fi) = m.vel_star[a](fi) - coeff[a](fi) / eps_face[a](fi) * grad;
+          cfl = std::max(cfl, std::abs(m.vel[a](fi)) * dt / m.h[a]);
+        }
+      }
+    }
+  }
+  {
+    double out = 0.0;
+    for (int k = 0; k < ny; ++k)
+      for (int i = 0; i < nx; ++i) {
+        const int fi = face_index(1, i, nz, k);
+        out += area[1] * eps_face[1](fi) * m.vel[1](fi);
+      }
+    m.top_outflow = out;
+  }
+  m.eps_e = m.eps_e_new;
+  diag_.max_cfl = std::max(diag_.max_cfl, cfl);
+  diag_.emulsion_wall_s += Seconds(emulsion_start);
+  time_ = t1;
+  diag_.steps += 1;
+  if (!(cfl <= 1.0)) {
+    throw std::runtime_error(
+        "dbm: at t = " + fmt(time_) + " s the emulsion moves " + fmt(cfl) +
+        " cells per step (above 1, the limit of its explicit advection): the run is diverging; "
+        "remedy: lower dt_s below " +
+        fmt(dt / std::max(cfl, 1e-300)) + " s or coarsen nothing and check the bubble flow");
+  }
+
+  // 9. Time averages and the bubble samples.
+  if (time_ > opt_.average_from_s + 1e-12) {
+    const double w = std::min(dt, time_ - opt_.average_from_s);
+    avg_.time_s += w;
+    avg_.u_cell += w * m.uc[0];
+    avg_.v_cell += w * m.uc[1];
+    avg_.w_cell += w * m.uc[2];
+    avg_.bubble_fraction += w * m.eps_b;
+  }
+  if (time_ >= m.next_sample - 1e-12 && time_ > opt_.average_from_s) {
+    m.next_sample += opt_.sample_interval_s;
+    avg_.samples += 1;
+    const double row_volume = opt_.width_m * opt_.depth_m * m.h[1];
+    for (const DbmBubble& b : bubbles_) {
+      const int row = std::clamp(static_cast<int>(b.x(2) / m.h[1]), 0, nz - 1);
+      avg_.holdup_by_height(row) += b.volume_m3 / row_volume;
+      avg_.diameter_sum_by_height(row) += b.diameter_m;
+      avg_.count_by_height(row) += 1.0;
+      const int s = std::min(static_cast<int>(b.diameter_m / avg_.size_bin_m), m.size_bins - 1);
+      avg_.size_histogram(row, s) += 1.0;
+    }
+  }
+}
+
+}  // namespace consumers
+}  // namespace draglab
