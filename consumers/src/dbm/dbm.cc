@@ -72,6 +72,16 @@ std::vector<DbmNozzle> square_nozzle_array(int nozzles_per_side, double pitch_m,
   return out;
 }
 
+DbmBubble merge_bubbles(const DbmBubble& a, const DbmBubble& b) {
+  DbmBubble m = a;
+  const double v = a.volume_m3 + b.volume_m3;
+  m.x = (a.volume_m3 * a.x + b.volume_m3 * b.x) / v;
+  m.v = (a.volume_m3 * a.v + b.volume_m3 * b.v) / v;
+  m.volume_m3 = v;
+  m.diameter_m = SphereDiameter(v);
+  return m;
+}
+
 bool DbmOptions::IsValid(std::string* error) const {
   auto positive = [&](double v, const char* name) {
     return std::isfinite(v) && v > 0.0
@@ -169,6 +179,30 @@ struct DbmSimulation::Impl {
   int Cell(int i, int j, int k) const { return i + n[0] * (j + n[1] * k); }
   internal::Tent3 TentOf(const Vec& x) const {
     return internal::TentAt3(x(0), x(1), x(2), h[0], h[2], h[1], n[0], n[2], n[1]);
+  }
+  /// The points a bubble is mapped through: its centre, or, for a bubble wider than the smallest
+  /// cell, a lattice of points filling its sphere (each carrying an equal share), so a large
+  /// bubble displaces and pushes the emulsion over its own volume, not one cell's.
+  std::vector<Vec> Spread(const Vec& x, double d, const std::array<double, 3>& lo,
+                          const std::array<double, 3>& hi) const {
+    const double h_min = std::min({h[0], h[1], h[2]});
+    if (d <= h_min) return {x};
+    const int per_axis = std::min(9, static_cast<int>(std::ceil(d / h_min)) + 1);
+    const double r = 0.5 * d;
+    std::vector<Vec> points;
+    for (int a = 0; a < per_axis; ++a)
+      for (int b = 0; b < per_axis; ++b)
+        for (int c = 0; c < per_axis; ++c) {
+          const Vec offset =
+              r * Vec(-1.0 + (2.0 * a + 1.0) / per_axis, -1.0 + (2.0 * b + 1.0) / per_axis,
+                      -1.0 + (2.0 * c + 1.0) / per_axis);
+          if (offset.norm() > r) continue;
+          Vec p = x + offset;
+          for (int k = 0; k < 3; ++k) p(k) = std::clamp(p(k), lo[k], hi[k]);
+          points.push_back(p);
+        }
+    if (points.empty()) points.push_back(x);
+    return points;
   }
 };
 
@@ -397,21 +431,26 @@ void DbmSimulation::Step() {
   const Vec gravity(0.0, 0.0, -g);
   const double rho_b = opt_.bubble_density_kg_m3;
   const double c_vm = opt_.virtual_mass_coefficient;
+  const std::array<double, 3> domain_lo{0.0, 0.0, 0.0};
+  const std::array<double, 3> domain_hi{opt_.width_m, opt_.depth_m, opt_.height_m};
 #pragma omp parallel for schedule(static)
   for (long b = 0; b < nb; ++b) {
     DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
-    const internal::Tent3 t = m.TentOf(bub.x);
-    Vec u, gp, acc;
-    for (int c = 0; c < 3; ++c) {
-      u(c) = internal::Interpolate3(m.uc[c], t, nx, nz);
-      gp(c) = internal::Interpolate3(m.grad_p[c], t, nx, nz);
-      acc(c) = internal::Interpolate3(m.accel[c], t, nx, nz);
+    const std::vector<Vec> points = m.Spread(bub.x, bub.diameter_m, domain_lo, domain_hi);
+    const double share = 1.0 / static_cast<double>(points.size());
+    Vec u = Vec::Zero(), gp = Vec::Zero(), acc = Vec::Zero(), w = Vec::Zero();
+    for (const Vec& point : points) {
+      const internal::Tent3 t = m.TentOf(point);
+      for (int c = 0; c < 3; ++c) {
+        u(c) += share * internal::Interpolate3(m.uc[c], t, nx, nz);
+        gp(c) += share * internal::Interpolate3(m.grad_p[c], t, nx, nz);
+        acc(c) += share * internal::Interpolate3(m.accel[c], t, nx, nz);
+        if (opt_.lift) w(c) += share * internal::Interpolate3(m.curl[c], t, nx, nz);
+      }
     }
     gp(2) -= rho_e * g;  // the hydrostatic head: grad p = grad p' + rho_e g_vec
     Vec gp_and_lift = gp;
     if (opt_.lift) {
-      Vec w;
-      for (int c = 0; c < 3; ++c) w(c) = internal::Interpolate3(m.curl[c], t, nx, nz);
       // F_L / V = -C_L rho_e (v - u) x curl u, folded into the pressure-gradient argument.
       const Vec slip = bub.v - u;
       gp_and_lift += opt_.lift_coefficient * rho_e * slip.cross(w);
@@ -443,10 +482,15 @@ void DbmSimulation::Step() {
   for (auto& f : m.reaction) f.setZero();
   for (long b = 0; b < nb; ++b) {
     const DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
-    const internal::Tent3 t = m.TentOf(bub.x);
-    for (int c = 0; c < 3; ++c)
-      internal::Deposit3(m.reaction[c], t,
-                         -reaction[static_cast<std::size_t>(b)](c) / m.cell_volume, nx, nz);
+    const std::vector<Vec> points = m.Spread(bub.x, bub.diameter_m, domain_lo, domain_hi);
+    const double share = 1.0 / static_cast<double>(points.size());
+    for (const Vec& point : points) {
+      const internal::Tent3 t = m.TentOf(point);
+      for (int c = 0; c < 3; ++c)
+        internal::Deposit3(m.reaction[c], t,
+                           -share * reaction[static_cast<std::size_t>(b)](c) / m.cell_volume, nx,
+                           nz);
+    }
   }
 
   // 4. Bubbles leave at the bed surface.
@@ -512,17 +556,12 @@ void DbmSimulation::Step() {
       }
     }
     m.contact_since = std::move(touching);
-    std::vector<char> gone(bubbles_.size(), 0);
+    std::vector<char> gone(bubbles_.size(), 0), merged(bubbles_.size(), 0);
     for (const auto& [a, b] : ready) {
-      if (gone[a] || gone[b]) continue;  // each bubble merges at most once per step
+      if (merged[a] || merged[b]) continue;  // each bubble merges at most once per step
       DbmBubble& A = bubbles_[a];
-      const DbmBubble& B = bubbles_[b];
-      const double v = A.volume_m3 + B.volume_m3;
-      A.x = (A.volume_m3 * A.x + B.volume_m3 * B.x) / v;
-      A.v = (A.volume_m3 * A.v + B.volume_m3 * B.v) / v;
-      A.volume_m3 = v;
-      A.diameter_m = SphereDiameter(v);
-      gone[b] = 1;
+      A = merge_bubbles(A, bubbles_[b]);
+      gone[b] = merged[a] = merged[b] = 1;
       // The merged bubble keeps A's id; its pending contacts restart.
       diag_.coalescences += 1;
       diag_.max_bubble_diameter_m = std::max(diag_.max_bubble_diameter_m, A.diameter_m);
@@ -548,7 +587,10 @@ void DbmSimulation::Step() {
     // A bubble breaking through the surface displaces less emulsion as it leaves.
     const double r = 0.5 * b.diameter_m;
     const double inside = std::clamp((opt_.height_m - b.x(2)) / r, 0.0, 1.0);
-    internal::Deposit3(m.eps_b, m.TentOf(b.x), inside * b.volume_m3 / m.cell_volume, nx, nz);
+    const std::vector<Vec> points = m.Spread(b.x, b.diameter_m, domain_lo, domain_hi);
+    const double share = inside / static_cast<double>(points.size());
+    for (const Vec& point : points)
+      internal::Deposit3(m.eps_b, m.TentOf(point), share * b.volume_m3 / m.cell_volume, nx, nz);
   }
   for (std::size_t k = 0; k < m.forming.size(); ++k) {
     const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));

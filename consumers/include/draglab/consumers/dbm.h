@@ -112,6 +112,10 @@ struct DbmBubble {
   std::uint64_t id = 0;
 };
 
+/// Coalescence of two bubbles: one bubble of their summed volume at the volume-weighted centre
+/// with the volume-weighted velocity (volume and momentum conserved; the id is a's).
+DbmBubble merge_bubbles(const DbmBubble& a, const DbmBubble& b);
+
 /// Counters and balances of a run.
 struct DbmDiagnostics {
   long steps = 0;
