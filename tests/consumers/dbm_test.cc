@@ -8,7 +8,8 @@
 //     2 % (the tolerance) relative to the emulsion it drags along, on cells at least
 //     1.25 d_b wide (the point-bubble coupling's requirement, docs/dbm.md).
 // (3) Gas volume: fed to the nozzles = in bubbles + forming + left at the surface, to
-//     round-off; coalescence conserves volume and momentum to round-off.
+//     round-off; coalescence conserves volume and momentum to round-off; a collision separates
+//     two bubbles and keeps their volume-weighted centre.
 // (4) Two-phase theory: bubbles fed uniformly over the bottom (no plume) at low u0 hold
 //     eps_b = (u0 - U_mf) / u_br; within 5 %: the emulsion's mean back-flow slows them by ~eps_b
 //     (2 %) and the time average over ~8 s of ~1e3 bubbles scatters by ~1 %.
@@ -189,6 +190,25 @@ TEST(DbmValidation, GasVolumeBalancesWithAndWithoutCoalescence) {
         d.gas_injected_m3 - d.gas_left_m3 - dbm.gas_in_bubbles_m3() - dbm.gas_forming_m3();
     EXPECT_LT(std::abs(balance) / d.gas_injected_m3, 1e-12) << "coalescence " << coalescence;
   }
+}
+
+TEST(DbmValidation, CollidingBubblesAreSeparatedAndKeepTheirMomentum) {
+  // Two bubbles released overlapping, side by side at the same height and velocity: the
+  // collision pushes them apart along the line of centres, volume-weighted, so their
+  // volume-weighted centre stays where it was (the forces on both are equal and vertical).
+  DbmOptions o = Column(6);
+  o.bubble_diameter_m = 0.04;
+  DbmSimulation dbm(o);
+  dbm.AddBubble({0.29, 0.3, 0.5}, {0.0, 0.0, 0.3}, 0.04);
+  dbm.AddBubble({0.31, 0.3, 0.5}, {0.0, 0.0, 0.3}, 0.03);
+  const double va = M_PI / 6 * std::pow(0.04, 3), vb = M_PI / 6 * std::pow(0.03, 3);
+  const double centre_x = (va * 0.29 + vb * 0.31) / (va + vb);
+  dbm.Step();
+  const DbmBubble& a = dbm.bubbles().at(0);
+  const DbmBubble& b = dbm.bubbles().at(1);
+  EXPECT_GE((a.x - b.x).norm(), 0.035 - 1e-12);
+  EXPECT_NEAR((va * a.x(0) + vb * b.x(0)) / (va + vb), centre_x, 1e-12);
+  EXPECT_EQ(dbm.diagnostics().collision_sweeps, 1);
 }
 
 class DbmSceneTest : public ::testing::Test {

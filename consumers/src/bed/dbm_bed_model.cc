@@ -69,6 +69,7 @@ DbmOptions SceneDbmOptions(const Scene& s, double umf_m_s, std::uint64_t seed) {
   o.seed = seed;
   o.coalescence = d.coalescence;
   o.film_drainage_s = d.film_drainage_s;
+  o.collisions = d.collisions;
   o.injection_ramp_s = d.injection_ramp_s;
   o.dt_s = d.dt_s;
   o.average_from_s = d.average_from_s;
@@ -405,6 +406,7 @@ class DbmBedModel : public BedModel {
         {"nozzles", o.nozzles.size()},
         {"coalescence", sd.coalescence},
         {"film_drainage_s", sd.film_drainage_s},
+        {"collisions", sd.collisions && !sd.coalescence},
         {"grid", {{"cells_x", o.nx}, {"cells_y", o.nz}, {"cells_z", o.ny}}},
         {"dt_s", o.dt_s},
         {"stable_dt_s", o.StableTimeStep()},

@@ -30,6 +30,8 @@ constexpr double kPi = 3.14159265358979323846;
 /// The emulsion fraction is kept above this where bubbles crowd (counted as clamps): the
 /// emulsion equations lose meaning as eps_e -> 0.
 constexpr double kMinEmulsionFraction = 0.4;
+/// Sweeps of the overlap resolution per step (each removes most of the remaining overlap).
+constexpr int kCollisionSweeps = 4;
 /// Size bins of the bubble-size histogram: 1 cm, up to 1 m (the last bin takes larger ones).
 constexpr int kSizeBins = 100;
 
@@ -56,6 +58,54 @@ BubbleForceOptions ForceOptions(const DbmOptions& o) {
   f.virtual_mass_coefficient = o.virtual_mass_coefficient;
   f.gravity = Vec(0.0, 0.0, -o.gravity_m_s2);
   return f;
+}
+
+/// Pairs (a < b) of touching bubbles, |x_a - x_b| < r_a + r_b, from cell lists of the largest
+/// diameter over the box [0, hi] (O(N)).
+std::vector<std::pair<int, int>> TouchingPairs(const std::vector<DbmBubble>& bubbles,
+                                               const std::array<double, 3>& hi) {
+  std::vector<std::pair<int, int>> pairs;
+  double d_max = 0.0;
+  for (const DbmBubble& b : bubbles) d_max = std::max(d_max, b.diameter_m);
+  if (bubbles.size() < 2 || d_max <= 0.0) return pairs;
+  const double L[3] = {hi[0], hi[1], hi[2] * 1.01};
+  int nb[3];
+  for (int c = 0; c < 3; ++c) nb[c] = std::max(1, std::min(512, static_cast<int>(L[c] / d_max)));
+  auto bin_of = [&](const Vec& x, int c) {
+    return std::clamp(static_cast<int>(x(c) / L[c] * nb[c]), 0, nb[c] - 1);
+  };
+  const int bins = nb[0] * nb[1] * nb[2];
+  std::vector<int> start(static_cast<std::size_t>(bins) + 1, 0), order(bubbles.size());
+  std::vector<int> bin(bubbles.size());
+  for (std::size_t b = 0; b < bubbles.size(); ++b) {
+    const Vec& x = bubbles[b].x;
+    bin[b] = bin_of(x, 0) + nb[0] * (bin_of(x, 1) + nb[1] * bin_of(x, 2));
+    ++start[static_cast<std::size_t>(bin[b]) + 1];
+  }
+  for (int q = 0; q < bins; ++q) start[q + 1] += start[q];
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (std::size_t b = 0; b < bubbles.size(); ++b) order[fill[bin[b]]++] = static_cast<int>(b);
+  }
+  for (std::size_t a = 0; a < bubbles.size(); ++a) {
+    const Vec& xa = bubbles[a].x;
+    const int b0 = bin_of(xa, 0), b1 = bin_of(xa, 1), b2 = bin_of(xa, 2);
+    for (int o2 = std::max(b2 - 1, 0); o2 <= std::min(b2 + 1, nb[2] - 1); ++o2) {
+      for (int o1 = std::max(b1 - 1, 0); o1 <= std::min(b1 + 1, nb[1] - 1); ++o1) {
+        for (int o0 = std::max(b0 - 1, 0); o0 <= std::min(b0 + 1, nb[0] - 1); ++o0) {
+          const int q = o0 + nb[0] * (o1 + nb[1] * o2);
+          for (int s = start[q]; s < start[q + 1]; ++s) {
+            const int b = order[s];
+            if (b <= static_cast<int>(a)) continue;
+            const double reach = 0.5 * (bubbles[a].diameter_m + bubbles[b].diameter_m);
+            if ((bubbles[b].x - xa).squaredNorm() < reach * reach)
+              pairs.emplace_back(static_cast<int>(a), b);
+          }
+        }
+      }
+    }
+  }
+  return pairs;
 }
 
 }  // namespace
@@ -425,7 +475,21 @@ void DbmSimulation::Step() {
     }
   }
 
-  // 3. Bubble motion (drag implicit) and the force each exerts on the emulsion.
+  // Walls: a bubble's centre stays a radius away; its velocity into a wall is dropped.
+  auto KeepInside = [&](DbmBubble& bub) {
+    const double r = 0.5 * bub.diameter_m;
+    const double lo[3] = {r, r, r};
+    const double hi[3] = {opt_.width_m - r, opt_.depth_m - r, 1e300};
+    for (int c = 0; c < 3; ++c) {
+      if (bub.x(c) < lo[c]) {
+        bub.x(c) = lo[c];
+        bub.v(c) = std::max(bub.v(c), 0.0);
+      } else if (bub.x(c) > hi[c]) {
+        bub.x(c) = hi[c];
+        bub.v(c) = std::min(bub.v(c), 0.0);
+      }
+    }
+  };  // 3. Bubble motion (drag implicit) and the force each exerts on the emulsion.
   const long nb = static_cast<long>(bubbles_.size());
   std::vector<Vec> reaction(static_cast<std::size_t>(nb));
   const Vec gravity(0.0, 0.0, -g);
@@ -464,19 +528,7 @@ void DbmSimulation::Step() {
         bub.volume_m3 * (rho_b * (v_new - bub.v) / dt - rho_b * gravity + gp - c_vm * rho_e * acc);
     bub.v = v_new;
     bub.x += dt * v_new;
-    // Walls: the centre stays a radius away; the normal velocity into a wall is dropped.
-    const double r = 0.5 * bub.diameter_m;
-    const double lo[3] = {r, r, r};
-    const double hi[3] = {opt_.width_m - r, opt_.depth_m - r, 1e300};
-    for (int c = 0; c < 3; ++c) {
-      if (bub.x(c) < lo[c]) {
-        bub.x(c) = lo[c];
-        bub.v(c) = std::max(bub.v(c), 0.0);
-      } else if (bub.x(c) > hi[c]) {
-        bub.x(c) = hi[c];
-        bub.v(c) = std::min(bub.v(c), 0.0);
-      }
-    }
+    KeepInside(bub);
   }
   diag_.bubble_steps += nb;
   for (auto& f : m.reaction) f.setZero();
@@ -507,53 +559,45 @@ void DbmSimulation::Step() {
     bubbles_.resize(kept);
   }
 
-  // 5. Coalescence: touching pairs from cell lists, merged after the film-drainage time.
+  // 5. Bubble-bubble contacts: without coalescence, overlapping bubbles are pushed apart and
+  // their approach along the line of centres is removed (a perfectly inelastic hard-sphere
+  // collision, volume-weighted, so momentum is kept); with coalescence, touching bubbles merge
+  // after the film-drainage time.
+  if (opt_.collisions && !opt_.coalescence && bubbles_.size() > 1) {
+    for (int sweep = 0; sweep < kCollisionSweeps; ++sweep) {
+      bool any = false;
+      for (const auto& [a, b] : TouchingPairs(bubbles_, domain_hi)) {
+        DbmBubble& A = bubbles_[static_cast<std::size_t>(a)];
+        DbmBubble& B = bubbles_[static_cast<std::size_t>(b)];
+        Vec n = B.x - A.x;
+        const double dist = n.norm();
+        const double overlap = 0.5 * (A.diameter_m + B.diameter_m) - dist;
+        if (overlap <= 0.0) continue;
+        n = dist > 1e-12 ? Vec(n / dist) : Vec(0.0, 0.0, 1.0);  // coincident: stack them
+        const double wa = B.volume_m3 / (A.volume_m3 + B.volume_m3), wb = 1.0 - wa;
+        A.x -= wa * overlap * n;
+        B.x += wb * overlap * n;
+        const double approach = (B.v - A.v).dot(n);
+        if (approach < 0.0) {
+          A.v += wa * approach * n;
+          B.v -= wb * approach * n;
+        }
+        any = true;
+      }
+      for (DbmBubble& b : bubbles_) KeepInside(b);
+      if (!any) break;
+      diag_.collision_sweeps += 1;
+    }
+  }
   if (opt_.coalescence && bubbles_.size() > 1) {
-    double d_max = 0.0;
-    for (const DbmBubble& b : bubbles_) d_max = std::max(d_max, b.diameter_m);
-    const double L[3] = {opt_.width_m, opt_.depth_m, opt_.height_m * 1.01};
-    int nb3[3];
-    for (int c = 0; c < 3; ++c) nb3[c] = std::max(1, std::min(512, static_cast<int>(L[c] / d_max)));
-    auto bin_of = [&](const Vec& x, int c) {
-      return std::clamp(static_cast<int>(x(c) / L[c] * nb3[c]), 0, nb3[c] - 1);
-    };
-    const int bins = nb3[0] * nb3[1] * nb3[2];
-    std::vector<int> start(static_cast<std::size_t>(bins) + 1, 0), order(bubbles_.size());
-    std::vector<int> bin(bubbles_.size());
-    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
-      const Vec& x = bubbles_[b].x;
-      bin[b] = bin_of(x, 0) + nb3[0] * (bin_of(x, 1) + nb3[1] * bin_of(x, 2));
-      ++start[static_cast<std::size_t>(bin[b]) + 1];
-    }
-    for (int q = 0; q < bins; ++q) start[q + 1] += start[q];
-    {
-      std::vector<int> fill(start.begin(), start.end() - 1);
-      for (std::size_t b = 0; b < bubbles_.size(); ++b) order[fill[bin[b]]++] = static_cast<int>(b);
-    }
     std::map<std::pair<std::uint64_t, std::uint64_t>, double> touching;
     std::vector<std::pair<int, int>> ready;
-    for (std::size_t a = 0; a < bubbles_.size(); ++a) {
-      const Vec& xa = bubbles_[a].x;
-      const int b0 = bin_of(xa, 0), b1 = bin_of(xa, 1), b2 = bin_of(xa, 2);
-      for (int o2 = std::max(b2 - 1, 0); o2 <= std::min(b2 + 1, nb3[2] - 1); ++o2) {
-        for (int o1 = std::max(b1 - 1, 0); o1 <= std::min(b1 + 1, nb3[1] - 1); ++o1) {
-          for (int o0 = std::max(b0 - 1, 0); o0 <= std::min(b0 + 1, nb3[0] - 1); ++o0) {
-            const int q = o0 + nb3[0] * (o1 + nb3[1] * o2);
-            for (int s = start[q]; s < start[q + 1]; ++s) {
-              const int b = order[s];
-              if (b <= static_cast<int>(a)) continue;
-              const double reach = 0.5 * (bubbles_[a].diameter_m + bubbles_[b].diameter_m);
-              if ((bubbles_[b].x - xa).squaredNorm() >= reach * reach) continue;
-              const auto key = std::minmax(bubbles_[a].id, bubbles_[b].id);
-              const auto found = m.contact_since.find(key);
-              const double since = found == m.contact_since.end() ? t1 : found->second;
-              touching[key] = since;
-              if (t1 - since >= opt_.film_drainage_s - 1e-12)
-                ready.emplace_back(static_cast<int>(a), b);
-            }
-          }
-        }
-      }
+    for (const auto& [a, b] : TouchingPairs(bubbles_, domain_hi)) {
+      const auto key = std::minmax(bubbles_[a].id, bubbles_[b].id);
+      const auto found = m.contact_since.find(key);
+      const double since = found == m.contact_since.end() ? t1 : found->second;
+      touching[key] = since;
+      if (t1 - since >= opt_.film_drainage_s - 1e-12) ready.emplace_back(a, b);
     }
     m.contact_since = std::move(touching);
     std::vector<char> gone(bubbles_.size(), 0), merged(bubbles_.size(), 0);

@@ -294,6 +294,10 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                    s.dbm.coalescence = as_bool(n, f, at);
                  }},
                 num("film_drainage_s", [](S& s) -> double& { return s.dbm.film_drainage_s; }),
+                {"collisions",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.dbm.collisions = as_bool(n, f, at);
+                 }},
                 num("dt_s", [](S& s) -> double& { return s.dbm.dt_s; }),
                 num("injection_ramp_s", [](S& s) -> double& { return s.dbm.injection_ramp_s; }),
                 {"walls", [](S& s, const toml::node& n, const std::string& f,

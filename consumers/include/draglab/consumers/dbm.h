@@ -20,8 +20,9 @@
 // as it grows) and releases it at d_b, from a seeded random start per nozzle; bubbles leave when
 // their centre reaches the bed surface (displacing less emulsion as they break through).
 // Coalescence (optional): bubbles that touch (|x1 - x2| < r1 + r2) for at least the film-drainage
-// time merge, conserving volume and momentum, at the volume-weighted centre. Pair search with
-// cell lists, O(N).
+// time merge, conserving volume and momentum, at the volume-weighted centre. Without it, bubbles
+// collide (overlaps pushed apart, the approach velocity removed, volume-weighted) unless
+// collisions are switched off. Pair search with cell lists, O(N).
 //
 // Time step: fixed; the bubble step is implicit in the drag, the emulsion explicit in advection
 // and viscosity, so dt is bounded by the emulsion's viscous and convective limits and, for the
@@ -29,8 +30,8 @@
 // and CheckTimeStep). A run whose emulsion velocity exceeds the convective limit stops with a
 // diagnosis (std::runtime_error).
 //
-// Units SI. Limits: spherical bubbles of one diameter each; no bubble-bubble collisions without
-// coalescence (bubbles may overlap, as in the seed's runs); no wake, cloud or wall effect on the
+// Units SI. Limits: spherical bubbles of one diameter each; collisions resolved by position
+// (a few sweeps per step), not by impulse timing; no wake, cloud or wall effect on the
 // rise velocity; bubbles larger than the column (slugs) stop the run.
 #pragma once
 
@@ -86,6 +87,9 @@ struct DbmOptions {
 
   bool coalescence = false;
   double film_drainage_s = 0.0;  ///< Contact time before two touching bubbles merge, >= 0.
+  /// Without coalescence: bubbles that overlap are pushed apart (perfectly inelastic hard-sphere
+  /// collisions, as the seed's DBM); false: they may overlap.
+  bool collisions = true;
 
   double dt_s = 2e-3;  ///< Fixed step, > 0, at most StableTimeStep().
   PoissonSolver solver = PoissonSolver::kConjugateGradient;
@@ -123,6 +127,7 @@ struct DbmDiagnostics {
   std::int64_t bubbles_injected = 0;
   std::int64_t bubbles_left = 0;  ///< At the bed surface.
   std::int64_t coalescences = 0;
+  std::int64_t collision_sweeps = 0;     ///< Overlap-resolution sweeps that moved bubbles.
   double gas_injected_m3 = 0.0;          ///< Bubble volume injected.
   double gas_left_m3 = 0.0;              ///< Bubble volume that left at the surface.
   double max_cfl = 0.0;                  ///< max |u| dt / h of the emulsion over steps.

@@ -162,6 +162,7 @@ struct SceneDbm {
   double lift_coefficient = 0.5;  ///< [-1, 1], with lift = true.
   bool coalescence = false;
   double film_drainage_s = 0.0;    ///< [0, 10].
+  bool collisions = true;          ///< Without coalescence: overlapping bubbles pushed apart.
   double dt_s = 2e-3;              ///< Fixed step, (0, the stability limit].
   double injection_ramp_s = 0.0;   ///< Start-up ramp of the bubble flow, [0, duration_s).
   std::string walls = "no_slip";   ///< Or "free_slip": the emulsion at the side walls.
