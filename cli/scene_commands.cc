@@ -155,10 +155,13 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
       format_number(first.bed_height_mf_m, 4), scene.eps_mf, format_number(first.archimedes, 4),
       format_number(first.particle_response_s, 3));
   std::cout << "  " << model_settings.line << "\n";
-  std::cout << fmt::format(
-      "  jet q = {} m^2/s through {} m at {} m/s; background: {}\n",
-      format_number(first.jet_area_rate_m2_s, 3), format_number(scene.jet.slot_width_m),
-      format_number(scene.jet.velocity_m_s), consumers::to_string(scene.distributor.mode));
+  // Scenes without a jet (the DBM's nozzles are in its settings line) have no jet line.
+  if (scene.jet.slot_width_m > 0.0) {
+    std::cout << fmt::format(
+        "  jet q = {} m^2/s through {} m at {} m/s; background: {}\n",
+        format_number(first.jet_area_rate_m2_s, 3), format_number(scene.jet.slot_width_m),
+        format_number(scene.jet.velocity_m_s), consumers::to_string(scene.distributor.mode));
+  }
   std::cout << fmt::format("{:<20} {:>8} {:>7} {:>10} {:>6} {:>10} {:>10} {:>10} {:>8}\n", "law",
                            "U_mf m/s", "Re_mf", "backgr m/s", "St", "tau_gas s", "tau_sol s",
                            "gas dt s", "D* m");

@@ -800,8 +800,7 @@ double Scene::particle_mass_kg() const { return particles.density_kg_m3 * partic
 
 std::int64_t Scene::particle_count() const {
   if (particles.count > 0) return particles.count;
-  const double solids =
-      (1.0 - eps_mf) * geometry.width_m * geometry.depth_m * particles.bed_height_mf_m;
+  const double solids = (1.0 - eps_mf) * geometry.width_m * geometry.depth_m * bed_height_mf_m();
   return static_cast<std::int64_t>(std::llround(solids / particle_volume_m3()));
 }
 
