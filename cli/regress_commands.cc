@@ -5,7 +5,9 @@
 //                   [--tol-diameter-abs M] [--tol-umf-rel X] [--replace]
 //   draglab regress list [--all]
 // Exit codes: 1 when a prediction moved beyond its baseline's tolerance, 0 otherwise (failed runs
-// are reported, with a warning, and not counted as moved), 2 on bad input.
+// are reported, with a warning, and not counted as moved), 2 on bad input. Every bed model's
+// scenes work alike; a model with headline numbers (the DBM) has them compared too.
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -164,15 +166,21 @@ nlohmann::json regress_json(const consumers::RegressSummary& summary) {
   for (const consumers::RegressEntry& e : summary.entries) {
     nlohmann::json comparisons = nlohmann::json::array();
     for (const consumers::MetricComparison& c : e.comparisons) {
+      const auto number = [](double x) {
+        return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+      };
       comparisons.push_back({{"metric", c.metric},
-                             {"baseline", c.baseline},
-                             {"new", c.value},
-                             {"delta", c.delta},
+                             {"baseline", number(c.baseline)},
+                             {"new", number(c.value)},
+                             {"delta", number(c.delta)},
                              {"tolerance", c.tolerance},
                              {"moved", c.moved}});
     }
     const bool failed =
         e.outcome == RegressOutcome::kFailed || e.outcome == RegressOutcome::kOutsideValidity;
+    nlohmann::json headline = nlohmann::json::object();
+    for (const auto& [name, value] : e.headline)
+      headline[name] = std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
     entries.push_back(
         {{"scene", e.scene_name},
          {"scene_hash", e.scene_hash},
@@ -186,6 +194,7 @@ nlohmann::json regress_json(const consumers::RegressSummary& summary) {
                                                          : nlohmann::json(nullptr)},
          {"tolerances", tolerances_json(e.tolerances)},
          {"metrics", failed ? nlohmann::json(nullptr) : metrics_json(e.metrics)},
+         {"headline", headline},
          {"comparisons", comparisons},
          {"error", failed ? nlohmann::json(e.error) : nlohmann::json(nullptr)},
          {"warnings", e.warnings},
@@ -244,8 +253,8 @@ void add_regress_commands(CLI::App& app, CliContext& ctx) {
   auto* regress = app.add_subcommand(
       "regress",
       "Re-run the registered scenes for every law version newer than its baseline and report "
-      "the predictions (U_mf, bubble at t_ref) that moved beyond the baseline's tolerance "
-      "(exit 1 when one did)");
+      "the predictions (U_mf, bubble at t_ref; DBM scenes: also hold-up, bubble sizes, "
+      "circulation) that moved beyond the baseline's tolerance (exit 1 when one did)");
   regress->require_subcommand(0, 1);
   regress->add_option("--law", args->law,
                       "Check this version only (NAME@V) on every registered scene; where its "
@@ -274,7 +283,7 @@ void add_regress_commands(CLI::App& app, CliContext& ctx) {
       ->check(CLI::Range(0.0, 10.0));
   reg->add_option("--tol-diameter-abs", args->tol_diameter_abs_m,
                   "Bubble diameter tolerance added to the relative one [m], [0, 10] (default: 2 "
-                  "gas cells)")
+                  "gas cells; DBM scenes: 0)")
       ->check(CLI::Range(0.0, 10.0));
   reg->add_option("--tol-umf-rel", args->tol_umf_rel,
                   "U_mf tolerance, fraction of the baseline U_mf, [0, 10] (default 0.01)")

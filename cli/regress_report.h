@@ -14,8 +14,9 @@ namespace cli {
 
 /// {"moved", "ok", "failed", "baselines_registered", "no_baseline", "runs", "wall_s",
 ///  "entries": [{scene, scene_hash, law, baseline, outcome, ran, result_id, baseline_result_id,
-///  tolerances, metrics, comparisons: [{metric, baseline, new, delta, tolerance, moved}], error,
-///  warnings}]}.
+///  tolerances, metrics, headline: {name: value} (DBM; {} otherwise), comparisons: [{metric,
+///  baseline, new, delta, tolerance, moved}] (a headline number's metric is its name; a value
+///  that is not finite is null), error, warnings}]}.
 nlohmann::json regress_json(const consumers::RegressSummary& summary);
 
 /// Progress of a check on a ProgressLine: "run k/n scene law: stage" and the fraction of the run.

@@ -1,9 +1,16 @@
 // `draglab sensitivity`: a bed scene (any model) per drag law, the bubble diameter at t_ref with
 // its numerical uncertainty, the seed's Fig. 4 (and with --beside Fig. 5) as a PNG; and
 // --work-precision (bubble diameter against grid size and the model's time step, with run
-// times). docs/scenes.md, "Sensitivity and work-precision".
+// times). A model with headline numbers (the DBM: hold-up, bubble sizes at the report heights,
+// circulation) reports those instead of the bubble at t_ref, and draws no figure (its own figure
+// comes from `scene run` with [outputs] fields = true). docs/scenes.md, "Sensitivity and
+// work-precision".
 //   draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1
 //   draglab sensitivity SCENE --uncertainty grids --out out/quick --json
+//   draglab sensitivity data/scenes/dbm_reactor.toml --laws gidaspow@1,bvk2007@1 --uncertainty
+//   both
+//   draglab sensitivity data/scenes/dbm_tiny.toml --work-precision --law gidaspow@1 --grids
+//   4x10x4,6x15x6 --dt 5e-3,2.5e-3
 //   draglab sensitivity SCENE --work-precision --law ergun@1 --grids 8x24,12x36 --contact-steps
 //   20,40
 //   draglab sensitivity data/scenes/tfm_bubble.toml --work-precision --law gidaspow@1 --cfl
@@ -25,6 +32,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/core.h>
@@ -63,7 +71,18 @@ struct SensitivityArgs {
   std::string grids;          // --grids 8x24,12x36
   std::string contact_steps;  // --contact-steps 20,40 (DPM)
   std::string cfl;            // --cfl 0.3,0.15 (TFM)
+  std::string dt;             // --dt 5e-3,2.5e-3 (DBM)
 };
+
+/// The command-line flag of each model's time resolution (BedModel::time_resolution().name).
+const std::vector<std::pair<std::string, std::string>> kTimeResolutionFlags = {
+    {"contact_steps", "--contact-steps"}, {"cfl", "--cfl"}, {"dt_s", "--dt"}};
+
+std::string time_resolution_flag(const std::string& name) {
+  for (const auto& [key, flag] : kTimeResolutionFlags)
+    if (key == name) return flag;
+  return "--" + name;
+}
 
 std::vector<std::string> split_list(const std::string& text, const std::string& field) {
   std::vector<std::string> out;
@@ -152,10 +171,25 @@ nlohmann::json snapshot_json(const consumers::BedSnapshot& s) {
           {"bubble", bubble_json(s.bubble)}};
 }
 
+/// Headline numbers as an object by name (their order: "headline_names" beside it).
+nlohmann::json headline_object(const consumers::HeadlineNumbers& numbers) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [name, value] : numbers) j[name] = number_or_null(value);
+  return j;
+}
+
+/// [cells_x, cells_y], or [cells_x, cells_y, cells_z] on a 3-D grid (as the grid text).
+nlohmann::json grid_json(int cells_x, int cells_y, int cells_z) {
+  return cells_z > 1 ? nlohmann::json{cells_x, cells_y, cells_z} : nlohmann::json{cells_x, cells_y};
+}
+
 nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySummary& s,
                             bool with_snapshots) {
   nlohmann::json grids = nlohmann::json::array();
-  for (const auto& g : s.grids) grids.push_back({g.cells_x, g.cells_y});
+  for (const auto& g : s.grids) grids.push_back(grid_json(g.cells_x, g.cells_y, g.cells_z));
+  nlohmann::json headline_names = nlohmann::json::array();
+  if (s.has_headline())
+    for (const auto& h : s.laws.front().headline) headline_names.push_back(h.name);
   nlohmann::json packings = nlohmann::json::array();
   for (const auto& p : s.packings) {
     packings.push_back({{"seed", p.seed},
@@ -179,6 +213,7 @@ nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySumm
       runs.push_back({{"seed", r.seed},
                       {"cells_x", r.cells_x},
                       {"cells_y", r.cells_y},
+                      {"cells_z", r.cells_z},
                       {"cell_size_m", r.cell_size_m},
                       {"bubble_diameter_m", r.bubble_diameter_m},
                       {"bubble_found", r.bubble_found},
@@ -193,6 +228,7 @@ nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySumm
                       {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
                       {"void_fraction_clamps", r.void_fraction_clamps},
                       {"drag_out_of_range", r.drag_out_of_range},
+                      {"headline", headline_object(r.headline)},
                       {"series",
                        {{"t_s", t},
                         {"bubble_diameter_m", d},
@@ -207,12 +243,28 @@ nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySumm
                           {"d_estimate_m", lr.diameter.estimate_m},
                           {"uncertainty_m", lr.diameter.total_m},
                           {"spread_m", lr.diameter.spread_m},
+                          {"grid_m", lr.diameter.grid_m},
                           {"boundary_m", lr.diameter.boundary_m},
                           {"bubbles_found", lr.bubbles_found},
                           {"bubble_found", lr.bubbles_found == static_cast<int>(lr.runs.size())},
                           {"runs", runs},
                           {"wall_s", lr.wall_s},
                           {"has_snapshot", lr.has_snapshot}};
+    // Each headline number: the value, its total uncertainty and the parts, per-run values.
+    nlohmann::json headline = nlohmann::json::array();
+    for (std::size_t n = 0; n < lr.headline.size(); ++n) {
+      const auto& h = lr.headline[n];
+      nlohmann::json per_run = nlohmann::json::array();
+      for (const auto& r : lr.runs)
+        per_run.push_back(n < r.headline.size() ? number_or_null(r.headline[n].second) : nullptr);
+      headline.push_back({{"name", h.name},
+                          {"estimate", h.estimate},
+                          {"uncertainty", h.total},
+                          {"spread", h.spread},
+                          {"grid", h.grid},
+                          {"per_run", per_run}});
+    }
+    law["headline"] = headline;
     if (with_snapshots) {
       law["snapshot"] = lr.has_snapshot ? snapshot_json(lr.snapshot) : nlohmann::json(nullptr);
     }
@@ -232,6 +284,8 @@ nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySumm
            {{"method", consumers::to_string(s.method)},
             {"description", s.method_description},
             {"grids", grids}}},
+          {"realization_kind", s.realization_kind},
+          {"headline_names", headline_names},
           {"packings", packings},
           {"laws", laws},
           {"wall_s", s.wall_s}};
@@ -240,8 +294,12 @@ nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySumm
 nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& r : w.rows) {
+    nlohmann::json difference = nlohmann::json::object();
+    for (std::size_t n = 0; n < r.headline.size() && n < r.headline_difference.size(); ++n)
+      difference[r.headline[n].first] = number_or_null(r.headline_difference[n]);
     rows.push_back({{"cells_x", r.cells_x},
                     {"cells_y", r.cells_y},
+                    {"cells_z", r.cells_z},
                     {"time_resolution", r.time_resolution},
                     {w.time_resolution_name, r.time_resolution},
                     {"cell_size_m", r.cell_size_m},
@@ -254,8 +312,12 @@ nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
                     {"gas_steps", r.gas_steps},
                     {"dem_steps", r.dem_steps},
                     {"gas_dt_s", r.gas_dt_s},
-                    {"dem_dt_s", r.dem_dt_s}});
+                    {"dem_dt_s", r.dem_dt_s},
+                    {"headline", headline_object(r.headline)},
+                    {"headline_difference", difference}});
   }
+  nlohmann::json headline_names = nlohmann::json::array();
+  for (const auto& [name, value] : w.reference_headline) headline_names.push_back(name);
   return {{"format", kWorkPrecisionFormat},
           {"version", 1},
           {"scene", w.scene},
@@ -271,6 +333,8 @@ nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
           {"observed_order", w.reference_method == "richardson" ? nlohmann::json(w.observed_order)
                                                                 : nlohmann::json(nullptr)},
           {"reference_note", w.reference_note},
+          {"headline_names", headline_names},
+          {"reference_headline", headline_object(w.reference_headline)},
           {"settle_wall_s", w.settle_wall_s},
           {"rows", rows},
           {"wall_s", w.wall_s}};
@@ -278,7 +342,53 @@ nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
 
 std::string cm(double metres) { return fmt::format("{:.2f}", 100.0 * metres); }
 
+/// The law table of a model with headline numbers: per law, one line per number with its value
+/// +- total uncertainty and the runs' values.
+void print_headline_table(const consumers::SensitivitySummary& s) {
+  std::size_t name_width = 6, per_run_width = 12;
+  std::vector<std::vector<std::string>> per_run(s.laws.size());
+  for (std::size_t i = 0; i < s.laws.size(); ++i) {
+    const auto& lr = s.laws[i];
+    for (std::size_t n = 0; n < lr.headline.size(); ++n) {
+      name_width = std::max(name_width, lr.headline[n].name.size());
+      std::string runs;
+      for (const auto& r : lr.runs)
+        runs += (runs.empty() ? "" : " ") +
+                (n < r.headline.size() ? format_number(r.headline[n].second, 4) : "-");
+      per_run_width = std::max(per_run_width, runs.size());
+      per_run[i].push_back(runs);
+    }
+  }
+  std::cout << fmt::format("Headline numbers per law, scene {} ({} uncertainty)\n", s.scene,
+                           consumers::to_string(s.method));
+  std::cout << fmt::format("{:<22} {:>8} {:<{}} {:>22}  {:<{}} {:>8}\n", "law", "U_mf m/s",
+                           "number", name_width, "value +- u", "per run", per_run_width, "wall s");
+  for (std::size_t i = 0; i < s.laws.size(); ++i) {
+    const auto& lr = s.laws[i];
+    for (std::size_t n = 0; n < lr.headline.size(); ++n) {
+      const auto& h = lr.headline[n];
+      const bool first = n == 0;
+      std::cout << fmt::format(
+          "{:<22} {:>8} {:<{}} {:>22}  {:<{}} {:>8}\n", first ? lr.law : std::string(),
+          first ? fmt::format("{:.4f}", lr.umf_m_s) : std::string(), h.name, name_width,
+          format_number(h.estimate, 4) + " +- " + format_number(h.total, 2), per_run[i][n],
+          per_run_width, first ? fmt::format("{:.1f}", lr.wall_s) : std::string());
+    }
+  }
+  std::cout << "  value +- u: " << s.method_description << "\n";
+  std::string runs;
+  for (const auto& r : s.laws.front().runs)
+    runs += fmt::format("{}{} {}", runs.empty() ? "" : ", ",
+                        s.realization_kind.empty() ? "run" : "seed " + std::to_string(r.seed),
+                        consumers::to_string(consumers::GridSize{r.cells_x, r.cells_y, r.cells_z}));
+  std::cout << "  per run: " << runs << "\n";
+}
+
 void print_sensitivity_table(const consumers::SensitivitySummary& s) {
+  if (s.has_headline()) {
+    print_headline_table(s);
+    return;
+  }
   std::vector<std::string> per_run;
   std::size_t per_run_width = 12;
   for (const auto& lr : s.laws) {
@@ -301,13 +411,42 @@ void print_sensitivity_table(const consumers::SensitivitySummary& s) {
   }
   std::cout << "  D +- u: " << s.method_description << "; '-': no bubble at t_ref (D = 0)\n";
   for (const auto& p : s.packings) {
+    if (p.particles == 0) continue;
     std::cout << fmt::format(
         "  packing seed {}: {} particles, settled bed {} cm, settling {:.1f} s\n", p.seed,
         p.particles, cm(p.settled_bed_height_m), p.settle_wall_s);
   }
 }
 
+/// Work-precision of a model with headline numbers: each number and its difference to the
+/// reference (the finest configuration) against the wall time.
+void print_headline_work_precision_table(const consumers::WorkPrecisionResult& w) {
+  std::cout << w.BriefReport();
+  std::string head = fmt::format("{:>10} {:>13}", "grid", w.time_resolution_name);
+  for (const auto& [name, value] : w.reference_headline)
+    head += fmt::format(" {:>24}", name + " (diff)");
+  std::cout << head << fmt::format(" {:>9} {:>8}\n", "steps", "wall s");
+  for (const auto& r : w.rows) {
+    std::string line = fmt::format(
+        "{:>10} {:>13}", consumers::to_string(consumers::GridSize{r.cells_x, r.cells_y, r.cells_z}),
+        format_number(r.time_resolution, 4));
+    for (std::size_t n = 0; n < r.headline.size(); ++n) {
+      const double diff = n < r.headline_difference.size() ? r.headline_difference[n] : 0.0;
+      line += fmt::format(
+          " {:>24}", format_number(r.headline[n].second, 4) + " (" +
+                         (std::isfinite(diff) ? format_number(diff, 2) : std::string("ref")) + ")");
+    }
+    std::cout << line << fmt::format(" {:>9} {:>8.2f}\n", r.gas_steps, r.wall_s);
+  }
+  std::cout << "  diff: value - the reference's (the finest configuration: most cells, then the "
+               "finest step)\n";
+}
+
 void print_work_precision_table(const consumers::WorkPrecisionResult& w) {
+  if (w.has_headline()) {
+    print_headline_work_precision_table(w);
+    return;
+  }
   std::cout << w.BriefReport();
   std::cout << fmt::format("{:>9} {:>13} {:>7} {:>7} {:>11} {:>9} {:>10} {:>8}\n", "grid",
                            w.time_resolution_name, "h cm", "D cm", "error cm", "steps", "DEM steps",
@@ -343,9 +482,9 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (args.law.find(',') != std::string::npos)
       throw UsageError("--law: --work-precision takes one NAME@V, got '" + args.law + "'");
   } else if (!args.law.empty() || !args.grids.empty() || !args.contact_steps.empty() ||
-             !args.cfl.empty()) {
+             !args.cfl.empty() || !args.dt.empty()) {
     throw UsageError(
-        "--law, --grids, --contact-steps and --cfl belong to --work-precision (the law "
+        "--law, --grids, --contact-steps, --cfl and --dt belong to --work-precision (the law "
         "table takes --laws a@1,b@1)");
   }
   if (args.duration_s < 0.0 || !std::isfinite(args.duration_s))
@@ -376,14 +515,14 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
         consumers::find_bed_model(scene.solver).time_resolution();
     for (const auto& [option, list] :
          {std::pair<std::string, std::string>{"contact_steps", args.contact_steps},
-          {"cfl", args.cfl}}) {
+          {"cfl", args.cfl},
+          {"dt_s", args.dt}}) {
       if (list.empty()) continue;
-      const std::string flag = option == "cfl" ? "--cfl" : "--contact-steps";
+      const std::string flag = time_resolution_flag(option);
       if (option != step.name)
-        throw UsageError(
-            fmt::format("{}: this scene's model ({}) sets its time step by {} ({}): use --{}", flag,
-                        scene.solver, step.name, step.description,
-                        step.name == "cfl" ? "cfl" : "contact-steps"));
+        throw UsageError(fmt::format(
+            "{}: this scene's model ({}) sets its time step by {} ({}): use {}", flag, scene.solver,
+            step.name, step.description, time_resolution_flag(step.name)));
       for (double v : parse_double_list(list, flag)) {
         if (step.whole_number && v != std::floor(v))
           throw UsageError(fmt::format("{}: {} is not a whole number ({}, {})", flag,
@@ -399,7 +538,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (args.realizations < 2 || args.realizations > 32)
       throw UsageError(fmt::format("--realizations must be in [2, 32], got {}", args.realizations));
     if (sens.uncertainty == consumers::UncertaintyMethod::kGrids && args.realizations != 2)
-      throw UsageError("--realizations applies to --uncertainty realizations only");
+      throw UsageError("--realizations applies to --uncertainty realizations or both only");
     if (args.realizations != 2 &&
         consumers::find_bed_model(scene.solver).realization_kind().empty())
       throw UsageError(fmt::format(
@@ -448,8 +587,11 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     const consumers::WorkPrecisionResult w =
         consumers::run_work_precision(scene, loader, wp, on_progress);
     progress.finish();
+    // A model with headline numbers has no bubble at t_ref and no figure of this study.
+    const bool headline = w.has_headline();
+    const bool no_figure = args.no_figure || headline;
     for (const auto& r : w.rows) {
-      if (!r.bubble_found)
+      if (!r.bubble_found && !headline)
         ctx.warn(fmt::format("grid {}x{}, {} {}: no bubble at t_ref (D = 0){}", r.cells_x,
                              r.cells_y, w.time_resolution_name, format_number(r.time_resolution, 4),
                              r.reached_t_ref ? ""
@@ -461,23 +603,33 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     const std::string figure = out_dir + "/work_precision.png";
     nlohmann::json j = work_precision_json(w);
     write_json_file(bundle, j);
-    if (!args.no_figure) render(ctx, bundle, out_dir, figure);
+    if (!no_figure) render(ctx, bundle, out_dir, figure);
     if (ctx.json) {
       j["out_dir"] = out_dir;
       j["data"] = bundle;
-      j["figure"] = args.no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
+      j["figure"] = no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
       ctx.print_json(j);
       return;
     }
     print_work_precision_table(w);
-    std::cout << "  data: " << bundle << (args.no_figure ? "" : "\n  figure: " + figure) << "\n";
+    std::cout << "  data: " << bundle << (no_figure ? "" : "\n  figure: " + figure) << "\n";
     return;
   }
 
   const consumers::SensitivitySummary s =
       consumers::run_sensitivity(scene, loader, sens, on_progress);
   progress.finish();
+  // A model with headline numbers has no bubble at t_ref (no snapshot, nothing for the figure
+  // script to draw): its numbers are the result.
+  const bool headline = s.has_headline();
+  if (headline && !args.beside.empty())
+    throw UsageError(fmt::format(
+        "--beside: the {} model reports headline numbers, not a bubble at t_ref, so there is no "
+        "Fig. 5 to draw; rerun without --beside",
+        scene.solver));
+  const bool no_figure = args.no_figure || headline;
   for (const auto& lr : s.laws) {
+    if (headline) break;
     int not_reached = 0;
     for (const auto& r : lr.runs) not_reached += r.reached_t_ref ? 0 : 1;
     if (not_reached > 0)
@@ -497,24 +649,24 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   const std::string figure = out_dir + "/fig4.png";
   write_json_file(bundle, summary_json(scene, s, /*with_snapshots=*/true));
   const std::string fig5 = out_dir + "/fig5.png";
-  if (!args.no_figure) {
+  if (!no_figure) {
     render(ctx, bundle, out_dir, figure, args.beside);
     if (!args.beside.empty() && !file_exists(fig5))
       throw std::runtime_error("the figure script wrote no " + fig5 + " (--beside " + args.beside +
                                ")");
   }
-  const bool with_fig5 = !args.no_figure && !args.beside.empty();
+  const bool with_fig5 = !no_figure && !args.beside.empty();
   if (ctx.json) {
     nlohmann::json j = summary_json(scene, s, /*with_snapshots=*/false);
     j["out_dir"] = out_dir;
     j["data"] = bundle;
-    j["figure"] = args.no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
+    j["figure"] = no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
     j["figure_beside"] = with_fig5 ? nlohmann::json(fig5) : nlohmann::json(nullptr);
     ctx.print_json(j);
     return;
   }
   print_sensitivity_table(s);
-  std::cout << "  data: " << bundle << (args.no_figure ? "" : "\n  figure: " + figure)
+  std::cout << "  data: " << bundle << (no_figure ? "" : "\n  figure: " + figure)
             << (with_fig5 ? "\n  figure: " + fig5 : "") << "\n";
 }
 
@@ -525,18 +677,23 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
   auto* cmd = app.add_subcommand(
       "sensitivity",
       "Run a scene per drag law with its bed model: bubble diameter at t_ref with its numerical "
-      "uncertainty (DPM: two packing realizations or two grids; TFM: two grids), the seed's "
-      "Fig. 4 (bubble snapshot per law: particles coloured by initial layer, or the TFM's solids "
-      "fraction in grey) as DIR/fig4.png, D(t) as DIR/bubble_series.png, with --beside the "
-      "seed's Fig. 5 (another study's panels above these) as DIR/fig5.png; or, with "
-      "--work-precision, the bubble diameter against grid size (and DEM step) with run times");
+      "uncertainty (DPM: two packing realizations, two grids or both; TFM: two grids), the "
+      "seed's Fig. 4 (bubble snapshot per law: particles coloured by initial layer, or the TFM's "
+      "solids fraction in grey) as DIR/fig4.png, D(t) as DIR/bubble_series.png, with --beside "
+      "the seed's Fig. 5 (another study's panels above these) as DIR/fig5.png; for the DBM its "
+      "headline numbers (hold-up, mean bubble diameter at the report heights, circulation) with "
+      "their uncertainty (injection seeds, grids or both), no figure; or, with --work-precision, "
+      "the bubble diameter (DBM: the headline numbers) against grid size and time step with run "
+      "times");
   cmd->add_option("SCENE", args->scene_path, "Scene file (TOML, docs/scenes.md)")->required();
   cmd->add_option("--laws", args->laws, "Laws NAME@V,... (default: the scene's [drag] laws)");
   cmd->add_option("--uncertainty", args->uncertainty,
-                  "realizations (default: seeds scene.seed and scene.seed+1, same grid) or grids "
-                  "(the scene's grid and a 1.5x finer one, same packing)");
+                  "realizations (default: seeds scene.seed and scene.seed+1, same grid), grids "
+                  "(the scene's grid and a 1.5x finer one, same realization) or both (every seed "
+                  "on both grids)");
   cmd->add_option("--realizations", args->realizations,
-                  "Packing realizations for --uncertainty realizations, [2, 32] (default 2)");
+                  "Realizations (packings, injection seeds) for --uncertainty realizations or "
+                  "both, [2, 32] (default 2)");
   cmd->add_option("--t-ref", args->t_ref_s,
                   "Snapshot time after the jet start [s] (default: the scene's [time] t_ref_s)");
   cmd->add_option("--duration", args->duration_s,
@@ -551,16 +708,20 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
                   "panels above this study's, per shared law");
   cmd->add_flag("--work-precision", args->work_precision,
                 "Work-precision study of one law (--law) over --grids x the model's time step "
-                "(--contact-steps for dpm scenes, --cfl for tfm scenes)");
+                "(--contact-steps for dpm scenes, --cfl for tfm scenes, --dt for dbm scenes)");
   cmd->add_option("--law", args->law, "--work-precision: the law NAME@V");
   cmd->add_option("--grids", args->grids,
-                  "--work-precision: grids CXxCY,... (default: the scene's), e.g. 8x24,12x36");
+                  "--work-precision: grids CXxCY or CXxCYxCZ (CZ: depth cells, 3-D scenes),... "
+                  "(default: the scene's), e.g. 8x24,12x36 or 4x10x4,6x15x6");
   cmd->add_option("--contact-steps", args->contact_steps,
                   "--work-precision, dpm scenes: DEM steps per contact time, [20, 1000], e.g. "
                   "20,40 (default: the scene's)");
   cmd->add_option("--cfl", args->cfl,
                   "--work-precision, tfm scenes: Courant numbers of the coupled step, (0, 0.5], "
                   "e.g. 0.3,0.15 (default: the scene's [tfm] cfl)");
+  cmd->add_option("--dt", args->dt,
+                  "--work-precision, dbm scenes: fixed time steps [s], (0, the stability limit], "
+                  "e.g. 5e-3,2.5e-3 (default: the scene's [dbm] dt_s)");
   cmd->footer(
       "Examples:\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1\n"
@@ -571,6 +732,10 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
       "--grids 8x24,12x36 --contact-steps 20,40\n"
       "  draglab sensitivity data/scenes/tfm_bubble.toml --work-precision --law gidaspow@1 "
       "--grids 12x40,18x60 --cfl 0.3,0.15\n"
+      "  draglab sensitivity data/scenes/dbm_reactor.toml --laws gidaspow@1,bvk2007@1 "
+      "--uncertainty both\n"
+      "  draglab sensitivity data/scenes/dbm_tiny.toml --work-precision --law gidaspow@1 "
+      "--grids 4x10x4,6x15x6 --dt 5e-3,2.5e-3 --duration 6\n"
       "Writes DIR/sensitivity.json + DIR/fig4.png, or DIR/work_precision.json + "
       "DIR/work_precision.png.");
   cmd->callback(

@@ -28,6 +28,12 @@
 #     |D - D_ref|; wall times and step counts are positive; the finer grid takes more gas steps.
 #  e. A run only reads the database (checksum unchanged); bad input exits 2 before any run and
 #     leaves no output folder behind.
+#  f. A model with headline numbers (data/scenes/dbm_tiny.toml, the DBM, 5 s runs of about a
+#     second): --uncertainty both on one law gives its four headline numbers, each the mean of the
+#     two seeds on the 6x15x6 grid with uncertainty sqrt(SE^2 + E^2) recomputed from the per-run
+#     values (1e-12 relative); no figure; the table shows the numbers; --beside and --cfl are
+#     refused (exit 2), the latter naming --dt; work-precision with --dt takes the finest
+#     configuration as the reference of the headline differences.
 set -u
 draglab="$1"
 work="$(mktemp -d)"
@@ -98,7 +104,7 @@ wp=("${sens[@]}" --work-precision --law gidaspow@1)
 check "unknown law" 2 "${sens[@]}" --laws gidaspow@1,nosuchlaw@1 --out "$work/bad1"
 ok "message names the law" grep -q "nosuchlaw" "$work/err"
 check "unknown uncertainty method" 2 "${sens[@]}" --uncertainty bootstrap --out "$work/bad2"
-ok "message names the choices" grep -q "realizations or grids" "$work/err"
+ok "message names the choices" grep -q "realizations, grids or both" "$work/err"
 check "one realization" 2 "${sens[@]}" --realizations 1 --out "$work/bad3"
 check "bad grid string" 2 "${wp[@]}" --grids 4by12 --out "$work/bad4"
 ok "message names --grids" grep -q -- "--grids" "$work/err"
@@ -264,4 +270,53 @@ assert rows[1]["gas_steps"] > rows[0]["gas_steps"], rows
 if [ "$have_matplotlib" -eq 1 ]; then
   ok "work_precision.png is a plausible PNG" "$py" -c "$png_check" "$work" wp/work_precision.png
 fi
+# A model with headline numbers: the DBM (reference f).
+src="$(cd "$(dirname "$0")/../.." && pwd)"
+dbm=("$draglab" -q --db "$db" sensitivity "$src/data/scenes/dbm_tiny.toml" --duration 5)
+check "dbm: --cfl on a dbm scene" 2 "${dbm[@]}" --work-precision --law gidaspow@1 --cfl 0.3 --out "$work/badd1"
+ok "the message points to --dt" grep -q -- "use --dt" "$work/err"
+check "dbm: a grid with no depth cells" 2 "${dbm[@]}" --work-precision --law gidaspow@1 --grids 4x10x0 --out "$work/badd2"
+ok "message names --grids" grep -q -- "--grids" "$work/err"
+check "dbm sensitivity both --json" 0 "${dbm[@]}" --laws gidaspow@1 --uncertainty both --out "$work/dbm" --json
+pycheck "dbm: headline numbers with their uncertainty, no figure" '
+import json, math, statistics, sys
+w = sys.argv[1]
+out = json.load(open(w + "/out"))
+s = json.load(open(w + "/dbm/sensitivity.json"))
+assert out["figure"] is None, out["figure"]
+assert s["uncertainty"]["method"] == "both" and s["uncertainty"]["grids"] == [[4, 10, 4], [6, 15, 6]], s["uncertainty"]
+names = ["holdup", "mean_diameter_at_0.3_m", "mean_diameter_at_0.7_m", "circulation_upflow_m_s"]
+assert s["headline_names"] == names, s["headline_names"]
+law = s["laws"][0]
+runs = law["runs"]
+assert [(r["seed"], r["cells_z"]) for r in runs] == [(1, 4), (1, 6), (2, 4), (2, 6)], runs
+r = runs[0]["cell_size_m"] / runs[1]["cell_size_m"]
+for h in law["headline"]:
+    fine = [x["headline"][h["name"]] for x in runs[1::2]]
+    coarse = [x["headline"][h["name"]] for x in runs[0::2]]
+    assert h["per_run"] == [x["headline"][h["name"]] for x in runs], h
+    se = statistics.stdev(fine) / math.sqrt(len(fine))
+    grid = abs(statistics.mean(fine) - statistics.mean(coarse)) / (r - 1)
+    for got, want in ((h["estimate"], statistics.mean(fine)), (h["spread"], se), (h["grid"], grid),
+                      (h["uncertainty"], math.hypot(se, grid))):
+        assert abs(got - want) <= 1e-12 * abs(h["estimate"]), (h["name"], got, want)
+    assert math.isfinite(h["uncertainty"])
+assert law["headline"][0]["uncertainty"] > 0, law["headline"][0]
+'
+check "dbm sensitivity table" 0 "${dbm[@]}" --laws gidaspow@1,bvk2007@1 --out "$work/dbm2"
+ok "the table shows the hold-up" grep -q "holdup .* +- " "$work/out"
+ok "and the circulation" grep -q "circulation_upflow_m_s" "$work/out"
+ok "no figure for a headline model" bash -c "! ls '$work'/dbm2/*.png 2>/dev/null"
+check "dbm: --beside refused" 2 "${dbm[@]}" --laws gidaspow@1 --out "$work/dbm3" --beside "$work/dbm/sensitivity.json"
+check "dbm work-precision" 0 "${dbm[@]}" --work-precision --law gidaspow@1 --grids 4x10 --dt 1e-2,5e-3 --out "$work/dbmwp" --json
+pycheck "dbm work-precision: the finest step is the reference" '
+import json, sys
+j = json.load(open(sys.argv[1] + "/out"))
+assert j["time_resolution_name"] == "dt_s" and j["reference_method"] == "finest as reference", j
+rows = j["rows"]
+assert [(r["cells_z"], r["dt_s"], r["is_reference"]) for r in rows] == [(4, 0.01, False), (4, 0.005, True)], rows
+for name, ref in j["reference_headline"].items():
+    assert rows[1]["headline_difference"][name] is None
+    assert abs(rows[0]["headline_difference"][name] - (rows[0]["headline"][name] - ref)) < 1e-15
+'
 finish "cli.sensitivity"

@@ -15,7 +15,16 @@
 //    refuses it before the DPM starts) is reported as failed, not moved, and stores nothing;
 //  - single-law mode: unknown law (kNotFound), a draft without include_drafts
 //    (kInvalidArgument), and a published version without a baseline whose stored result becomes
-//    the baseline.
+//    the baseline;
+//  - compare_headline against hand-computed limits: a bubble size by the diameter tolerances,
+//    the others 10 % of the baseline, inclusive; a number missing from the new result moved; no
+//    comparison when the baseline has no headline numbers (the dpm and tfm results);
+//  - a DBM scene end to end (data/scenes/dbm_tiny.toml, runs of 6 s, about a second each): the
+//    default tolerances (no cell part); registering a baseline stores the four headline numbers;
+//    a new version with the same content compares equal (the DBM run is deterministic: delta
+//    0 exactly); one with every coefficient scaled by 1.1 (the Ergun branch at eps_mf 0.45: 10 %
+//    more drag) moves U_mf (measured -7 %, 0.0369 to 0.0343 m/s) and with it the hold-up
+//    (+36 %: the bubble gas flow u0 - U_mf grows by half) and the circulation (+27 %).
 #include "draglab/consumers/regress.h"
 
 #include <gtest/gtest.h>
@@ -26,6 +35,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
@@ -308,6 +318,115 @@ TEST_F(RegressPlan, SingleLawModeRegistersMissingBaselinesAndRefusesBadReference
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kNotFound);
   }
+}
+
+TEST(RegressCompare, HeadlineNumbersUseTheDiameterOrTheHeadlineTolerance) {
+  RegressionTolerances tol;
+  tol.diameter_abs_m = 0.0;
+  tol.diameter_rel = 0.125;
+  tol.umf_rel = 0.01;
+  // Exactly representable: hold-up 0.5 (limit 0.05), size 0.25 (limit 0.03125), upflow 2.0.
+  const std::string base =
+      R"({"solver": "dbm", "headline": {"holdup": 0.5, "mean_diameter_at_0.3_m": 0.25, )"
+      R"("circulation_upflow_m_s": 2.0}})";
+  EXPECT_EQ(headline_of_result_json(base).size(), 3u);
+  EXPECT_NEAR(headline_tolerance("holdup", 0.5, tol), 0.05, 1e-15);
+  EXPECT_EQ(headline_tolerance("mean_diameter_at_0.3_m", 0.25, tol), 0.03125);
+  auto c = compare_headline(base,
+                            R"({"headline": {"holdup": 0.54, "mean_diameter_at_0.3_m": 0.28125, )"
+                            R"("circulation_upflow_m_s": 1.75}})",
+                            tol);
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_FALSE(find(c, "holdup")->moved);                  // 0.04 < 0.05
+  EXPECT_FALSE(find(c, "mean_diameter_at_0.3_m")->moved);  // at the limit
+  EXPECT_TRUE(find(c, "circulation_upflow_m_s")->moved);   // 0.25 > 0.2
+  EXPECT_NEAR(find(c, "circulation_upflow_m_s")->delta, -0.25, 1e-15);
+  EXPECT_NEAR(find(c, "circulation_upflow_m_s")->tolerance, 0.2, 1e-15);
+  // A number the new result lacks (or holds as null) moved.
+  c = compare_headline(base, R"({"headline": {"holdup": null}})", tol);
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_TRUE(find(c, "holdup")->moved);
+  EXPECT_TRUE(std::isnan(find(c, "mean_diameter_at_0.3_m")->value));
+  EXPECT_TRUE(find(c, "mean_diameter_at_0.3_m")->moved);
+  // Nothing to compare without a baseline headline (dpm, tfm, or results stored before).
+  EXPECT_TRUE(compare_headline("{}", base, tol).empty());
+  EXPECT_TRUE(compare_headline("not json", base, tol).empty());
+  EXPECT_TRUE(headline_of_result_json(R"({"headline": 3})").empty());
+}
+
+class RegressDbm : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = ::testing::TempDir() + "/regress_dbm_test_" + std::to_string(::getpid()) + ".db";
+    std::remove(path_.c_str());
+    db_ = std::make_unique<Database>(path_);
+    scene_ = load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dbm_tiny.toml");
+    options_.run.duration_s = 6.0;  // the scene averages from 4 s
+  }
+  void TearDown() override {
+    db_.reset();
+    std::remove(path_.c_str());
+  }
+  // A new published version of gidaspow with every coefficient scaled.
+  LawRecord NewGidaspow(double scale) {
+    LawRecord r = db_->resolve("gidaspow@1");
+    for (LawParameter& p : r.parameters) p.value *= scale;
+    r.status = LawStatus::kDraft;
+    return db_->add_published(r);
+  }
+  std::string path_;
+  std::unique_ptr<Database> db_;
+  Scene scene_;
+  RegressOptions options_;
+};
+
+TEST_F(RegressDbm, RunsOnADbmSceneAndComparesItsHeadlineNumbers) {
+  const RegressionTolerances defaults = default_regression_tolerances(scene_);
+  EXPECT_EQ(defaults.diameter_abs_m, 0.0);  // Lagrangian bubbles: no cell part
+  EXPECT_EQ(defaults.diameter_rel, 0.1);
+  EXPECT_EQ(defaults.umf_rel, 0.01);
+
+  options_.law = "gidaspow@1";
+  const RegressSummary reg = register_regression_baseline(*db_, scene_, options_);
+  ASSERT_EQ(reg.entries.size(), 1u);
+  const RegressEntry& base = reg.entries[0];
+  EXPECT_EQ(base.outcome, RegressOutcome::kBaselineRegistered);
+  EXPECT_TRUE(base.ran);
+  EXPECT_GT(base.metrics.umf_m_s, 0.0);
+  EXPECT_TRUE(base.metrics.bubble_present);
+  ASSERT_EQ(base.headline.size(), 4u);  // alphabetical, as stored
+  for (const auto& [name, value] : base.headline) {
+    EXPECT_TRUE(std::isfinite(value) && value > 0.0) << name << " " << value;
+  }
+  EXPECT_NE(reg.FullReport().find("holdup"), std::string::npos) << reg.FullReport();
+
+  NewGidaspow(1.0);  // gidaspow@2: the same content
+  NewGidaspow(1.1);  // gidaspow@3: 10 % more drag
+  RegressOptions check;
+  check.run.duration_s = 6.0;
+  int planned = 0;
+  const RegressSummary s = run_regression(
+      *db_, check, [&](int, int runs, double, const std::string&) { planned = runs; });
+  EXPECT_EQ(planned, 2);
+  EXPECT_EQ(s.runs, 2);
+  ASSERT_EQ(s.entries.size(), 2u);
+  const RegressEntry& same = s.entries[0];
+  EXPECT_EQ(same.law, "gidaspow@2");
+  EXPECT_EQ(same.outcome, RegressOutcome::kOk) << s.FullReport();
+  ASSERT_EQ(same.comparisons.size(), 3u + 4u);  // U_mf, bubble present, D, 4 headline numbers
+  for (const MetricComparison& c : same.comparisons) EXPECT_EQ(c.delta, 0.0) << c.metric;
+  ASSERT_NE(find(same.comparisons, "holdup"), nullptr);
+  EXPECT_NEAR(find(same.comparisons, "holdup")->tolerance,
+              0.1 * find(same.comparisons, "holdup")->baseline, 1e-15);
+
+  const RegressEntry& more_drag = s.entries[1];
+  EXPECT_EQ(more_drag.law, "gidaspow@3");
+  EXPECT_EQ(more_drag.outcome, RegressOutcome::kMoved) << s.FullReport();
+  EXPECT_TRUE(find(more_drag.comparisons, "umf_m_s")->moved);
+  EXPECT_LT(find(more_drag.comparisons, "umf_m_s")->delta, 0.0);
+  EXPECT_TRUE(find(more_drag.comparisons, "holdup")->moved) << s.FullReport();
+  EXPECT_GT(find(more_drag.comparisons, "holdup")->delta, 0.0);
+  EXPECT_NE(s.FullReport().find("MOVED"), std::string::npos);
 }
 
 }  // namespace

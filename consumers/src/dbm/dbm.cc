@@ -28,14 +28,15 @@ using scene_util::fmt;
 using Vec = Eigen::Vector3d;
 constexpr double kPi = 3.14159265358979323846;
 /// The emulsion fraction the emulsion equations see is kept above this where bubbles crowd
-/// (counted as clamps). Why 0.7: the bubbles feel the pressure of the last step, and where they
-/// crowd, their response to it changes the bubble fraction, whose storage term sets the next
-/// pressure. The gain of that loop per step, ~ rho_e eps_b / ((rho_b + C_VM rho_e) eps_e^2),
-/// does not depend on dt and passes 1 near eps_b = 0.3 for the seed's densities (measured:
-/// the u0 = 0.3 m/s reactor diverges there, docs/dbm.md).
-constexpr double kMinEmulsionFraction = 0.7;
+/// (counted as clamps): 0.6 bubble fraction is about the random close packing of spheres, beyond
+/// which bubbles pushed together (collisions resolved by position) no longer displace more.
+constexpr double kMinEmulsionFraction = 0.4;
 /// Sweeps of the overlap resolution per step (each removes most of the remaining overlap).
 constexpr int kCollisionSweeps = 4;
+/// Loops run on several threads only above these sizes: a parallel region costs more than a
+/// small loop, and far more when another process holds a core (the threads wait on each other).
+constexpr int kParallelCells = 20000;
+constexpr long kParallelBubbles = 20000;
 /// Size bins of the bubble-size histogram: 1 cm, up to 1 m (the last bin takes larger ones).
 constexpr int kSizeBins = 100;
 
@@ -216,7 +217,7 @@ struct DbmSimulation::Impl {
   int cells = 0;
   double cell_volume = 0.0;
   std::array<Eigen::VectorXd, 3> vel, vel_star;  // face velocities normal to each axis
-  Eigen::VectorXd eps_e, eps_e_new, eps_b, pressure;
+  Eigen::VectorXd eps_e, eps_e_new, eps_b, pressure, mobility;
   // Cell-centred emulsion quantities the bubbles see, by physical component (x, y, z).
   std::array<Eigen::VectorXd, 3> uc, uc_prev, grad_p, accel, curl, reaction;
   bool have_prev = false;
@@ -288,6 +289,7 @@ DbmSimulation::DbmSimulation(const DbmOptions& options)
   }
   for (auto* field : {&m.eps_e, &m.eps_e_new}) *field = Eigen::VectorXd::Ones(m.cells);
   m.eps_b = Eigen::VectorXd::Zero(m.cells);
+  m.mobility = Eigen::VectorXd::Zero(m.cells);
   m.pressure = Eigen::VectorXd::Zero(m.cells);
   for (auto* group : {&m.uc, &m.uc_prev, &m.grad_p, &m.accel, &m.curl, &m.reaction}) {
     for (auto& field : *group) field = Eigen::VectorXd::Zero(m.cells);
@@ -406,7 +408,7 @@ void DbmSimulation::Step() {
   auto at = [&](const Eigen::VectorXd& f, int i, int j, int k) {
     return f(m.Cell(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1), std::clamp(k, 0, ny - 1)));
   };
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (m.cells >= kParallelCells)
   for (int k = 0; k < ny; ++k) {
     for (int j = 0; j < nz; ++j) {
       for (int i = 0; i < nx; ++i) {
@@ -501,7 +503,7 @@ void DbmSimulation::Step() {
   const double c_vm = opt_.virtual_mass_coefficient;
   const std::array<double, 3> domain_lo{0.0, 0.0, 0.0};
   const std::array<double, 3> domain_hi{opt_.width_m, opt_.depth_m, opt_.height_m};
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nb >= kParallelBubbles)
   for (long b = 0; b < nb; ++b) {
     DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
     const std::vector<Vec> points = m.Spread(bub.x, bub.diameter_m, domain_lo, domain_hi);
@@ -628,30 +630,54 @@ void DbmSimulation::Step() {
   }
   diag_.bubble_wall_s += Seconds(bubbles_start);
 
-  // 6. The new bubble and emulsion fractions.
+  // 6. The new bubble and emulsion fractions (again after the bubbles' pressure correction).
   const auto emulsion_start = std::chrono::steady_clock::now();
-  m.eps_b.setZero();
-  for (const DbmBubble& b : bubbles_) {
-    // A bubble breaking through the surface displaces less emulsion as it leaves.
-    const double r = 0.5 * b.diameter_m;
-    const double inside = std::clamp((opt_.height_m - b.x(2)) / r, 0.0, 1.0);
-    const std::vector<Vec> points = m.Spread(b.x, b.diameter_m, domain_lo, domain_hi);
-    const double share = inside / static_cast<double>(points.size());
-    for (const Vec& point : points)
-      internal::Deposit3(m.eps_b, m.TentOf(point), share * b.volume_m3 / m.cell_volume, nx, nz);
-  }
-  for (std::size_t k = 0; k < m.forming.size(); ++k) {
-    const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
-    internal::Deposit3(m.eps_b, m.TentOf(at), m.forming[k] / m.cell_volume, nx, nz);
-  }
-  for (int c = 0; c < m.cells; ++c) {
-    diag_.max_bubble_fraction = std::max(diag_.max_bubble_fraction, m.eps_b(c));
-    double e = 1.0 - m.eps_b(c);
-    if (e < kMinEmulsionFraction) {
-      e = kMinEmulsionFraction;
-      diag_.fraction_clamps += 1;
+  auto deposit_fractions = [&](bool count) {
+    m.eps_b.setZero();
+    for (const DbmBubble& b : bubbles_) {
+      // A bubble breaking through the surface displaces less emulsion as it leaves.
+      const double r = 0.5 * b.diameter_m;
+      const double inside = std::clamp((opt_.height_m - b.x(2)) / r, 0.0, 1.0);
+      const std::vector<Vec> points = m.Spread(b.x, b.diameter_m, domain_lo, domain_hi);
+      const double share = inside / static_cast<double>(points.size());
+      for (const Vec& point : points)
+        internal::Deposit3(m.eps_b, m.TentOf(point), share * b.volume_m3 / m.cell_volume, nx, nz);
     }
-    m.eps_e_new(c) = e;
+    for (std::size_t k = 0; k < m.forming.size(); ++k) {
+      const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
+      internal::Deposit3(m.eps_b, m.TentOf(at), m.forming[k] / m.cell_volume, nx, nz);
+    }
+    for (int c = 0; c < m.cells; ++c) {
+      if (count) diag_.max_bubble_fraction = std::max(diag_.max_bubble_fraction, m.eps_b(c));
+      double e = 1.0 - m.eps_b(c);
+      if (e < kMinEmulsionFraction) {
+        e = kMinEmulsionFraction;
+        if (count) diag_.fraction_clamps += 1;
+      }
+      m.eps_e_new(c) = e;
+    }
+  };
+  deposit_fractions(true);
+  // The bubbles' mobility under a pressure-gradient change, per cell: sum of V dt / (m + k dt)
+  // (m the inertia density, k the drag linearised at the bubble's slip) over the cell volume.
+  m.mobility.setZero();
+  std::vector<double> bubble_mobility(bubbles_.size(), 0.0);
+  if (opt_.implicit_bubble_pressure) {
+    const double inertia = force_.inertia_density();
+    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
+      const DbmBubble& bub = bubbles_[b];
+      const internal::Tent3 t = m.TentOf(bub.x);
+      Vec u;
+      for (int c = 0; c < 3; ++c) u(c) = internal::Interpolate3(m.uc[c], t, nx, nz);
+      const double k =
+          0.75 * force_.drag_coefficient() * rho_e * (bub.v - u).norm() / bub.diameter_m;
+      bubble_mobility[b] = dt / (inertia + k * dt);
+      const std::vector<Vec> points = m.Spread(bub.x, bub.diameter_m, domain_lo, domain_hi);
+      const double share =
+          bub.volume_m3 * bubble_mobility[b] / (static_cast<double>(points.size()) * m.cell_volume);
+      for (const Vec& point : points)
+        internal::Deposit3(m.mobility, m.TentOf(point), share, nx, nz);
+    }
   }
 
   // 7. Emulsion predictor: advection and viscosity explicit, the bubbles' reaction as a source,
@@ -685,7 +711,7 @@ void DbmSimulation::Step() {
     star.setZero();
     // Evaluated faces: interior ones, and the top face for the vertical axis.
     const int last = a == 1 ? f[a] - 1 : f[a] - 2;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (m.cells >= kParallelCells)
     for (int k = 0; k < f[2]; ++k) {
       for (int j = 0; j < f[1]; ++j) {
         for (int i = 0; i < f[0]; ++i) {
@@ -705,7 +731,7 @@ void DbmSimulation::Step() {
 
   // 8. Projection: eps_e u = eps_e u* - eps_e a (dt / rho_e) grad p', a = eps_e / (eps_e +
   // C_VM eps_b), continuity with storage.
-  std::array<Eigen::VectorXd, 3> coeff, eps_face;
+  std::array<Eigen::VectorXd, 3> coeff, eps_face, coeff_total;
   for (int a = 0; a < 3; ++a) {
     std::array<int, 3> f = m.n;
     ++f[a];
@@ -724,6 +750,35 @@ void DbmSimulation::Step() {
         }
       }
     }
+    coeff_total[a] = coeff[a];
+  }
+  // The bubbles' response to the pressure change enters the pressure equation (semi-implicit):
+  // -div((C_e + M) grad p_new) = -residual - div(M grad p_old), M the face mobility.
+  Eigen::VectorXd mobility_flux = Eigen::VectorXd::Zero(m.cells);  // div(M grad p_old) V
+  if (opt_.implicit_bubble_pressure) {
+    for (int a = 0; a < 3; ++a) {
+      std::array<int, 3> f = m.n;
+      ++f[a];
+      const double face_area =
+          a == 0 ? m.h[1] * m.h[2] : (a == 1 ? m.h[0] * m.h[2] : m.h[0] * m.h[1]);
+      for (int k = 0; k < f[2]; ++k)
+        for (int j = 0; j < f[1]; ++j)
+          for (int i = 0; i < f[0]; ++i) {
+            const std::array<int, 3> p{i, j, k};
+            const int fi = face_index(a, i, j, k);
+            if (coeff[a](fi) == 0.0) continue;  // walls
+            const int below = cell_below(a, p);
+            const bool top = p[a] == m.n[a];
+            const double mf =
+                top ? m.mobility(below) : 0.5 * (m.mobility(below) + m.mobility(cell_above(a, p)));
+            coeff_total[a](fi) += mf;
+            const double hh = top ? 0.5 * m.h[a] : m.h[a];
+            const double p_up = top ? 0.0 : m.pressure(cell_above(a, p));
+            const double flux = mf * face_area * (m.pressure(below) - p_up) / hh;  // out of below
+            mobility_flux(below) += flux;
+            if (!top) mobility_flux(cell_above(a, p)) -= flux;
+          }
+    }
   }
   const double area[3] = {m.h[1] * m.h[2], m.h[0] * m.h[2], m.h[0] * m.h[1]};
   Eigen::VectorXd residual(m.cells);
@@ -740,11 +795,13 @@ void DbmSimulation::Step() {
           net += area[a] *
                  (eps_face[a](fhi) * m.vel_star[a](fhi) - eps_face[a](flo) * m.vel_star[a](flo));
         }
-        residual(cell) = net;
+        residual(cell) = net - mobility_flux(cell);
       }
     }
   }
-  m.pressure = m.solver->Solve(coeff[0], coeff[2], coeff[1], residual, 0.0, m.pressure);
+  const Eigen::VectorXd pressure_old = m.pressure;
+  m.pressure =
+      m.solver->Solve(coeff_total[0], coeff_total[2], coeff_total[1], residual, 0.0, m.pressure);
   diag_.max_continuity_residual =
       std::max(diag_.max_continuity_residual, m.solver->diagnostics().relative_residual);
   diag_.max_cg_iterations = std::max(diag_.max_cg_iterations, m.solver->diagnostics().iterations);
@@ -778,6 +835,40 @@ void DbmSimulation::Step() {
         out += area[1] * eps_face[1](fi) * m.vel[1](fi);
       }
     m.top_outflow = out;
+  }
+  if (opt_.implicit_bubble_pressure && !bubbles_.empty()) {
+    // The bubbles follow the pressure change: dv = -dt / (m + k dt) grad(p_new - p_old).
+    const Eigen::VectorXd dp = m.pressure - pressure_old;
+    std::array<Eigen::VectorXd, 3> grad_dp;
+    for (auto& g : grad_dp) g = Eigen::VectorXd::Zero(m.cells);
+    for (int k = 0; k < ny; ++k)
+      for (int j = 0; j < nz; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const int cell = m.Cell(i, j, k);
+          auto face_grad = [&](int di, int dj, int dk, double hh, bool wall) {
+            return wall ? 0.0 : (at(dp, i + di, j + dj, k + dk) - dp(cell)) / hh;
+          };
+          grad_dp[0](cell) =
+              0.5 * (face_grad(1, 0, 0, m.h[0], i == nx - 1) - face_grad(-1, 0, 0, m.h[0], i == 0));
+          grad_dp[1](cell) =
+              0.5 * (face_grad(0, 0, 1, m.h[2], k == ny - 1) - face_grad(0, 0, -1, m.h[2], k == 0));
+          const double g_top =
+              j == nz - 1 ? -dp(cell) / (0.5 * m.h[1]) : face_grad(0, 1, 0, m.h[1], false);
+          grad_dp[2](cell) = 0.5 * (g_top - face_grad(0, -1, 0, m.h[1], j == 0));
+        }
+#pragma omp parallel for schedule(static) if (static_cast <long>(bubbles_.size()) >= \
+                                              kParallelBubbles)
+    for (long b = 0; b < static_cast<long>(bubbles_.size()); ++b) {
+      DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
+      const internal::Tent3 t = m.TentOf(bub.x);
+      Vec g;
+      for (int c = 0; c < 3; ++c) g(c) = internal::Interpolate3(grad_dp[c], t, nx, nz);
+      const Vec dv = -bubble_mobility[static_cast<std::size_t>(b)] * g;
+      bub.v += dv;
+      bub.x += dt * dv;
+      KeepInside(bub);
+    }
+    deposit_fractions(false);
   }
   m.eps_e = m.eps_e_new;
   diag_.max_cfl = std::max(diag_.max_cfl, cfl);

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -39,14 +40,47 @@ double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-std::string GridText(int cells_x, int cells_y) {
-  return std::to_string(cells_x) + "x" + std::to_string(cells_y);
+std::string GridText(int cells_x, int cells_y, int cells_z = 1) {
+  return to_string(GridSize{cells_x, cells_y, cells_z});
 }
 
+/// "packing seed 5", "injection seed 1": a realization of a kind by its seed.
+std::string RealizationText(const std::string& kind, std::uint64_t seed) {
+  const bool named_seed = kind.size() >= 4 && kind.compare(kind.size() - 4, 4, "seed") == 0;
+  return kind + (named_seed ? " " : " seed ") + std::to_string(seed);
+}
+
+/// The progress label of preparing a realization (a packing settles).
+std::string PrepareText(const std::string& kind, std::uint64_t seed) {
+  return (kind == "packing" ? "settle " : "prepare ") + RealizationText(kind, seed);
+}
+
+GridSize GridOf(const Scene& s) { return {s.grid.cells_x, s.grid.cells_y, s.grid.cells_z}; }
+
 /// The bubble boundary bound of a grid (bubble.h): the traced boundary is misplaced by up to half
-/// a cell along the perimeter; with non-square cells the larger side bounds it.
+/// a cell along the perimeter; with non-square cells the larger side bounds it. On a 3-D grid
+/// (cells_z > 1) the depth side counts too: it is the size the grid method refines.
 double CellSize(const Scene& s) {
-  return std::max(s.geometry.width_m / s.grid.cells_x, s.geometry.height_m / s.grid.cells_y);
+  double h = std::max(s.geometry.width_m / s.grid.cells_x, s.geometry.height_m / s.grid.cells_y);
+  if (s.grid.cells_z > 1) h = std::max(h, s.geometry.depth_m / s.grid.cells_z);
+  return h;
+}
+
+/// Mean and standard error of the mean s / sqrt(n) (s the sample standard deviation, n >= 2).
+std::pair<double, double> MeanAndStandardError(const std::vector<double>& values) {
+  const double n = static_cast<double>(values.size());
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  const double mean = sum / n;
+  double squares = 0.0;
+  for (double v : values) squares += (v - mean) * (v - mean);
+  return {mean, std::sqrt(squares / (n - 1.0) / n)};  // n = 2: |x1 - x2| / 2
+}
+
+double Mean(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double v : values) sum += v;
+  return sum / static_cast<double>(values.size());
 }
 
 /// The scene on another grid (and, if `time_resolution` is given, at that value of the model's
@@ -57,6 +91,8 @@ Scene SceneOnGrid(const Scene& scene, GridSize grid, const BedModel& model,
   Scene s = time_resolution ? model.WithTimeResolution(scene, *time_resolution) : scene;
   s.grid.cells_x = grid.cells_x;
   s.grid.cells_y = grid.cells_y;
+  // "AxB" names no depth: a 3-D scene keeps its depth cells.
+  if (grid.cells_z > 1) s.grid.cells_z = grid.cells_z;
   std::string why;
   if (!s.IsValid(&why)) Fail(what + ": " + why);
   return s;
@@ -89,6 +125,7 @@ SensitivityRun MakeRun(const BedResult& r, const Scene& s, std::uint64_t seed) {
   run.seed = seed;
   run.cells_x = s.grid.cells_x;
   run.cells_y = s.grid.cells_y;
+  run.cells_z = s.grid.cells_z;
   run.cell_size_m = CellSize(s);
   run.bubble_found = r.metrics.bubble_present;
   run.reached_t_ref = r.has_snapshot;
@@ -104,6 +141,7 @@ SensitivityRun MakeRun(const BedResult& r, const Scene& s, std::uint64_t seed) {
   run.max_relative_mass_imbalance = r.max_relative_mass_imbalance;
   run.void_fraction_clamps = r.void_fraction_clamps;
   run.drag_out_of_range = r.law_out_of_range;
+  run.headline = r.headline;
   return run;
 }
 
@@ -112,6 +150,7 @@ WorkPrecisionRow RowOf(const SensitivityRun& run, double time_resolution) {
   WorkPrecisionRow row;
   row.cells_x = run.cells_x;
   row.cells_y = run.cells_y;
+  row.cells_z = run.cells_z;
   row.time_resolution = time_resolution;
   row.cell_size_m = run.cell_size_m;
   row.bubble_found = run.bubble_found;
@@ -122,6 +161,7 @@ WorkPrecisionRow RowOf(const SensitivityRun& run, double time_resolution) {
   row.dem_steps = run.dem_steps;
   row.gas_dt_s = run.gas_dt_s;
   row.dem_dt_s = run.dem_dt_s;
+  row.headline = run.headline;
   return row;
 }
 
@@ -181,34 +221,61 @@ void CheckLawList(const std::vector<std::string>& laws, const std::string& field
 }  // namespace
 
 const char* to_string(UncertaintyMethod method) {
-  return method == UncertaintyMethod::kGrids ? "grids" : "realizations";
+  switch (method) {
+    case UncertaintyMethod::kGrids:
+      return "grids";
+    case UncertaintyMethod::kRealizationsAndGrids:
+      return "both";
+    case UncertaintyMethod::kRealizations:
+      break;
+  }
+  return "realizations";
 }
 
 UncertaintyMethod uncertainty_method_from_string(const std::string& text) {
   if (text == "realizations") return UncertaintyMethod::kRealizations;
   if (text == "grids") return UncertaintyMethod::kGrids;
-  Fail("uncertainty: '" + text + "' is not a method (use realizations or grids)");
+  if (text == "both") return UncertaintyMethod::kRealizationsAndGrids;
+  Fail("uncertainty: '" + text + "' is not a method (use realizations, grids or both)");
+}
+
+std::string to_string(const GridSize& grid) {
+  std::string text = std::to_string(grid.cells_x) + "x" + std::to_string(grid.cells_y);
+  if (grid.cells_z > 1) text += "x" + std::to_string(grid.cells_z);
+  return text;
 }
 
 std::vector<GridSize> parse_grid_list(const std::string& text, const std::string& field) {
-  const std::string form = " (expected CELLS_XxCELLS_Y[,...], e.g. 8x24,12x36)";
+  const std::string form =
+      " (expected CELLS_XxCELLS_Y or CELLS_XxCELLS_YxCELLS_Z[,...], e.g. 8x24,12x36 or "
+      "4x10x4,6x15x6)";
   std::vector<GridSize> grids;
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t comma = text.find(',', start);
     const std::string item =
         text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    const std::size_t x = item.find('x');
-    GridSize g;
-    bool ok = x != std::string::npos && x > 0 && x + 1 < item.size();
-    for (std::size_t k = 0; ok && k < item.size(); ++k)
-      ok = k == x || (item[k] >= '0' && item[k] <= '9');
-    if (ok && x <= 6 && item.size() - x - 1 <= 6) {
-      g.cells_x = std::stoi(item.substr(0, x));
-      g.cells_y = std::stoi(item.substr(x + 1));
+    // Two or three counts of 1 to 6 digits separated by 'x'.
+    std::vector<std::string> parts(1);
+    for (char c : item) {
+      if (c == 'x')
+        parts.emplace_back();
+      else
+        parts.back() += c;
     }
-    if (!ok || g.cells_x < 1 || g.cells_y < 1)
-      Fail(field + ": '" + item + "' is not a grid of at least 1x1 cells" + form);
+    bool ok = parts.size() == 2 || parts.size() == 3;
+    for (const std::string& part : parts) {
+      ok = ok && !part.empty() && part.size() <= 6 &&
+           part.find_first_not_of("0123456789") == std::string::npos;
+    }
+    GridSize g;
+    if (ok) {
+      g.cells_x = std::stoi(parts[0]);
+      g.cells_y = std::stoi(parts[1]);
+      g.cells_z = parts.size() == 3 ? std::stoi(parts[2]) : 1;
+    }
+    if (!ok || g.cells_x < 1 || g.cells_y < 1 || g.cells_z < 1)
+      Fail(field + ": '" + item + "' is not a grid of at least 1x1 (or 1x1x1) cells" + form);
     grids.push_back(g);
     if (comma == std::string::npos) break;
     start = comma + 1;
@@ -241,15 +308,16 @@ bool WorkPrecisionOptions::IsValid(std::string* error) const {
   bool ok = true;
   CheckLawList({law}, "WorkPrecisionOptions.law", &why, &ok);
   for (std::size_t a = 0; ok && a < grids.size(); ++a) {
-    if (grids[a].cells_x < 1 || grids[a].cells_y < 1) {
-      why = "WorkPrecisionOptions.grids: " + GridText(grids[a].cells_x, grids[a].cells_y) +
+    if (grids[a].cells_x < 1 || grids[a].cells_y < 1 || grids[a].cells_z < 1) {
+      why = "WorkPrecisionOptions.grids: " + to_string(grids[a]) +
+            (grids[a].cells_z < 1 ? " (cells_z " + std::to_string(grids[a].cells_z) + ")" : "") +
             " needs at least 1 cell each way";
       ok = false;
     }
     for (std::size_t b = 0; ok && b < a; ++b) {
-      if (grids[a].cells_x == grids[b].cells_x && grids[a].cells_y == grids[b].cells_y) {
-        why = "WorkPrecisionOptions.grids: " + GridText(grids[a].cells_x, grids[a].cells_y) +
-              " is listed twice";
+      if (grids[a].cells_x == grids[b].cells_x && grids[a].cells_y == grids[b].cells_y &&
+          grids[a].cells_z == grids[b].cells_z) {
+        why = "WorkPrecisionOptions.grids: " + to_string(grids[a]) + " is listed twice";
         ok = false;
       }
     }
@@ -317,6 +385,57 @@ DiameterUncertainty grid_uncertainty(double d_coarse_m, double h_coarse_m, doubl
   return u;
 }
 
+DiameterUncertainty combined_uncertainty(const std::vector<double>& d_coarse_m, double h_coarse_m,
+                                         const std::vector<double>& d_fine_m, double h_fine_m) {
+  if (d_coarse_m.size() < 2 || d_fine_m.size() < 2)
+    Fail("combined_uncertainty: needs at least two realizations on each grid, got " +
+         std::to_string(d_coarse_m.size()) + " and " + std::to_string(d_fine_m.size()));
+  for (double d : d_coarse_m)
+    if (!std::isfinite(d)) Fail("combined_uncertainty: a diameter is not finite");
+  if (!(h_fine_m > 0.0 && h_fine_m < h_coarse_m) || !std::isfinite(h_coarse_m))
+    Fail("combined_uncertainty: needs 0 < h_fine < h_coarse, got h_fine = " + Num(h_fine_m) +
+         " m, h_coarse = " + Num(h_coarse_m) + " m");
+  DiameterUncertainty u = realization_uncertainty(d_fine_m, h_fine_m);
+  // Richardson for order 1 on the means of the seeds.
+  u.grid_m = std::abs(u.mean_m - Mean(d_coarse_m)) / (h_coarse_m / h_fine_m - 1.0);
+  u.total_m =
+      std::sqrt(u.spread_m * u.spread_m + u.grid_m * u.grid_m + u.boundary_m * u.boundary_m);
+  return u;
+}
+
+HeadlineUncertainty headline_uncertainty(const std::string& name, const std::vector<double>& coarse,
+                                         double h_coarse_m, const std::vector<double>& fine,
+                                         double h_fine_m) {
+  const std::string what = "headline_uncertainty (" + name + ")";
+  for (const auto* values : {&coarse, &fine})
+    for (double v : *values)
+      if (!std::isfinite(v)) Fail(what + ": a value is not finite");
+  HeadlineUncertainty u;
+  u.name = name;
+  if (coarse.empty()) {  // realizations
+    if (fine.size() < 2)
+      Fail(what + ": needs at least two realizations, got " + std::to_string(fine.size()));
+    std::tie(u.estimate, u.spread) = MeanAndStandardError(fine);
+  } else {
+    if (!(h_fine_m > 0.0 && h_fine_m < h_coarse_m) || !std::isfinite(h_coarse_m))
+      Fail(what + ": needs 0 < h_fine < h_coarse, got h_fine = " + Num(h_fine_m) +
+           " m, h_coarse = " + Num(h_coarse_m) + " m");
+    const double r = h_coarse_m / h_fine_m;
+    if (coarse.size() == 1 && fine.size() == 1) {  // grids
+      u.estimate = fine.front();
+      u.grid = std::abs(fine.front() - coarse.front()) / (r - 1.0);
+    } else {  // both
+      if (coarse.size() < 2 || fine.size() < 2)
+        Fail(what + ": needs one value per grid, or at least two realizations on each, got " +
+             std::to_string(coarse.size()) + " and " + std::to_string(fine.size()));
+      std::tie(u.estimate, u.spread) = MeanAndStandardError(fine);
+      u.grid = std::abs(u.estimate - Mean(coarse)) / (r - 1.0);
+    }
+  }
+  u.total = std::hypot(u.spread, u.grid);
+  return u;
+}
+
 RichardsonEstimate richardson_extrapolate(const std::vector<double>& cell_sizes_m,
                                           const std::vector<double>& diameters_m) {
   RichardsonEstimate est;
@@ -366,22 +485,26 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   // A deterministic model has no realizations: its uncertainty comes from two grids.
   const bool realized = !model.realization_kind().empty();
   const UncertaintyMethod method = realized ? options.uncertainty : UncertaintyMethod::kGrids;
+  const bool with_grids = method != UncertaintyMethod::kRealizations;
 
   // Grids and seeds of the study.
   std::vector<Scene> grid_scenes = {scene};
-  if (method == UncertaintyMethod::kGrids) {
-    GridSize fine{static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_x)),
-                  static_cast<int>(std::lround(options.grid_refinement * scene.grid.cells_y))};
+  if (with_grids) {
+    const auto refine = [&](int cells) {
+      return static_cast<int>(std::lround(options.grid_refinement * cells));
+    };
+    // The depth is refined with the rest on a 3-D grid; a pseudo-2D grid keeps its one cell.
+    const GridSize fine{refine(scene.grid.cells_x), refine(scene.grid.cells_y),
+                        scene.grid.cells_z > 1 ? refine(scene.grid.cells_z) : 1};
     grid_scenes.push_back(SceneOnGrid(scene, fine, model, nullptr,
                                       "the finer grid (" + Num(options.grid_refinement) +
-                                          " x the scene's, " +
-                                          GridText(fine.cells_x, fine.cells_y) + " cells)"));
+                                          " x the scene's, " + to_string(fine) + " cells)"));
     if (!(CellSize(grid_scenes[1]) < CellSize(scene)))
-      Fail("the finer grid " + GridText(fine.cells_x, fine.cells_y) +
+      Fail("the finer grid " + to_string(fine) +
            " has no smaller cells than the scene's; raise grid_refinement");
   }
   std::vector<std::uint64_t> seeds;
-  const int n_seeds = method == UncertaintyMethod::kRealizations ? options.realizations : 1;
+  const int n_seeds = method == UncertaintyMethod::kGrids ? 1 : options.realizations;
   for (int k = 0; k < n_seeds; ++k) seeds.push_back(scene.seed + static_cast<std::uint64_t>(k));
 
   // Fail fast: every law loads and has a U_mf and stable steps on every grid.
@@ -396,27 +519,9 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   summary.method = method;
   summary.t_ref_s = scene.time.t_ref_s;
   summary.eps_threshold = scene.bubble.eps_threshold;
-  for (const Scene& gs : grid_scenes) summary.grids.push_back({gs.grid.cells_x, gs.grid.cells_y});
+  summary.realization_kind = model.realization_kind();
+  for (const Scene& gs : grid_scenes) summary.grids.push_back(GridOf(gs));
   const std::string kind = model.realization_kind();
-  if (method == UncertaintyMethod::kRealizations) {
-    summary.method_description =
-        std::to_string(n_seeds) + " " + kind + " realizations (seeds " +
-        std::to_string(seeds.front()) + ".." + std::to_string(seeds.back()) +
-        ") on one grid; D = mean of the runs; uncertainty = sqrt(SE^2 + h^2) with SE = s/sqrt(n) "
-        "the standard error of the mean (n = 2: |D1 - D2|/2) and h = max(dx, dy) = " +
-        Cm(CellSize(scene)) + " cm the bubble-boundary bound of the grid";
-  } else {
-    const double r = CellSize(grid_scenes[0]) / CellSize(grid_scenes[1]);
-    summary.method_description =
-        (realized ? "one " + kind + " (seed " + std::to_string(scene.seed) + ")"
-                  : "the " + scene.solver + " model (deterministic: no realizations)") +
-        " on the grids " + GridText(scene.grid.cells_x, scene.grid.cells_y) + " and " +
-        GridText(grid_scenes[1].grid.cells_x, grid_scenes[1].grid.cells_y) + " (r = " + Num(r) +
-        "); D = the finer grid's; uncertainty = sqrt(E^2 + h^2) with E = |D_fine - D_coarse|/(r - "
-        "1) the Richardson error of the finer value for first-order convergence and h = max(dx, "
-        "dy) = " +
-        Cm(CellSize(grid_scenes[1])) + " cm the bubble-boundary bound of the finer grid";
-  }
 
   summary.laws.resize(laws.size());
   for (std::size_t i = 0; i < laws.size(); ++i) summary.laws[i].law = laws[i];
@@ -431,13 +536,13 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
       seeded.seed = seed;
       SensitivityPacking info;
       realization = Realize(model, seeded, Load(load_law, laws.front()),
-                            study.Unit("settle " + kind + " seed " + std::to_string(seed)), &info);
+                            study.Unit(PrepareText(kind, seed)), &info);
       summary.packings.push_back(info);
     }
     for (const Scene& grid_scene : grid_scenes) {
       Scene run_scene = grid_scene;
       run_scene.seed = seed;
-      const std::string grid = GridText(run_scene.grid.cells_x, run_scene.grid.cells_y);
+      const std::string grid = to_string(GridOf(run_scene));
       const std::string tag = realized ? "seed" + std::to_string(seed) + "_" + grid : grid;
       for (std::size_t i = 0; i < laws.size(); ++i) {
         const BedResult r = run_bed_model(run_scene, Load(load_law, laws[i]),
@@ -457,24 +562,118 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
     }
   }
 
+  // Runs are seed-major, grid-minor: run k * G + g is seed k on grid g.
+  const std::size_t n_grids = grid_scenes.size();
+  const double h_coarse = CellSize(grid_scenes.front()), h_fine = CellSize(grid_scenes.back());
   for (SensitivityLawResult& lr : summary.laws) {
-    std::vector<double> d;
-    for (const SensitivityRun& run : lr.runs) {
-      d.push_back(run.bubble_diameter_m);
+    // Per grid, the values of every seed: D, and each headline number.
+    std::vector<std::vector<double>> d(n_grids);
+    const HeadlineNumbers& names = lr.runs.front().headline;
+    std::vector<std::vector<std::vector<double>>> head(names.size(),
+                                                       std::vector<std::vector<double>>(n_grids));
+    for (std::size_t k = 0; k < lr.runs.size(); ++k) {
+      const SensitivityRun& run = lr.runs[k];
+      d[k % n_grids].push_back(run.bubble_diameter_m);
       lr.bubbles_found += run.bubble_found ? 1 : 0;
+      if (run.headline.size() != names.size())
+        Fail(lr.law + ": the model's headline numbers differ between runs");
+      for (std::size_t n = 0; n < names.size(); ++n) {
+        if (run.headline[n].first != names[n].first)
+          Fail(lr.law + ": the model's headline numbers differ between runs ('" +
+               run.headline[n].first + "' against '" + names[n].first + "')");
+        head[n][k % n_grids].push_back(run.headline[n].second);
+      }
     }
-    if (method == UncertaintyMethod::kRealizations) {
-      lr.diameter = realization_uncertainty(d, lr.runs.front().cell_size_m);
+    switch (method) {
+      case UncertaintyMethod::kRealizations:
+        lr.diameter = realization_uncertainty(d[0], h_coarse);
+        break;
+      case UncertaintyMethod::kGrids:
+        lr.diameter = grid_uncertainty(d[0][0], h_coarse, d[1][0], h_fine);
+        break;
+      case UncertaintyMethod::kRealizationsAndGrids:
+        lr.diameter = combined_uncertainty(d[0], h_coarse, d[1], h_fine);
+        break;
+    }
+    for (std::size_t n = 0; n < names.size(); ++n) {
+      lr.headline.push_back(
+          with_grids
+              ? headline_uncertainty(names[n].first, head[n][0], h_coarse, head[n][1], h_fine)
+              : headline_uncertainty(names[n].first, {}, 0.0, head[n][0], h_coarse));
+    }
+  }
+
+  // How the uncertainty was formed, in words (for D, or for the headline numbers).
+  const bool headline = summary.has_headline();
+  const std::string seed_range =
+      "seeds " + std::to_string(seeds.front()) + ".." + std::to_string(seeds.back());
+  const std::string se_text = "SE = s/sqrt(n) the standard error of the mean (n = 2: |x1 - x2|/2)";
+  if (method == UncertaintyMethod::kRealizations) {
+    summary.method_description =
+        std::to_string(n_seeds) + " " + kind + " realizations (" + seed_range + ") on the grid " +
+        to_string(GridOf(scene)) + "; " +
+        (headline ? "each number = the mean of the runs; uncertainty = " + se_text
+                  : "D = mean of the runs; uncertainty = sqrt(SE^2 + h^2) with " + se_text +
+                        " and h = max(dx, dy) = " + Cm(CellSize(scene)) +
+                        " cm the bubble-boundary bound of the grid");
+  } else {
+    const double r = h_coarse / h_fine;
+    const std::string grids = "the grids " + to_string(GridOf(grid_scenes[0])) + " and " +
+                              to_string(GridOf(grid_scenes[1])) + " (r = " + Num(r) + ")";
+    const std::string richardson_text =
+        "the Richardson error of the finer value for first-order convergence";
+    const std::string bound_text =
+        " and h = max(dx, dy) = " + Cm(h_fine) + " cm the bubble-boundary bound of the finer grid";
+    if (method == UncertaintyMethod::kGrids) {
+      summary.method_description =
+          (realized ? "one " + kind + " (seed " + std::to_string(scene.seed) + ")"
+                    : "the " + scene.solver + " model (deterministic: no realizations)") +
+          " on " + grids + "; " +
+          (headline
+               ? "each number = the finer grid's; uncertainty = E = |fine - coarse|/(r - 1), " +
+                     richardson_text
+               : "D = the finer grid's; uncertainty = sqrt(E^2 + h^2) with E = |D_fine - "
+                 "D_coarse|/(r - 1) " +
+                     richardson_text + bound_text);
     } else {
-      lr.diameter = grid_uncertainty(d[0], lr.runs[0].cell_size_m, d[1], lr.runs[1].cell_size_m);
+      summary.method_description =
+          std::to_string(n_seeds) + " " + kind + " realizations (" + seed_range + "), each on " +
+          grids + "; " + (headline ? "each number" : std::string("D")) +
+          " = the mean over the seeds on the finer grid; uncertainty = sqrt(SE^2 + E^2" +
+          (headline ? "" : " + h^2") +
+          ") with SE = s/sqrt(n) on the finer grid, E = |mean_fine - "
+          "mean_coarse|/(r - 1) " +
+          richardson_text + (headline ? "" : bound_text);
     }
   }
   summary.wall_s = Seconds(t0);
   return summary;
 }
 
+namespace {
+
+/// "name = value" for each headline number of a run or a row.
+std::string HeadlineText(const HeadlineNumbers& numbers) {
+  std::string text;
+  for (const auto& [name, value] : numbers)
+    text += (text.empty() ? "" : ", ") + name + " " + Num(value);
+  return text;
+}
+
+}  // namespace
+
 std::string SensitivitySummary::BriefReport() const {
   std::ostringstream s;
+  if (has_headline()) {
+    s << "Headline numbers of scene " << scene << " (" << to_string(method) << "):\n";
+    for (const SensitivityLawResult& lr : laws) {
+      s << "  " << lr.law << ":";
+      for (const HeadlineUncertainty& h : lr.headline)
+        s << " " << h.name << " = " << Num(h.estimate) << " +- " << Num(h.total, 2) << ";";
+      s << " U_mf " << Num(lr.umf_m_s) << " m/s\n";
+    }
+    return s.str();
+  }
   s << "Bubble diameter at t_ref = " << Num(t_ref_s) << " s after injection, scene " << scene
     << " (" << to_string(method) << "):\n";
   for (const SensitivityLawResult& lr : laws) {
@@ -491,18 +690,36 @@ std::string SensitivitySummary::BriefReport() const {
 std::string SensitivitySummary::FullReport() const {
   std::ostringstream s;
   s << BriefReport() << "  uncertainty: " << method_description << "\n";
+  const bool headline = has_headline();
   for (const SensitivityPacking& p : packings) {
+    if (p.particles == 0) continue;  // a realization without particles (DBM: a seed) says nothing
     s << "  packing seed " << p.seed << ": " << p.particles << " particles, settled bed "
       << Cm(p.settled_bed_height_m) << " cm, settling " << Num(p.settle_wall_s, 3) << " s wall\n";
   }
   for (const SensitivityLawResult& lr : laws) {
-    s << "  " << lr.law << " (mean " << Cm(lr.diameter.mean_m) << " cm, spread "
-      << Cm(lr.diameter.spread_m) << " cm, cell bound " << Cm(lr.diameter.boundary_m) << " cm):\n";
+    if (headline) {
+      s << "  " << lr.law << ":\n";
+      for (const HeadlineUncertainty& h : lr.headline) {
+        s << "    " << h.name << " = " << Num(h.estimate) << " +- " << Num(h.total, 3)
+          << " (statistical " << Num(h.spread, 3) << ", grid " << Num(h.grid, 3) << ")\n";
+      }
+    } else {
+      s << "  " << lr.law << " (mean " << Cm(lr.diameter.mean_m) << " cm, spread "
+        << Cm(lr.diameter.spread_m) << " cm";
+      if (method == UncertaintyMethod::kRealizationsAndGrids)
+        s << ", grid " << Cm(lr.diameter.grid_m) << " cm";
+      s << ", cell bound " << Cm(lr.diameter.boundary_m) << " cm):\n";
+    }
     for (const SensitivityRun& r : lr.runs) {
-      s << "    seed " << r.seed << ", grid " << GridText(r.cells_x, r.cells_y) << ": D "
-        << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none")) << ", "
-        << r.gas_steps << " gas / " << r.dem_steps << " DEM steps, " << Num(r.wall_s, 3)
-        << " s wall, momentum mismatch " << Num(r.momentum_mismatch, 2) << "\n";
+      s << "    seed " << r.seed << ", grid " << GridText(r.cells_x, r.cells_y, r.cells_z) << ": ";
+      if (headline) {
+        s << HeadlineText(r.headline) << "; " << r.gas_steps << " steps, " << Num(r.wall_s, 3)
+          << " s wall\n";
+      } else {
+        s << "D " << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none"))
+          << ", " << r.gas_steps << " gas / " << r.dem_steps << " DEM steps, " << Num(r.wall_s, 3)
+          << " s wall, momentum mismatch " << Num(r.momentum_mismatch, 2) << "\n";
+      }
     }
   }
   s << "  total wall " << Num(wall_s, 3) << " s\n";
@@ -526,8 +743,7 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   }
   const bool realized = !model.realization_kind().empty();
   const std::vector<GridSize> grids =
-      options.grids.empty() ? std::vector<GridSize>{{scene.grid.cells_x, scene.grid.cells_y}}
-                            : options.grids;
+      options.grids.empty() ? std::vector<GridSize>{GridOf(scene)} : options.grids;
   // The scene's own value goes through WithTimeResolution too, so that it alone sets the step
   // (DPM: the scene's dem_dt_s is dropped for t_c / contact_steps) in every row alike.
   const std::vector<double> steps = options.time_resolutions.empty()
@@ -538,7 +754,7 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   std::vector<Scene> configs;
   std::vector<double> config_steps;
   for (const GridSize& g : grids) {
-    const std::string grid = "grid " + GridText(g.cells_x, g.cells_y);
+    const std::string grid = "grid " + to_string(g);
     for (const double& v : steps) {
       configs.push_back(
           SceneOnGrid(scene, g, model, &v, grid + " with " + resolution.name + " " + Num(v)));
@@ -564,16 +780,13 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   if (realized) {
     SensitivityPacking info;
     // One realization, prepared with the scene's own settings, for every configuration.
-    realization = Realize(
-        model, scene, Load(load_law, options.law),
-        study.Unit("settle " + model.realization_kind() + " seed " + std::to_string(scene.seed)),
-        &info);
+    realization = Realize(model, scene, Load(load_law, options.law),
+                          study.Unit(PrepareText(model.realization_kind(), scene.seed)), &info);
     result.settle_wall_s = info.settle_wall_s;
   }
   for (std::size_t k = 0; k < configs.size(); ++k) {
     const Scene& c = configs[k];
-    const std::string tag =
-        GridText(c.grid.cells_x, c.grid.cells_y) + "_" + resolution.name + Num(config_steps[k]);
+    const std::string tag = to_string(GridOf(c)) + "_" + resolution.name + Num(config_steps[k]);
     const BedResult r =
         run_bed_model(c, Load(load_law, options.law), RunOptions(options.run, c, options.law, tag),
                       study.Unit(options.law + " " + tag), realization.get());
@@ -597,8 +810,13 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
             [](const WorkPrecisionRow* a, const WorkPrecisionRow* b) {
               return a->cell_size_m > b->cell_size_m;  // coarse to fine
             });
+  // A model with headline numbers is compared with its finest configuration: its D (DBM: the
+  // mean bubble size) is no traced boundary whose O(h) error Richardson would extrapolate.
+  const bool headline = !result.rows.front().headline.empty();
   RichardsonEstimate rich;
-  if (at_finest_steps.size() >= 3) {
+  if (headline) {
+    rich.reason = "the model's headline numbers are compared with the finest configuration";
+  } else if (at_finest_steps.size() >= 3) {
     const std::size_t n = at_finest_steps.size();
     std::vector<double> h, d;
     bool uniform = true;
@@ -628,13 +846,13 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
       row.error_m = std::abs(row.bubble_diameter_m - result.reference_diameter_m);
   } else {
     result.reference_method = "finest as reference";
-    result.reference_note = "Richardson not possible: " + rich.reason;
+    result.reference_note = headline ? "" : "Richardson not possible: " + rich.reason;
     std::size_t finest = 0;
     for (std::size_t k = 1; k < result.rows.size(); ++k) {
       const auto& a = result.rows[k];
       const auto& b = result.rows[finest];
-      const long cells_a = static_cast<long>(a.cells_x) * a.cells_y,
-                 cells_b = static_cast<long>(b.cells_x) * b.cells_y;
+      const long cells_a = static_cast<long>(a.cells_x) * a.cells_y * a.cells_z,
+                 cells_b = static_cast<long>(b.cells_x) * b.cells_y * b.cells_z;
       if (cells_a > cells_b ||
           (cells_a == cells_b && finer_time(a.time_resolution, b.time_resolution)))
         finest = k;
@@ -646,6 +864,24 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
                         ? std::numeric_limits<double>::quiet_NaN()
                         : std::abs(row.bubble_diameter_m - result.reference_diameter_m);
     }
+    if (headline) {
+      result.reference_headline = result.rows[finest].headline;
+      const HeadlineNumbers& ref = result.reference_headline;
+      for (auto& row : result.rows) {
+        if (row.headline.size() != ref.size())
+          Fail("run_work_precision: the model's headline numbers differ between configurations");
+        for (std::size_t n = 0; n < ref.size(); ++n) {
+          if (row.headline[n].first != ref[n].first)
+            Fail(
+                "run_work_precision: the model's headline numbers differ between configurations "
+                "('" +
+                row.headline[n].first + "' against '" + ref[n].first + "')");
+          row.headline_difference.push_back(row.is_reference
+                                                ? std::numeric_limits<double>::quiet_NaN()
+                                                : row.headline[n].second - ref[n].second);
+        }
+      }
+    }
   }
   result.wall_s = Seconds(t0);
   return result;
@@ -654,7 +890,19 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
 std::string WorkPrecisionResult::BriefReport() const {
   std::ostringstream s;
   s << "Work-precision of " << law << " on scene " << scene;
-  if (!realization_kind.empty()) s << " (" << realization_kind << " seed " << seed << ")";
+  if (!realization_kind.empty()) s << " (" << RealizationText(realization_kind, seed) << ")";
+  if (has_headline()) {
+    const WorkPrecisionRow* ref = nullptr;
+    for (const WorkPrecisionRow& r : rows)
+      if (r.is_reference) ref = &r;
+    s << ": headline numbers against the finest configuration";
+    if (ref)
+      s << " (grid " << GridText(ref->cells_x, ref->cells_y, ref->cells_z) << ", "
+        << time_resolution_name << " " << Num(ref->time_resolution) << ")";
+    s << ": " << HeadlineText(reference_headline) << "; " << rows.size()
+      << " configurations, total " << Num(wall_s, 3) << " s wall\n";
+    return s.str();
+  }
   s << ": D at t_ref = " << Num(t_ref_s) << " s; reference " << reference_method
     << " D = " << Cm(reference_diameter_m) << " cm";
   if (reference_method == "richardson") s << " (observed order " << Num(observed_order, 3) << ")";
@@ -669,6 +917,17 @@ std::string WorkPrecisionResult::FullReport() const {
   std::ostringstream s;
   s << BriefReport();
   for (const WorkPrecisionRow& r : rows) {
+    if (has_headline()) {
+      s << "  grid " << GridText(r.cells_x, r.cells_y, r.cells_z) << ", " << time_resolution_name
+        << " " << Num(r.time_resolution) << ":";
+      for (std::size_t n = 0; n < r.headline.size(); ++n) {
+        const double diff = n < r.headline_difference.size() ? r.headline_difference[n] : 0.0;
+        s << " " << r.headline[n].first << " " << Num(r.headline[n].second) << " ("
+          << (std::isnan(diff) ? std::string("reference") : "diff " + Num(diff, 3)) << "),";
+      }
+      s << " " << r.gas_steps << " steps, " << Num(r.wall_s, 3) << " s wall\n";
+      continue;
+    }
     s << "  grid " << GridText(r.cells_x, r.cells_y) << ", " << time_resolution_name << " "
       << Num(r.time_resolution) << ": D "
       << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none")) << ", error "

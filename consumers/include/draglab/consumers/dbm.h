@@ -90,6 +90,10 @@ struct DbmOptions {
   /// Without coalescence: bubbles that overlap are pushed apart (perfectly inelastic hard-sphere
   /// collisions, as the seed's DBM); false: they may overlap.
   bool collisions = true;
+  /// The bubbles' response to the new pressure in the pressure equation (semi-implicit: their
+  /// mobility dt / (m + k dt) joins the emulsion's, and they are corrected by the pressure
+  /// change); false: they feel the last step's pressure only (unstable where they crowd).
+  bool implicit_bubble_pressure = true;
 
   double dt_s = 2e-3;  ///< Fixed step, > 0, at most StableTimeStep().
   PoissonSolver solver = PoissonSolver::kConjugateGradient;

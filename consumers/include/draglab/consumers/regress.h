@@ -9,19 +9,29 @@
 //   - U_mf [m/s]: moved if |U - U_base| > umf_rel U_base;
 //   - bubble at t_ref present / absent: moved if it appears or disappears;
 //   - bubble diameter at t_ref [m] (both present): moved if |D - D_base| > diameter_abs_m +
-//     diameter_rel D_base.
+//     diameter_rel D_base;
+//   - the model's headline numbers (BedResult::headline, stored in the result JSON's "headline"
+//     object; the DBM: hold-up, mean bubble diameter at the report heights, circulation), each
+//     that the baseline's result has: mean_diameter_* as the bubble diameter, the others moved
+//     if |x - x_base| > kHeadlineRelativeTolerance |x_base| (headline_tolerance). A number the
+//     baseline has and the new result lacks has moved.
+// For the DBM, whose `metrics` hold no jet bubble, "bubble at t_ref" is the time-averaged mean
+// bubble diameter over the run (present when a bubble was sampled) and t_ref is 0.
 // A version with a stored result for the scene (same law content hash) is compared without a new
 // run. A run that fails (draglab::Error: law outside its validity box, solver instability) is
 // reported as failed, not as moved, and nothing of it is stored. In single-law mode
 // (RegressOptions::law = "NAME@V") that version is compared on every registered scene; where its
 // law name has no baseline yet, its (published) result becomes the baseline.
-// Limits: DPM scenes only; one run per (scene, version): the tolerances, not repeated runs,
-// absorb the run-to-run scatter of the bubble (packing, chaotic particle motion).
+// Limits: one run per (scene, version): the tolerances, not repeated runs, absorb the run-to-run
+// scatter of the bubble (packing, chaotic particle motion; the DBM's injection phases); the
+// headline tolerances are not stored with the baseline (RegressionTolerances has no field for
+// them): they follow from the stored diameter tolerances and kHeadlineRelativeTolerance.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "draglab/consumers/bed_model.h"
@@ -34,8 +44,22 @@ class Database;
 namespace consumers {
 
 /// Default tolerances of a baseline of `scene`: bubble diameter 2 gas cells (the larger cell
-/// side) + 10 % of the baseline diameter, U_mf 1 % (the reasons are in regress.cc).
+/// side) + 10 % of the baseline diameter, U_mf 1 %; a DBM scene: bubble diameter 10 % without a
+/// cell part (its bubbles are Lagrangian volumes, not traced on the grid), U_mf 1 % (the reasons
+/// are in regress.cc).
 RegressionTolerances default_regression_tolerances(const Scene& scene);
+
+/// Relative tolerance of a headline number that is not a bubble diameter (hold-up, circulation):
+/// 0.1 (the reasons are in regress.cc).
+inline constexpr double kHeadlineRelativeTolerance = 0.10;
+/// Largest allowed |x - x_base| of the headline number `name`: a bubble diameter
+/// ("mean_diameter_..."): diameter_abs_m + diameter_rel |x_base|; any other:
+/// kHeadlineRelativeTolerance |x_base|.
+double headline_tolerance(const std::string& name, double baseline,
+                          const RegressionTolerances& tolerances);
+/// The "headline" object of a stored result JSON (name, value; a null value is NaN), in the
+/// object's (alphabetical) order; empty without one or for text that is not a JSON object.
+std::vector<std::pair<std::string, double>> headline_of_result_json(const std::string& json);
 
 /// What a regression compares, from a DPM result: U_mf, background, the bubble at t_ref (its
 /// diameter and centroid height), the highest bed surface over the samples, wall time.
@@ -46,7 +70,8 @@ std::string dpm_result_json(const DpmResult& result);
 
 /// One metric of a comparison.
 struct MetricComparison {
-  std::string metric;      ///< "umf_m_s", "bubble_present" or "bubble_diameter_m".
+  /// "umf_m_s", "bubble_present", "bubble_diameter_m", or a headline number's name.
+  std::string metric;
   double baseline = 0.0;   ///< Baseline value (bubble_present: 1 or 0).
   double value = 0.0;      ///< Value of the checked version.
   double delta = 0.0;      ///< value - baseline.
@@ -59,6 +84,11 @@ struct MetricComparison {
 std::vector<MetricComparison> compare_metrics(const ConsumerMetrics& baseline,
                                               const ConsumerMetrics& value,
                                               const RegressionTolerances& tolerances);
+/// Compares the headline numbers of two stored result JSONs: one comparison per number of the
+/// baseline (value NaN, moved, when the new result lacks it); none when the baseline has none.
+std::vector<MetricComparison> compare_headline(const std::string& baseline_result_json,
+                                               const std::string& value_result_json,
+                                               const RegressionTolerances& tolerances);
 
 enum class RegressOutcome {
   kOk,      ///< Every metric within its tolerance.
@@ -85,6 +115,8 @@ struct RegressEntry {
   std::int64_t baseline_result_id = 0;  ///< The baseline's result (0 without one).
   RegressionTolerances tolerances;      ///< Of the baseline (or of the one registered now).
   ConsumerMetrics metrics;              ///< Of the checked version (not set when failed).
+  /// Its headline numbers (from its result JSON; empty for dpm and tfm, or when failed).
+  std::vector<std::pair<std::string, double>> headline;
   std::vector<MetricComparison> comparisons;
   std::string error;                  ///< Why the run failed.
   std::vector<std::string> warnings;  ///< From loading the law (draft, retracted).
