@@ -77,6 +77,12 @@ BedSampler::Taken BedSampler::Take(double t_abs, const Eigen::ArrayXXd& gas_frac
   return t;
 }
 
+std::string scene_output_directory(const Scene& scene, const std::string& override_directory) {
+  if (!override_directory.empty()) return override_directory;
+  if (!scene.outputs.directory.empty()) return scene.outputs.directory;
+  return "out/" + scene.name;
+}
+
 }  // namespace internal
 }  // namespace consumers
 }  // namespace draglab

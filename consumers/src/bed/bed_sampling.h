@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include <string>
+
 #include "draglab/consumers/bubble.h"
 #include "draglab/consumers/gas_phase.h"
 #include "draglab/consumers/scene.h"
@@ -21,6 +23,10 @@ GasOptions scene_gas_options(const Scene& scene, double background_m_s, bool wit
 /// The scene's [bubble] criterion around its jet (a column at least one cell wide), with the
 /// bed's initial height for the expansion ratio.
 BubbleOptions scene_bubble_options(const Scene& scene, double initial_bed_height_m);
+
+/// Where a run writes the files its scene asks for: `override` (BedRunOptions), else the
+/// scene's [outputs] directory, else out/<scene name>.
+std::string scene_output_directory(const Scene& scene, const std::string& override_directory);
 
 /// A cell field (nx x nz, Eigen index (i, j)) on the scene's grid as a GridField2D.
 GridField2D scene_grid_field(const Scene& scene, const Eigen::ArrayXXd& values);

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
 #include "draglab/consumers/dbm.h"
 #include "draglab/drag_db/error.h"
@@ -303,9 +304,7 @@ class DbmBedModel : public BedModel {
 
     // Figure data: the mid-plane averaged field, profiles, size histograms, the last bubbles.
     if (scene.outputs.fields) {
-      const std::string dir = !options.output_directory.empty()  ? options.output_directory
-                              : !scene.outputs.directory.empty() ? scene.outputs.directory
-                                                                 : "out/" + scene.name;
+      const std::string dir = internal::scene_output_directory(scene, options.output_directory);
       std::filesystem::create_directories(dir);
       const int k0 = (o.ny - 1) / 2, k1 = o.ny / 2;  // the vertical mid-plane (y = D/2)
       nlohmann::json ux = nlohmann::json::array(), uz = nlohmann::json::array(),

@@ -172,9 +172,7 @@ class TfmBedModel : public BedModel {
     std::vector<std::pair<double, bool>> stops;  // (time, is a field output)
     for (int n = 1; n <= samples; ++n) stops.push_back({std::min(n * interval, duration), false});
     if (scene.outputs.fields) {
-      const std::string dir = !options.output_directory.empty()  ? options.output_directory
-                              : !scene.outputs.directory.empty() ? scene.outputs.directory
-                                                                 : "out/" + scene.name;
+      const std::string dir = internal::scene_output_directory(scene, options.output_directory);
       writer = std::make_unique<DpmOutputWriter>(scene, out.law, dir, true, false);
       if (scene.outputs.interval_s > 0.0) {
         for (int k = 1; k * scene.outputs.interval_s <= duration * (1.0 + 1e-12); ++k)
