@@ -243,6 +243,29 @@ TEST(DbmValidation, CrowdedBubblesNeedTheirPressureResponseInThePressureEquation
   EXPECT_THROW(lagged.AdvanceTo(6.0), std::runtime_error);
 }
 
+TEST(DbmValidation, AnAdaptiveStepHoldsTheEmulsionCfl) {
+  // The crowded column of the test above with a long step (20 ms, below the 27 ms stability
+  // limit of 4 cm bubbles) cut to an emulsion CFL of 0.1: the steps shrink where the plume is
+  // fast, and the emulsion moves about 0.1 cells per step (measured after the step, so a little
+  // above).
+  DbmOptions o;
+  o.width_m = o.depth_m = 0.4;
+  o.height_m = 1.0;
+  o.nx = o.ny = 4;
+  o.nz = 10;
+  o.bubble_diameter_m = 0.04;
+  o.nozzles = square_nozzle_array(2, 0.1, o.width_m, o.depth_m);
+  o.bubble_gas_flow_m3_s = 0.263 * o.width_m * o.depth_m;
+  o.dt_s = 0.02;
+  o.cfl = 0.1;
+  DbmSimulation dbm(o);
+  dbm.AdvanceTo(4.0);
+  const DbmDiagnostics& d = dbm.diagnostics();
+  EXPECT_LT(d.min_dt_s, 0.5 * o.dt_s);
+  EXPECT_LT(d.max_cfl, 0.15);
+  EXPECT_GT(d.steps, static_cast<long>(4.0 / o.dt_s));
+}
+
 class DbmSceneTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {

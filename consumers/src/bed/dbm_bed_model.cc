@@ -72,6 +72,7 @@ DbmOptions SceneDbmOptions(const Scene& s, double umf_m_s, std::uint64_t seed) {
   o.film_drainage_s = d.film_drainage_s;
   o.collisions = d.collisions;
   o.injection_ramp_s = d.injection_ramp_s;
+  o.cfl = d.cfl;
   o.dt_s = d.dt_s;
   o.average_from_s = d.average_from_s;
   o.sample_interval_s = d.sample_interval_s;
@@ -385,7 +386,7 @@ class DbmBedModel : public BedModel {
     out.law_out_of_range = law->out_of_range_count();
     out.threads = 1;
     out.steps = dg.steps;
-    out.mean_dt_s = o.dt_s;
+    out.mean_dt_s = dg.steps > 0 ? dbm.time() / static_cast<double>(dg.steps) : o.dt_s;
     out.inner_steps = dg.bubble_steps;
     out.wall_s = wall_s;
     m.wall_s = wall_s;
@@ -412,6 +413,8 @@ class DbmBedModel : public BedModel {
         {"grid", {{"cells_x", o.nx}, {"cells_y", o.nz}, {"cells_z", o.ny}}},
         {"dt_s", o.dt_s},
         {"stable_dt_s", o.StableTimeStep()},
+        {"cfl", o.cfl},
+        {"min_dt_s", dg.min_dt_s},
         {"headline", head},
         {"holdup",
          {{"mean", holdup_mean},

@@ -171,6 +171,8 @@ bool DbmOptions::IsValid(std::string* error) const {
   if (!(film_drainage_s >= 0.0 && film_drainage_s <= 10.0))
     return fail(error, "film_drainage_s must be in [0, 10] s, got " + fmt(film_drainage_s));
   if (!(average_from_s >= 0.0)) return fail(error, "average_from_s must be >= 0");
+  if (!(cfl >= 0.0 && cfl <= 0.9))
+    return fail(error, "cfl must be in [0, 0.9] (0: the fixed step dt_s), got " + fmt(cfl));
   if (!(injection_ramp_s >= 0.0 && injection_ramp_s <= 1e4))
     return fail(error, "injection_ramp_s must be in [0, 1e4] s, got " + fmt(injection_ramp_s));
   const double column = std::min(width_m, depth_m);
@@ -221,6 +223,7 @@ struct DbmSimulation::Impl {
   // Cell-centred emulsion quantities the bubbles see, by physical component (x, y, z).
   std::array<Eigen::VectorXd, 3> uc, uc_prev, grad_p, accel, curl, reaction;
   bool have_prev = false;
+  double previous_dt = 0.0;
   std::unique_ptr<MacPressureSolver> solver;
   std::vector<double> forming;  // gas in the bubble forming at each nozzle [m^3]
   double nozzle_flow = 0.0;     // per nozzle [m^3/s]
@@ -391,11 +394,19 @@ Eigen::Vector3d DbmSimulation::EmulsionVelocityAt(const Vec& x) const {
 
 void DbmSimulation::AdvanceTo(double t_s) {
   while (time_ < t_s - 1e-9 * opt_.dt_s) Step();
+  // (With cfl > 0 the last step may end past t_s by less than one step.)
 }
 
 void DbmSimulation::Step() {
   Impl& m = *impl_;
-  const double dt = opt_.dt_s;
+  // The step: dt_s, or less where the emulsion would move more than `cfl` cells per step.
+  double dt = opt_.dt_s;
+  if (opt_.cfl > 0.0) {
+    double rate = 0.0;  // max over faces of |u| / h
+    for (int a = 0; a < 3; ++a) rate = std::max(rate, m.vel[a].cwiseAbs().maxCoeff() / m.h[a]);
+    if (rate > 0.0) dt = std::min(dt, opt_.cfl / rate);
+  }
+  diag_.min_dt_s = diag_.steps == 0 ? dt : std::min(diag_.min_dt_s, dt);
   const double t1 = time_ + dt;
   const double rho_e = opt_.emulsion_density_kg_m3;
   const double g = opt_.gravity_m_s2;
@@ -445,7 +456,8 @@ void DbmSimulation::Step() {
         };
         const Vec u(m.uc[0](cell), m.uc[1](cell), m.uc[2](cell));
         for (int c = 0; c < 3; ++c) {
-          const double dudt = m.have_prev ? (m.uc[c](cell) - m.uc_prev[c](cell)) / dt : 0.0;
+          const double dudt =
+              m.have_prev ? (m.uc[c](cell) - m.uc_prev[c](cell)) / m.previous_dt : 0.0;
           m.accel[c](cell) =
               dudt + u(0) * d_dx(m.uc[c]) + u(1) * d_dy(m.uc[c]) + u(2) * d_dz(m.uc[c]);
         }
@@ -459,6 +471,7 @@ void DbmSimulation::Step() {
   }
   for (int c = 0; c < 3; ++c) m.uc_prev[c] = m.uc[c];
   m.have_prev = true;
+  m.previous_dt = dt;
 
   // 2. Injection: the forming bubbles grow by the nozzle flow; a full one is released, leaving
   // the nozzle at its rise velocity. The emulsion sees them grow (no impulsive displacement).
@@ -879,8 +892,8 @@ void DbmSimulation::Step() {
     throw std::runtime_error(
         "dbm: at t = " + fmt(time_) + " s the emulsion moves " + fmt(cfl) +
         " cells per step (above 1, the limit of its explicit advection): the run is diverging; "
-        "remedy: lower dt_s below " +
-        fmt(dt / std::max(cfl, 1e-300)) + " s or coarsen nothing and check the bubble flow");
+        "remedy: [dbm] cfl (an adaptive step) or dt_s below " +
+        fmt(dt / std::max(cfl, 1e-300)) + " s");
   }
 
   // 9. Time averages and the bubble samples.

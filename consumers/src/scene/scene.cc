@@ -300,6 +300,7 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                  }},
                 num("dt_s", [](S& s) -> double& { return s.dbm.dt_s; }),
                 num("injection_ramp_s", [](S& s) -> double& { return s.dbm.injection_ramp_s; }),
+                num("cfl", [](S& s) -> double& { return s.dbm.cfl; }),
                 {"walls", [](S& s, const toml::node& n, const std::string& f,
                              const std::string& at) { s.dbm.walls = as_text(n, f, at); }},
                 num("average_from_s", [](S& s) -> double& { return s.dbm.average_from_s; }),
@@ -402,6 +403,7 @@ bool dbm_is_valid(const Scene& s, std::string* error) {
       !in_range(d.dt_s, 0.0, 1.0, true, false, "[dbm] dt_s", "s (and the stability limit)",
                 error) ||
       !in_range(s.time.duration_s, 0.0, 1e5, true, false, "[time] duration_s", "s", error) ||
+      !in_range(d.cfl, 0.0, 0.9, false, false, "[dbm] cfl", "(0: the fixed step dt_s)", error) ||
       !in_range(d.injection_ramp_s, 0.0, s.time.duration_s, false, true, "[dbm] injection_ramp_s",
                 "s [0, duration_s)", error) ||
       !in_range(d.average_from_s, 0.0, s.time.duration_s, false, true, "[dbm] average_from_s",

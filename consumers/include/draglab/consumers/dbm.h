@@ -24,11 +24,11 @@
 // collide (overlaps pushed apart, the approach velocity removed, volume-weighted) unless
 // collisions are switched off. Pair search with cell lists, O(N).
 //
-// Time step: fixed; the bubble step is implicit in the drag, the emulsion explicit in advection
-// and viscosity, so dt is bounded by the emulsion's viscous and convective limits and, for the
-// explicitly mapped reaction, by the bubbles' momentum relaxation time (DbmOptions::StableTimeStep
-// and CheckTimeStep). A run whose emulsion velocity exceeds the convective limit stops with a
-// diagnosis (std::runtime_error).
+// Time step: dt_s, optionally cut by an emulsion CFL number; the bubble step is implicit in the
+// drag, the emulsion explicit in advection and viscosity, so dt is bounded by the emulsion's
+// viscous and convective limits and, for the explicitly mapped reaction, by the bubbles' momentum
+// relaxation time (DbmOptions::StableTimeStep and CheckTimeStep). A run whose emulsion velocity
+// exceeds the convective limit stops with a diagnosis (std::runtime_error).
 //
 // Units SI. Limits: spherical bubbles of one diameter each; collisions resolved by position
 // (a few sweeps per step), not by impulse timing; no wake, cloud or wall effect on the
@@ -95,7 +95,10 @@ struct DbmOptions {
   /// change); false: they feel the last step's pressure only (unstable where they crowd).
   bool implicit_bubble_pressure = true;
 
-  double dt_s = 2e-3;  ///< Fixed step, > 0, at most StableTimeStep().
+  double dt_s = 2e-3;  ///< The step, > 0, at most StableTimeStep().
+  /// > 0: the step is cut below dt_s so the emulsion moves at most this many cells per step,
+  /// (0, 0.9]; 0: dt_s always.
+  double cfl = 0.0;
   PoissonSolver solver = PoissonSolver::kConjugateGradient;
   double cg_tolerance = 1e-9;
   /// Time averages (emulsion velocity, hold-up, bubble sizes) start here [s].
@@ -135,6 +138,7 @@ struct DbmDiagnostics {
   double gas_injected_m3 = 0.0;          ///< Bubble volume injected.
   double gas_left_m3 = 0.0;              ///< Bubble volume that left at the surface.
   double max_cfl = 0.0;                  ///< max |u| dt / h of the emulsion over steps.
+  double min_dt_s = 0.0;                 ///< The smallest step taken.
   double max_bubble_fraction = 0.0;      ///< Largest cell bubble fraction before the clamp.
   std::int64_t fraction_clamps = 0;      ///< Cell-steps with eps_e clamped at its minimum.
   double max_continuity_residual = 0.0;  ///< Relative residual of the pressure solve, max.

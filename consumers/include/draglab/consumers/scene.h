@@ -164,6 +164,7 @@ struct SceneDbm {
   double film_drainage_s = 0.0;    ///< [0, 10].
   bool collisions = true;          ///< Without coalescence: overlapping bubbles pushed apart.
   double dt_s = 2e-3;              ///< Fixed step, (0, the stability limit].
+  double cfl = 0.0;                ///< > 0: the step is cut to this emulsion CFL, (0, 0.9].
   double injection_ramp_s = 0.0;   ///< Start-up ramp of the bubble flow, [0, duration_s).
   std::string walls = "no_slip";   ///< Or "free_slip": the emulsion at the side walls.
   double average_from_s = 10.0;    ///< Time averages from here, [0, duration_s).
