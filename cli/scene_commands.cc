@@ -232,12 +232,19 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
     return;
   }
   std::cout << r.brief << "\n";
-  std::cout << fmt::format("{:>9} {:>10} {:>11} {:>10} {:>10}\n", "t-jet s", "D m", "centroid m",
-                           "bed m", "dp Pa");
-  for (const auto& smp : r.series) {
-    std::cout << fmt::format("{:>9.3f} {:>10.4f} {:>11.4f} {:>10.4f} {:>10.1f}\n", smp.t_s,
-                             smp.bubble_diameter_m, smp.bubble_centroid_m, smp.bed_height_m,
-                             smp.pressure_drop_pa);
+  if (!r.headline.empty()) {
+    // A model with headline numbers (the DBM) has no jet bubble to follow: its series is in the
+    // JSON result; the headline numbers are what its studies compare.
+    for (const auto& [name, value] : r.headline)
+      std::cout << fmt::format("  {:<28} {}\n", name, format_number(value, 4));
+  } else {
+    std::cout << fmt::format("{:>9} {:>10} {:>11} {:>10} {:>10}\n", "t-jet s", "D m", "centroid m",
+                             "bed m", "dp Pa");
+    for (const auto& smp : r.series) {
+      std::cout << fmt::format("{:>9.3f} {:>10.4f} {:>11.4f} {:>10.4f} {:>10.1f}\n", smp.t_s,
+                               smp.bubble_diameter_m, smp.bubble_centroid_m, smp.bed_height_m,
+                               smp.pressure_drop_pa);
+    }
   }
   std::cout << "  numerical uncertainty: not estimated (one grid, one packing; see draglab "
                "sensitivity)\n";
