@@ -217,21 +217,28 @@ TEST(DbmValidation, CollidingBubblesAreSeparatedAndKeepTheirMomentum) {
   EXPECT_EQ(dbm.diagnostics().collision_sweeps, 1);
 }
 
+/// 4 cm bubbles from 2 x 2 nozzles at 0.263 m/s excess in a 0.4 x 1.0 x 0.4 m column of 10 cm
+/// cells, 5 ms steps: bubbles crowd over the nozzles.
+DbmOptions CrowdedColumn() {
+  DbmOptions o;
+  o.width_m = o.depth_m = 0.4;
+  o.height_m = 1.0;
+  o.nx = o.ny = 4;
+  o.nz = 10;
+  o.bubble_diameter_m = 0.04;
+  o.nozzles = square_nozzle_array(2, 0.1, o.width_m, o.depth_m);
+  o.bubble_gas_flow_m3_s = 0.263 * o.width_m * o.depth_m;
+  o.dt_s = 5e-3;
+  return o;
+}
+
 TEST(DbmValidation, CrowdedBubblesNeedTheirPressureResponseInThePressureEquation) {
   // 4 cm bubbles from 2 x 2 nozzles at 0.26 m/s excess in a 0.4 x 1.0 x 0.4 m column crowd to
   // eps_b ~ 0.6 over the nozzles. Feeling only the last step's pressure, their response to it
   // feeds the next pressure through the storage term with a gain that grows with eps_b and not
   // with 1/dt: the run diverges. With their mobility in the pressure equation it stays bounded.
   auto crowded = [](bool implicit) {
-    DbmOptions o;
-    o.width_m = o.depth_m = 0.4;
-    o.height_m = 1.0;
-    o.nx = o.ny = 4;
-    o.nz = 10;
-    o.bubble_diameter_m = 0.04;
-    o.nozzles = square_nozzle_array(2, 0.1, o.width_m, o.depth_m);
-    o.bubble_gas_flow_m3_s = 0.263 * o.width_m * o.depth_m;
-    o.dt_s = 5e-3;
+    DbmOptions o = CrowdedColumn();
     o.implicit_bubble_pressure = implicit;
     return o;
   };
@@ -248,14 +255,7 @@ TEST(DbmValidation, AnAdaptiveStepHoldsTheEmulsionCfl) {
   // limit of 4 cm bubbles) cut to an emulsion CFL of 0.1: the steps shrink where the plume is
   // fast, and the emulsion moves about 0.1 cells per step (measured after the step, so a little
   // above).
-  DbmOptions o;
-  o.width_m = o.depth_m = 0.4;
-  o.height_m = 1.0;
-  o.nx = o.ny = 4;
-  o.nz = 10;
-  o.bubble_diameter_m = 0.04;
-  o.nozzles = square_nozzle_array(2, 0.1, o.width_m, o.depth_m);
-  o.bubble_gas_flow_m3_s = 0.263 * o.width_m * o.depth_m;
+  DbmOptions o = CrowdedColumn();
   o.dt_s = 0.02;
   o.cfl = 0.1;
   DbmSimulation dbm(o);
