@@ -170,6 +170,56 @@ TEST(DbmValidation, CoalescenceConservesVolumeAndMomentum) {
     EXPECT_NEAR(m.volume_m3 * m.v(c), a.volume_m3 * a.v(c) + b.volume_m3 * b.v(c), 1e-20);
     EXPECT_NEAR(m.volume_m3 * m.x(c), a.volume_m3 * a.x(c) + b.volume_m3 * b.x(c), 1e-20);
   }
+  // The emulsion still sees the gas where it was: lobes at the parents' centres.
+  EXPECT_LT((m.x + m.lobe_offset - a.x).norm(), 1e-15);
+  const double rest = m.volume_m3 - m.lobe_volume_m3;
+  EXPECT_LT((m.x - m.lobe_volume_m3 / rest * m.lobe_offset - b.x).norm(), 1e-15);
+  // A small bubble c merging with m before its lobes meet joins b's lobe (the nearer), and a's
+  // lobe stays: the gas that moves is c's alone, and the lobes' centroid is the new centre.
+  DbmBubble c;
+  c.x = {0.125, 0.195, 0.335};
+  c.volume_m3 = 1e-6;
+  c.diameter_m = std::cbrt(6.0 * c.volume_m3 / M_PI);
+  const DbmBubble n = merge_bubbles(m, c);
+  EXPECT_LT((n.x + n.lobe_offset - a.x).norm(), 1e-15);
+  EXPECT_NEAR(n.lobe_volume_m3, a.volume_m3, 1e-20);
+  const Eigen::Vector3d bc = (b.volume_m3 * b.x + c.volume_m3 * c.x) / (b.volume_m3 + c.volume_m3);
+  const double n_rest = n.volume_m3 - n.lobe_volume_m3;
+  EXPECT_LT((n.x - n.lobe_volume_m3 / n_rest * n.lobe_offset - bc).norm(), 1e-15);
+}
+
+TEST(DbmValidation, AMergerDisplacesTheEmulsionNoFasterThanARisingBubble) {
+  // Two 0.15 m bubbles side by side, overlapping by 2 cm, in a 0.6 x 1.0 x 0.6 m column of 5 cm
+  // cells, merge after a film-drainage time of 0.02 s (10 steps). Placed at once at their
+  // volume-weighted centre, the merged bubble would move 0.075 m of gas per bubble within one step,
+  // a displacement no step resolves. The mapped bubble fraction must instead change per step by no
+  // more than a single bubble of the merged volume changes it by rising: the reference run below,
+  // at the same place. Measure: the volume of fraction moved per step, sum |d eps_b| V_cell.
+  DbmOptions o = Column(12);
+  o.coalescence = true;
+  o.film_drainage_s = 0.02;
+  auto moved_per_step = [&](bool merging) {
+    DbmSimulation dbm(o);
+    const double d = 0.15, merged = std::cbrt(2.0) * d;
+    if (merging) {
+      dbm.AddBubble({0.3 - 0.5 * d + 0.01, 0.3, 0.35}, {0.0, 0.0, 0.0}, d);
+      dbm.AddBubble({0.3 + 0.5 * d - 0.01, 0.3, 0.35}, {0.0, 0.0, 0.0}, d);
+    } else {
+      dbm.AddBubble({0.3, 0.3, 0.35}, {0.0, 0.0, 0.0}, merged);
+    }
+    double most = 0.0;
+    Eigen::VectorXd before = Eigen::VectorXd::Zero(dbm.bubble_fraction().size());
+    for (int step = 0; step < 50; ++step) {
+      dbm.Step();
+      if (step > 0) most = std::max(most, (dbm.bubble_fraction() - before).cwiseAbs().sum());
+      before = dbm.bubble_fraction();
+    }
+    if (merging) EXPECT_EQ(dbm.bubbles().size(), 1u) << "they merged";
+    return most * std::pow(0.05, 3);
+  };
+  const double single = moved_per_step(false), merger = moved_per_step(true);
+  EXPECT_GT(single, 0.0);
+  EXPECT_LT(merger, 2.0 * single) << "merger " << merger << " m^3, single " << single << " m^3";
 }
 
 TEST(DbmValidation, GasVolumeBalancesWithAndWithoutCoalescence) {
@@ -236,7 +286,10 @@ TEST(DbmValidation, CrowdedBubblesNeedTheirPressureResponseInThePressureEquation
   // 4 cm bubbles from 2 x 2 nozzles at 0.26 m/s excess in a 0.4 x 1.0 x 0.4 m column crowd to
   // eps_b ~ 0.6 over the nozzles. Feeling only the last step's pressure, their response to it
   // feeds the next pressure through the storage term with a gain that grows with eps_b and not
-  // with 1/dt: the run diverges. With their mobility in the pressure equation it stays bounded.
+  // with 1/dt: the pressure and the emulsion oscillate from step to step, up to the convective
+  // limit (with the tent kernel the run diverged; the smooth kernel's lower peaks hold it just
+  // below). With their mobility in the pressure equation the emulsion moves an order of
+  // magnitude less per step.
   auto crowded = [](bool implicit) {
     DbmOptions o = CrowdedColumn();
     o.implicit_bubble_pressure = implicit;
@@ -245,9 +298,14 @@ TEST(DbmValidation, CrowdedBubblesNeedTheirPressureResponseInThePressureEquation
   DbmSimulation stable(crowded(true));
   stable.AdvanceTo(6.0);
   EXPECT_GT(stable.diagnostics().max_bubble_fraction, 0.4);
-  EXPECT_LT(stable.diagnostics().max_cfl, 0.5);
+  EXPECT_LT(stable.diagnostics().max_cfl, 0.2);
   DbmSimulation lagged(crowded(false));
-  EXPECT_THROW(lagged.AdvanceTo(6.0), std::runtime_error);
+  try {
+    lagged.AdvanceTo(6.0);
+    EXPECT_GT(lagged.diagnostics().max_cfl, 4.0 * stable.diagnostics().max_cfl);
+  } catch (const std::runtime_error&) {
+    SUCCEED() << "the lagged run diverged";
+  }
 }
 
 TEST(DbmValidation, AnAdaptiveStepHoldsTheEmulsionCfl) {
@@ -337,6 +395,9 @@ TEST_F(DbmSceneTest, BadInputNamesTheFieldOrLimit) {
   fails(with(tiny(), "dt_s = 5e-3", "dt_s = 0.05"), "stability limit");
   // Overlapping nozzles.
   fails(with(tiny(), "nozzle_pitch_m = 0.1", "nozzle_pitch_m = 0.01"), "overlap");
+  // A coupling kernel wider than the column.
+  fails(with(tiny(), "nozzle_pitch_m = 0.1", "nozzle_pitch_m = 0.1\ncoupling_width_m = 5.0"),
+        "coupling_width_m");
   // The jet models' tables and the particle inventory.
   fails(tiny() + "\n[jet]\nslot_width_m = 0.01\n", "[jet]");
   fails(with(tiny(), "density_kg_m3 = 700.0", "density_kg_m3 = 700.0\ncount = 100"), "[particles]");

@@ -68,6 +68,7 @@ DbmOptions SceneDbmOptions(const Scene& s, double umf_m_s, std::uint64_t seed) {
           : (per_nozzle > 0.0 ? davidson_harrison_bubble_diameter(per_nozzle, s.gas.gravity_m_s2)
                               : 0.0);
   o.seed = seed;
+  o.coupling_width_m = d.coupling_width_m;
   o.coalescence = d.coalescence;
   o.film_drainage_s = d.film_drainage_s;
   o.collisions = d.collisions;
@@ -115,6 +116,9 @@ class DbmBedModel : public BedModel {
              " from " + std::to_string(d.nozzles_per_side * d.nozzles_per_side) +
              " nozzles (pitch " + Num(d.nozzle_pitch_m) + " m); coalescence " +
              (d.coalescence ? "on (film drainage " + Num(d.film_drainage_s) + " s)" : "off") +
+             "; coupling width " +
+             (d.coupling_width_m > 0.0 ? Num(d.coupling_width_m) + " m"
+                                       : std::string("5 bubble diameters")) +
              "; " + std::to_string(scene.grid.cells_x) + " x " +
              std::to_string(scene.grid.cells_z) + " x " + std::to_string(scene.grid.cells_y) +
              " cells, dt " + Num(d.dt_s) + " s";
@@ -407,6 +411,7 @@ class DbmBedModel : public BedModel {
         {"injected_diameter_from",
          sd.bubble_diameter_m > 0.0 ? "scene" : "davidson_harrison_per_nozzle"},
         {"nozzles", o.nozzles.size()},
+        {"coupling_width_m", o.CouplingWidth()},
         {"coalescence", sd.coalescence},
         {"film_drainage_s", sd.film_drainage_s},
         {"collisions", sd.collisions && !sd.coalescence},

@@ -8,6 +8,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -127,6 +128,27 @@ std::vector<DbmNozzle> square_nozzle_array(int nozzles_per_side, double pitch_m,
   return out;
 }
 
+namespace {
+
+/// Where a bubble's gas is mapped: its lobes (two while a merger relaxes), or its centre.
+struct Blob {
+  Vec x;
+  double volume;
+};
+
+void AppendBlobs(const DbmBubble& b, std::vector<Blob>* blobs) {
+  if (b.lobe_remaining > 0.0 && b.lobe_volume_m3 > 0.0 && b.lobe_volume_m3 < b.volume_m3) {
+    const Vec offset = b.lobe_remaining * b.lobe_offset;
+    const double rest = b.volume_m3 - b.lobe_volume_m3;
+    blobs->push_back({b.x + offset, b.lobe_volume_m3});
+    blobs->push_back({b.x - (b.lobe_volume_m3 / rest) * offset, rest});
+  } else {
+    blobs->push_back({b.x, b.volume_m3});
+  }
+}
+
+}  // namespace
+
 DbmBubble merge_bubbles(const DbmBubble& a, const DbmBubble& b) {
   DbmBubble m = a;
   const double v = a.volume_m3 + b.volume_m3;
@@ -134,6 +156,34 @@ DbmBubble merge_bubbles(const DbmBubble& a, const DbmBubble& b) {
   m.v = (a.volume_m3 * a.v + b.volume_m3 * b.v) / v;
   m.volume_m3 = v;
   m.diameter_m = SphereDiameter(v);
+  // The merged gas stays where it was mapped: the parents' blobs (a parent still relaxing from a
+  // merger has two), reduced to two lobes by joining, each time, the pair whose joining moves
+  // the least gas (the smallest V_i V_j / (V_i + V_j) |x_i - x_j|^2). Joining keeps the centroid.
+  std::vector<Blob> blobs;
+  AppendBlobs(a, &blobs);
+  AppendBlobs(b, &blobs);
+  while (blobs.size() > 2) {
+    std::size_t bi = 0, bj = 1;
+    double least = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < blobs.size(); ++i)
+      for (std::size_t j = i + 1; j < blobs.size(); ++j) {
+        const double cost = blobs[i].volume * blobs[j].volume /
+                            (blobs[i].volume + blobs[j].volume) *
+                            (blobs[i].x - blobs[j].x).squaredNorm();
+        if (cost < least) {
+          least = cost;
+          bi = i;
+          bj = j;
+        }
+      }
+    const double joined = blobs[bi].volume + blobs[bj].volume;
+    blobs[bi].x = (blobs[bi].volume * blobs[bi].x + blobs[bj].volume * blobs[bj].x) / joined;
+    blobs[bi].volume = joined;
+    blobs.erase(blobs.begin() + static_cast<long>(bj));
+  }
+  m.lobe_volume_m3 = blobs[0].volume;
+  m.lobe_offset = blobs[0].x - m.x;
+  m.lobe_remaining = 1.0;
   return m;
 }
 
@@ -176,6 +226,11 @@ bool DbmOptions::IsValid(std::string* error) const {
   if (!(injection_ramp_s >= 0.0 && injection_ramp_s <= 1e4))
     return fail(error, "injection_ramp_s must be in [0, 1e4] s, got " + fmt(injection_ramp_s));
   const double column = std::min(width_m, depth_m);
+  if (!(coupling_width_m >= 0.0 && coupling_width_m <= column))
+    return fail(error, "coupling_width_m must be in [0, " + fmt(column) +
+                           "] m (0: " + fmt(kCouplingWidthInDiameters) +
+                           " bubble diameters; at most the column's width and depth), got " +
+                           fmt(coupling_width_m));
   if (!(bubble_diameter_m < column))
     return fail(error, "bubble_diameter_m = " + fmt(bubble_diameter_m) +
                            " m is not smaller than the column (" + fmt(column) +
@@ -199,6 +254,10 @@ bool DbmOptions::IsValid(std::string* error) const {
     }
   }
   return true;
+}
+
+double DbmOptions::CouplingWidth() const {
+  return coupling_width_m > 0.0 ? coupling_width_m : kCouplingWidthInDiameters * bubble_diameter_m;
 }
 
 double DbmOptions::StableTimeStep() const {
@@ -232,35 +291,20 @@ struct DbmSimulation::Impl {
   double next_sample = 0.0;
   double top_outflow = 0.0;
   int size_bins = kSizeBins;
+  double kernel_radius = 0.0;  // half the coupling width [m]
 
   static int AxisOf(int component) { return component == 0 ? 0 : (component == 1 ? 2 : 1); }
   int Cell(int i, int j, int k) const { return i + n[0] * (j + n[1] * k); }
   internal::Tent3 TentOf(const Vec& x) const {
     return internal::TentAt3(x(0), x(1), x(2), h[0], h[2], h[1], n[0], n[2], n[1]);
   }
-  /// The points a bubble is mapped through: its centre, or, for a bubble wider than the smallest
-  /// cell, a lattice of points filling its sphere (each carrying an equal share), so a large
-  /// bubble displaces and pushes the emulsion over its own volume, not one cell's.
-  std::vector<Vec> Spread(const Vec& x, double d, const std::array<double, 3>& lo,
-                          const std::array<double, 3>& hi) const {
-    const double h_min = std::min({h[0], h[1], h[2]});
-    if (d <= h_min) return {x};
-    const int per_axis = std::min(9, static_cast<int>(std::ceil(d / h_min)) + 1);
-    const double r = 0.5 * d;
-    std::vector<Vec> points;
-    for (int a = 0; a < per_axis; ++a)
-      for (int b = 0; b < per_axis; ++b)
-        for (int c = 0; c < per_axis; ++c) {
-          const Vec offset =
-              r * Vec(-1.0 + (2.0 * a + 1.0) / per_axis, -1.0 + (2.0 * b + 1.0) / per_axis,
-                      -1.0 + (2.0 * c + 1.0) / per_axis);
-          if (offset.norm() > r) continue;
-          Vec p = x + offset;
-          for (int k = 0; k < 3; ++k) p(k) = std::clamp(p(k), lo[k], hi[k]);
-          points.push_back(p);
-        }
-    if (points.empty()) points.push_back(x);
-    return points;
+  /// The cells a bubble of diameter d at x is mapped to: the smooth kernel of the coupling
+  /// width, or, for a bubble wider than half of it, of twice the bubble's own diameter, so a
+  /// large bubble displaces and pushes the emulsion over its own volume and alone never fills
+  /// a cell past about half (pi / 6 at the kernel's centre).
+  internal::Smooth3 StencilOf(const Vec& x, double d) const {
+    return internal::SmoothAt3(x(0), x(1), x(2), std::max(kernel_radius, d), h[0], h[2], h[1], n[0],
+                               n[2], n[1]);
   }
 };
 
@@ -284,6 +328,7 @@ DbmSimulation::DbmSimulation(const DbmOptions& options)
   m.h = {opt_.width_m / opt_.nx, opt_.height_m / opt_.nz, opt_.depth_m / opt_.ny};
   m.cells = opt_.nx * opt_.ny * opt_.nz;
   m.cell_volume = m.h[0] * m.h[1] * m.h[2];
+  m.kernel_radius = 0.5 * opt_.CouplingWidth();
   for (int a = 0; a < 3; ++a) {
     std::array<int, 3> f = m.n;
     ++f[a];
@@ -413,6 +458,42 @@ void DbmSimulation::Step() {
   const int nx = m.n[0], nz = m.n[1], ny = m.n[2];
   const auto bubbles_start = std::chrono::steady_clock::now();
 
+  // The bubble and emulsion fractions from the bubbles' mapped volumes (fraction clamps and the
+  // largest bubble fraction counted when `count`).
+  std::vector<Blob> blobs;
+  auto deposit_fractions = [&](bool count) {
+    m.eps_b.setZero();
+    for (const DbmBubble& b : bubbles_) {
+      // A bubble breaking through the surface displaces less emulsion as it leaves.
+      const double r = 0.5 * b.diameter_m;
+      const double inside = std::clamp((opt_.height_m - b.x(2)) / r, 0.0, 1.0);
+      blobs.clear();
+      AppendBlobs(b, &blobs);
+      for (const Blob& blob : blobs)
+        internal::Deposit3(m.eps_b, m.StencilOf(blob.x, SphereDiameter(blob.volume)),
+                           inside * blob.volume / m.cell_volume, nx, nz);
+    }
+    for (std::size_t k = 0; k < m.forming.size(); ++k) {
+      const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
+      internal::Deposit3(m.eps_b, m.StencilOf(at, opt_.bubble_diameter_m),
+                         m.forming[k] / m.cell_volume, nx, nz);
+    }
+    for (int c = 0; c < m.cells; ++c) {
+      if (count) diag_.max_bubble_fraction = std::max(diag_.max_bubble_fraction, m.eps_b(c));
+      double e = 1.0 - m.eps_b(c);
+      if (e < kMinEmulsionFraction) {
+        e = kMinEmulsionFraction;
+        if (count) diag_.fraction_clamps += 1;
+      }
+      m.eps_e_new(c) = e;
+    }
+  };
+  // Bubbles placed before the first step are the initial state, not a sudden displacement.
+  if (diag_.steps == 0) {
+    deposit_fractions(false);
+    m.eps_e = m.eps_e_new;
+  }
+
   // 1. What the bubbles see: cell-centred emulsion velocity, pressure gradient (less the
   // hydrostatic head), material acceleration and (for lift) vorticity, by physical component.
   for (int c = 0; c < 3; ++c) m.uc[c] = emulsion_velocity(c);
@@ -514,22 +595,17 @@ void DbmSimulation::Step() {
   const Vec gravity(0.0, 0.0, -g);
   const double rho_b = opt_.bubble_density_kg_m3;
   const double c_vm = opt_.virtual_mass_coefficient;
-  const std::array<double, 3> domain_lo{0.0, 0.0, 0.0};
   const std::array<double, 3> domain_hi{opt_.width_m, opt_.depth_m, opt_.height_m};
 #pragma omp parallel for schedule(static) if (nb >= kParallelBubbles)
   for (long b = 0; b < nb; ++b) {
     DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
-    const std::vector<Vec> points = m.Spread(bub.x, bub.diameter_m, domain_lo, domain_hi);
-    const double share = 1.0 / static_cast<double>(points.size());
+    const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
     Vec u = Vec::Zero(), gp = Vec::Zero(), acc = Vec::Zero(), w = Vec::Zero();
-    for (const Vec& point : points) {
-      const internal::Tent3 t = m.TentOf(point);
-      for (int c = 0; c < 3; ++c) {
-        u(c) += share * internal::Interpolate3(m.uc[c], t, nx, nz);
-        gp(c) += share * internal::Interpolate3(m.grad_p[c], t, nx, nz);
-        acc(c) += share * internal::Interpolate3(m.accel[c], t, nx, nz);
-        if (opt_.lift) w(c) += share * internal::Interpolate3(m.curl[c], t, nx, nz);
-      }
+    for (int c = 0; c < 3; ++c) {
+      u(c) = internal::Interpolate3(m.uc[c], s, nx, nz);
+      gp(c) = internal::Interpolate3(m.grad_p[c], s, nx, nz);
+      acc(c) = internal::Interpolate3(m.accel[c], s, nx, nz);
+      if (opt_.lift) w(c) = internal::Interpolate3(m.curl[c], s, nx, nz);
     }
     gp(2) -= rho_e * g;  // the hydrostatic head: grad p = grad p' + rho_e g_vec
     Vec gp_and_lift = gp;
@@ -547,21 +623,20 @@ void DbmSimulation::Step() {
         bub.volume_m3 * (rho_b * (v_new - bub.v) / dt - rho_b * gravity + gp - c_vm * rho_e * acc);
     bub.v = v_new;
     bub.x += dt * v_new;
+    if (bub.lobe_remaining > 0.0) {
+      const double rise = davies_taylor_rise_velocity(bub.diameter_m, g);
+      bub.lobe_remaining = std::max(0.0, bub.lobe_remaining - dt * rise / bub.diameter_m);
+    }
     KeepInside(bub);
   }
   diag_.bubble_steps += nb;
   for (auto& f : m.reaction) f.setZero();
   for (long b = 0; b < nb; ++b) {
     const DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
-    const std::vector<Vec> points = m.Spread(bub.x, bub.diameter_m, domain_lo, domain_hi);
-    const double share = 1.0 / static_cast<double>(points.size());
-    for (const Vec& point : points) {
-      const internal::Tent3 t = m.TentOf(point);
-      for (int c = 0; c < 3; ++c)
-        internal::Deposit3(m.reaction[c], t,
-                           -share * reaction[static_cast<std::size_t>(b)](c) / m.cell_volume, nx,
-                           nz);
-    }
+    const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
+    for (int c = 0; c < 3; ++c)
+      internal::Deposit3(m.reaction[c], s,
+                         -reaction[static_cast<std::size_t>(b)](c) / m.cell_volume, nx, nz);
   }
 
   // 4. Bubbles leave at the bed surface.
@@ -645,31 +720,6 @@ void DbmSimulation::Step() {
 
   // 6. The new bubble and emulsion fractions (again after the bubbles' pressure correction).
   const auto emulsion_start = std::chrono::steady_clock::now();
-  auto deposit_fractions = [&](bool count) {
-    m.eps_b.setZero();
-    for (const DbmBubble& b : bubbles_) {
-      // A bubble breaking through the surface displaces less emulsion as it leaves.
-      const double r = 0.5 * b.diameter_m;
-      const double inside = std::clamp((opt_.height_m - b.x(2)) / r, 0.0, 1.0);
-      const std::vector<Vec> points = m.Spread(b.x, b.diameter_m, domain_lo, domain_hi);
-      const double share = inside / static_cast<double>(points.size());
-      for (const Vec& point : points)
-        internal::Deposit3(m.eps_b, m.TentOf(point), share * b.volume_m3 / m.cell_volume, nx, nz);
-    }
-    for (std::size_t k = 0; k < m.forming.size(); ++k) {
-      const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
-      internal::Deposit3(m.eps_b, m.TentOf(at), m.forming[k] / m.cell_volume, nx, nz);
-    }
-    for (int c = 0; c < m.cells; ++c) {
-      if (count) diag_.max_bubble_fraction = std::max(diag_.max_bubble_fraction, m.eps_b(c));
-      double e = 1.0 - m.eps_b(c);
-      if (e < kMinEmulsionFraction) {
-        e = kMinEmulsionFraction;
-        if (count) diag_.fraction_clamps += 1;
-      }
-      m.eps_e_new(c) = e;
-    }
-  };
   deposit_fractions(true);
   // The bubbles' mobility under a pressure-gradient change, per cell: sum of V dt / (m + k dt)
   // (m the inertia density, k the drag linearised at the bubble's slip) over the cell volume.
@@ -679,17 +729,13 @@ void DbmSimulation::Step() {
     const double inertia = force_.inertia_density();
     for (std::size_t b = 0; b < bubbles_.size(); ++b) {
       const DbmBubble& bub = bubbles_[b];
-      const internal::Tent3 t = m.TentOf(bub.x);
+      const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
       Vec u;
-      for (int c = 0; c < 3; ++c) u(c) = internal::Interpolate3(m.uc[c], t, nx, nz);
+      for (int c = 0; c < 3; ++c) u(c) = internal::Interpolate3(m.uc[c], s, nx, nz);
       const double k =
           0.75 * force_.drag_coefficient() * rho_e * (bub.v - u).norm() / bub.diameter_m;
       bubble_mobility[b] = dt / (inertia + k * dt);
-      const std::vector<Vec> points = m.Spread(bub.x, bub.diameter_m, domain_lo, domain_hi);
-      const double share =
-          bub.volume_m3 * bubble_mobility[b] / (static_cast<double>(points.size()) * m.cell_volume);
-      for (const Vec& point : points)
-        internal::Deposit3(m.mobility, m.TentOf(point), share, nx, nz);
+      internal::Deposit3(m.mobility, s, bub.volume_m3 * bubble_mobility[b] / m.cell_volume, nx, nz);
     }
   }
 
@@ -819,6 +865,7 @@ void DbmSimulation::Step() {
       std::max(diag_.max_continuity_residual, m.solver->diagnostics().relative_residual);
   diag_.max_cg_iterations = std::max(diag_.max_cg_iterations, m.solver->diagnostics().iterations);
   double cfl = 0.0;
+  int fastest_cell = 0;  // for the diagnosis
   for (int a = 0; a < 3; ++a) {
     std::array<int, 3> f = m.n;
     ++f[a];
@@ -835,7 +882,11 @@ void DbmSimulation::Step() {
           const double hh = p[a] < m.n[a] ? m.h[a] : 0.5 * m.h[a];
           const double grad = (p_up - m.pressure(cell_below(a, p))) / hh;
           m.vel[a](fi) = m.vel_star[a](fi) - coeff[a](fi) / eps_face[a](fi) * grad;
-          cfl = std::max(cfl, std::abs(m.vel[a](fi)) * dt / m.h[a]);
+          const double face_cfl = std::abs(m.vel[a](fi)) * dt / m.h[a];
+          if (face_cfl > cfl) {
+            cfl = face_cfl;
+            fastest_cell = cell_below(a, p);
+          }
         }
       }
     }
@@ -873,9 +924,9 @@ void DbmSimulation::Step() {
                                               kParallelBubbles)
     for (long b = 0; b < static_cast<long>(bubbles_.size()); ++b) {
       DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
-      const internal::Tent3 t = m.TentOf(bub.x);
+      const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
       Vec g;
-      for (int c = 0; c < 3; ++c) g(c) = internal::Interpolate3(grad_dp[c], t, nx, nz);
+      for (int c = 0; c < 3; ++c) g(c) = internal::Interpolate3(grad_dp[c], s, nx, nz);
       const Vec dv = -bubble_mobility[static_cast<std::size_t>(b)] * g;
       bub.v += dv;
       bub.x += dt * dv;
@@ -889,11 +940,24 @@ void DbmSimulation::Step() {
   time_ = t1;
   diag_.steps += 1;
   if (!(cfl <= 1.0)) {
-    throw std::runtime_error(
-        "dbm: at t = " + fmt(time_) + " s the emulsion moves " + fmt(cfl) +
-        " cells per step (above 1, the limit of its explicit advection): the run is diverging; "
-        "remedy: [dbm] cfl (an adaptive step) or dt_s below " +
-        fmt(dt / std::max(cfl, 1e-300)) + " s");
+    const int i = fastest_cell % nx, j = (fastest_cell / nx) % nz, k = fastest_cell / (nx * nz);
+    auto Where = [&](int) {
+      return fmt((i + 0.5) * m.h[0]) + ", " + fmt((k + 0.5) * m.h[2]) + ", " +
+             fmt((j + 0.5) * m.h[1]);
+    };
+    auto LargestBubble = [&] {
+      double d = 0.0;
+      for (const DbmBubble& b : bubbles_) d = std::max(d, b.diameter_m);
+      return d;
+    };
+    throw std::runtime_error("dbm: at t = " + fmt(time_) + " s the emulsion moves " + fmt(cfl) +
+                             " cells per step (above 1, the limit of its explicit advection) at (" +
+                             Where(fastest_cell) + ") m, bubble fraction " +
+                             fmt(m.eps_b(fastest_cell)) + ", largest bubble " +
+                             fmt(LargestBubble()) +
+                             " m: the run is diverging; "
+                             "remedy: [dbm] cfl (an adaptive step) or dt_s below " +
+                             fmt(dt / std::max(cfl, 1e-300)) + " s");
   }
 
   // 9. Time averages and the bubble samples.

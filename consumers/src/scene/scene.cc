@@ -289,6 +289,7 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                 {"lift", [](S& s, const toml::node& n, const std::string& f,
                             const std::string& at) { s.dbm.lift = as_bool(n, f, at); }},
                 num("lift_coefficient", [](S& s) -> double& { return s.dbm.lift_coefficient; }),
+                num("coupling_width_m", [](S& s) -> double& { return s.dbm.coupling_width_m; }),
                 {"coalescence",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.dbm.coalescence = as_bool(n, f, at);
@@ -400,6 +401,8 @@ bool dbm_is_valid(const Scene& s, std::string* error) {
                 "[dbm] virtual_mass_coefficient", "", error) ||
       !in_range(d.lift_coefficient, -1.0, 1.0, false, false, "[dbm] lift_coefficient", "", error) ||
       !in_range(d.film_drainage_s, 0.0, 10.0, false, false, "[dbm] film_drainage_s", "s", error) ||
+      !in_range(d.coupling_width_m, 0.0, column, false, false, "[dbm] coupling_width_m",
+                "m (0: 5 bubble diameters; at most the column's width and depth)", error) ||
       !in_range(d.dt_s, 0.0, 1.0, true, false, "[dbm] dt_s", "s (and the stability limit)",
                 error) ||
       !in_range(s.time.duration_s, 0.0, 1e5, true, false, "[time] duration_s", "s", error) ||

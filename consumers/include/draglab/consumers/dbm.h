@@ -6,11 +6,14 @@
 // 3-D staggered grid (x across the width, y across the depth, z up; mac_pressure.h layout):
 //   d(eps_e)/dt + div(eps_e u) = 0,
 //   eps_e rho_e (du/dt + u.grad u) = -eps_e grad p + div(eps_e mu_e grad u) + eps_e rho_e g + R,
-// R the reaction of the bubbles' drag, virtual-mass and lift forces, mapped to the cells with the
-// family's tent kernel (particle_kernel.h). Projection with the shared pressure equation, on the
-// pressure less the emulsion's hydrostatic head. Walls: side walls no-slip (or free-slip) and a
-// closed bottom; the top of the column is the bed surface, a pressure outlet through which the
-// emulsion the bubbles displace leaves (and returns as they leave).
+// R the reaction of the bubbles' drag, virtual-mass and lift forces. Bubbles and cells exchange
+// fraction, force and the fields the bubbles see through a smooth kernel of a fixed physical
+// width, the coupling width (particle_kernel.h Smooth3), so the coupled fields converge as the
+// grid is refined under it; a bubble wider than half of it is spread over twice its diameter.
+// Projection with the shared pressure equation, on the pressure less the emulsion's hydrostatic
+// head. Walls: side walls no-slip (or free-slip) and a closed bottom; the top of the column is the
+// bed surface, a pressure outlet through which the emulsion the bubbles displace leaves (and
+// returns as they leave).
 //
 // Bubbles: spheres of volume-equivalent diameter d_b and density rho_b, moved by Newton's second
 // law with gravity, the emulsion pressure gradient, drag calibrated to the Davies-Taylor rise
@@ -60,6 +63,11 @@ struct DbmNozzle {
 std::vector<DbmNozzle> square_nozzle_array(int nozzles_per_side, double pitch_m, double width_m,
                                            double depth_m);
 
+/// The default coupling width in injected bubble diameters: Euler-Lagrange bubble-column models
+/// map bubbles over a few diameters; five puts two cells in the kernel's half-width on the
+/// reactor's default grid and keeps one bubble's fraction small.
+constexpr double kCouplingWidthInDiameters = 5.0;
+
 /// Everything a DBM run needs. Checked by IsValid (each message names the field and range).
 struct DbmOptions {
   double width_m = 1.0;           ///< x, > 0.
@@ -85,6 +93,11 @@ struct DbmOptions {
   /// emulsion's circulation can form before the full flow crowds the nozzles.
   double injection_ramp_s = 0.0;
 
+  /// Width [m] of the kernel that maps each bubble to the cells (and the cells to it), fixed so
+  /// the results converge as the grid is refined under it; at least a cell is used on each
+  /// axis. 0: kCouplingWidthInDiameters injected bubble diameters. In [0, column width].
+  double coupling_width_m = 0.0;
+
   bool coalescence = false;
   double film_drainage_s = 0.0;  ///< Contact time before two touching bubbles merge, >= 0.
   /// Without coalescence: bubbles that overlap are pushed apart (perfectly inelastic hard-sphere
@@ -107,6 +120,8 @@ struct DbmOptions {
   double sample_interval_s = 0.05;
 
   bool IsValid(std::string* error) const;
+  /// The coupling width in use [m].
+  double CouplingWidth() const;
   /// The largest stable step: min of the emulsion's explicit viscous limit h^2 rho_e / (2 d mu_e)
   /// (d the number of dimensions), and the relaxation time of the injected bubble's slip
   /// (rho_b + C_VM rho_e) / (3/4 C_D rho_e u_br / d_b), below which the mapped reaction of an
@@ -121,10 +136,21 @@ struct DbmBubble {
   double diameter_m = 0.0;
   double volume_m3 = 0.0;
   std::uint64_t id = 0;
+  /// After a coalescence the emulsion still sees the gas where the two bubbles were, drawn to
+  /// the centre as lobe_remaining falls from 1 to 0 over the time the merged bubble takes to
+  /// rise its own diameter: a lobe of lobe_volume_m3 at x + lobe_remaining * lobe_offset and the
+  /// rest opposite, at the same centroid x. So a merger displaces the emulsion no faster than a
+  /// rising bubble does, not within one step (which no step can resolve: two 0.3 m bubbles
+  /// meeting move 0.3 m of gas). Only the mapped fraction uses the lobes.
+  Eigen::Vector3d lobe_offset = Eigen::Vector3d::Zero();
+  double lobe_volume_m3 = 0.0;
+  double lobe_remaining = 0.0;
 };
 
 /// Coalescence of two bubbles: one bubble of their summed volume at the volume-weighted centre
-/// with the volume-weighted velocity (volume and momentum conserved; the id is a's).
+/// with the volume-weighted velocity (volume and momentum conserved; the id is a's), mapped as
+/// two lobes where the parents' gas was (lobe_remaining 1): the parents' centres, or, for a
+/// parent still relaxing from a merger, its lobes, joined to two so the least gas moves.
 DbmBubble merge_bubbles(const DbmBubble& a, const DbmBubble& b);
 
 /// Counters and balances of a run.

@@ -160,6 +160,8 @@ struct SceneDbm {
   double virtual_mass_coefficient = 0.5;  ///< [0, 10].
   bool lift = false;
   double lift_coefficient = 0.5;  ///< [-1, 1], with lift = true.
+  /// Width of the kernel mapping bubbles to cells [m], [0, column]; 0: 5 injected diameters.
+  double coupling_width_m = 0.0;
   bool coalescence = false;
   double film_drainage_s = 0.0;    ///< [0, 10].
   bool collisions = true;          ///< Without coalescence: overlapping bubbles pushed apart.
