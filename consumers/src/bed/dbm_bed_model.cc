@@ -448,6 +448,7 @@ class DbmBedModel : public BedModel {
         {"coalescences", dg.coalescences},
         {"max_bubble_diameter_m", dg.max_bubble_diameter_m},
         {"max_cfl", dg.max_cfl},
+        {"retaken_steps", dg.retaken_steps},
         {"max_bubble_fraction", dg.max_bubble_fraction},
         {"fraction_clamps", dg.fraction_clamps},
         {"max_pressure_residual", dg.max_continuity_residual},

@@ -291,6 +291,41 @@ struct DbmSimulation::Impl {
   double next_sample = 0.0;
   double top_outflow = 0.0;
   int size_bins = kSizeBins;
+  int fastest_cell = 0;  // of the last step, for the diagnosis
+
+  /// What a step changes, to take it again from its start.
+  struct State {
+    double time = 0.0;
+    std::vector<DbmBubble> bubbles;
+    DbmDiagnostics diag;
+    std::array<Eigen::VectorXd, 3> vel, uc_prev;
+    Eigen::VectorXd eps_e, eps_b, pressure;
+    bool have_prev = false;
+    double previous_dt = 0.0, top_outflow = 0.0;
+    std::vector<double> forming;
+    std::uint64_t next_id = 1;
+    std::map<std::pair<std::uint64_t, std::uint64_t>, double> contact_since;
+  };
+  State Save(double t, const std::vector<DbmBubble>& b, const DbmDiagnostics& d) const {
+    return State{t,        b,         d,           vel,         uc_prev, eps_e,   eps_b,
+                 pressure, have_prev, previous_dt, top_outflow, forming, next_id, contact_since};
+  }
+  void Restore(const State& s, double* t, std::vector<DbmBubble>* b, DbmDiagnostics* d) {
+    *t = s.time;
+    *b = s.bubbles;
+    *d = s.diag;
+    vel = s.vel;
+    uc_prev = s.uc_prev;
+    eps_e = s.eps_e;
+    eps_b = s.eps_b;
+    pressure = s.pressure;
+    have_prev = s.have_prev;
+    previous_dt = s.previous_dt;
+    top_outflow = s.top_outflow;
+    forming = s.forming;
+    next_id = s.next_id;
+    contact_since = s.contact_since;
+  }
   double kernel_radius = 0.0;  // half the coupling width [m]
 
   static int AxisOf(int component) { return component == 0 ? 0 : (component == 1 ? 2 : 1); }
@@ -451,6 +486,40 @@ void DbmSimulation::Step() {
     for (int a = 0; a < 3; ++a) rate = std::max(rate, m.vel[a].cwiseAbs().maxCoeff() / m.h[a]);
     if (rate > 0.0) dt = std::min(dt, opt_.cfl / rate);
   }
+  // The step is chosen from the velocity at its start; a sudden displacement within it (a large
+  // bubble breaking through the surface) can still pass the convective limit. With the adaptive
+  // step, such a step is taken again from its start, shortened to the CFL number it reached.
+  Impl::State saved;
+  if (opt_.cfl > 0.0) saved = m.Save(time_, bubbles_, diag_);
+  for (int attempt = 0;; ++attempt) {
+    const double cfl = TakeStep(dt);
+    if (cfl <= 1.0) break;
+    if (opt_.cfl > 0.0 && attempt < kMaxStepRetakes) {
+      m.Restore(saved, &time_, &bubbles_, &diag_);
+      diag_.retaken_steps += 1;
+      dt *= opt_.cfl / cfl;
+      continue;
+    }
+    const int nx = m.n[0], nz = m.n[1];
+    const int c = m.fastest_cell, i = c % nx, j = (c / nx) % nz, k = c / (nx * nz);
+    double largest = 0.0;
+    for (const DbmBubble& b : bubbles_) largest = std::max(largest, b.diameter_m);
+    throw std::runtime_error(
+        "dbm: at t = " + fmt(time_) + " s the emulsion moves " + fmt(cfl) +
+        " cells per step (above 1, the limit of its explicit advection) at (" +
+        fmt((i + 0.5) * m.h[0]) + ", " + fmt((k + 0.5) * m.h[2]) + ", " + fmt((j + 0.5) * m.h[1]) +
+        ") m, bubble fraction " + fmt(m.eps_b(c)) + ", largest bubble " + fmt(largest) +
+        " m: the run is diverging" +
+        (opt_.cfl > 0.0 ? " (" + std::to_string(kMaxStepRetakes) + " shorter steps did not hold it)"
+                        : std::string()) +
+        "; remedy: [dbm] cfl (an adaptive step) or dt_s below " + fmt(dt / std::max(cfl, 1e-300)) +
+        " s");
+  }
+  Accumulate(dt);
+}
+
+double DbmSimulation::TakeStep(double dt) {
+  Impl& m = *impl_;
   diag_.min_dt_s = diag_.steps == 0 ? dt : std::min(diag_.min_dt_s, dt);
   const double t1 = time_ + dt;
   const double rho_e = opt_.emulsion_density_kg_m3;
@@ -939,27 +1008,13 @@ void DbmSimulation::Step() {
   diag_.emulsion_wall_s += Seconds(emulsion_start);
   time_ = t1;
   diag_.steps += 1;
-  if (!(cfl <= 1.0)) {
-    const int i = fastest_cell % nx, j = (fastest_cell / nx) % nz, k = fastest_cell / (nx * nz);
-    auto Where = [&](int) {
-      return fmt((i + 0.5) * m.h[0]) + ", " + fmt((k + 0.5) * m.h[2]) + ", " +
-             fmt((j + 0.5) * m.h[1]);
-    };
-    auto LargestBubble = [&] {
-      double d = 0.0;
-      for (const DbmBubble& b : bubbles_) d = std::max(d, b.diameter_m);
-      return d;
-    };
-    throw std::runtime_error("dbm: at t = " + fmt(time_) + " s the emulsion moves " + fmt(cfl) +
-                             " cells per step (above 1, the limit of its explicit advection) at (" +
-                             Where(fastest_cell) + ") m, bubble fraction " +
-                             fmt(m.eps_b(fastest_cell)) + ", largest bubble " +
-                             fmt(LargestBubble()) +
-                             " m: the run is diverging; "
-                             "remedy: [dbm] cfl (an adaptive step) or dt_s below " +
-                             fmt(dt / std::max(cfl, 1e-300)) + " s");
-  }
+  m.fastest_cell = fastest_cell;
+  return cfl;
+}
 
+void DbmSimulation::Accumulate(double dt) {
+  Impl& m = *impl_;
+  const int nz = m.n[1];
   // 9. Time averages and the bubble samples.
   if (time_ > opt_.average_from_s + 1e-12) {
     const double w = std::min(dt, time_ - opt_.average_from_s);

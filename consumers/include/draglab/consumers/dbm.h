@@ -68,6 +68,10 @@ std::vector<DbmNozzle> square_nozzle_array(int nozzles_per_side, double pitch_m,
 /// reactor's default grid and keeps one bubble's fraction small.
 constexpr double kCouplingWidthInDiameters = 5.0;
 
+/// With an adaptive step (DbmOptions::cfl > 0), how many times a step that passed the convective
+/// limit is taken again, shorter, before the run stops.
+constexpr int kMaxStepRetakes = 4;
+
 /// Everything a DBM run needs. Checked by IsValid (each message names the field and range).
 struct DbmOptions {
   double width_m = 1.0;           ///< x, > 0.
@@ -160,10 +164,12 @@ struct DbmDiagnostics {
   std::int64_t bubbles_injected = 0;
   std::int64_t bubbles_left = 0;  ///< At the bed surface.
   std::int64_t coalescences = 0;
-  std::int64_t collision_sweeps = 0;     ///< Overlap-resolution sweeps that moved bubbles.
-  double gas_injected_m3 = 0.0;          ///< Bubble volume injected.
-  double gas_left_m3 = 0.0;              ///< Bubble volume that left at the surface.
-  double max_cfl = 0.0;                  ///< max |u| dt / h of the emulsion over steps.
+  std::int64_t collision_sweeps = 0;  ///< Overlap-resolution sweeps that moved bubbles.
+  double gas_injected_m3 = 0.0;       ///< Bubble volume injected.
+  double gas_left_m3 = 0.0;           ///< Bubble volume that left at the surface.
+  double max_cfl = 0.0;               ///< max |u| dt / h of the emulsion over steps.
+  /// Steps taken again, shorter, because the emulsion passed the convective limit (cfl > 0).
+  std::int64_t retaken_steps = 0;
   double min_dt_s = 0.0;                 ///< The smallest step taken.
   double max_bubble_fraction = 0.0;      ///< Largest cell bubble fraction before the clamp.
   std::int64_t fraction_clamps = 0;      ///< Cell-steps with eps_e clamped at its minimum.
@@ -203,7 +209,8 @@ class DbmSimulation {
   DbmSimulation& operator=(const DbmSimulation&) = delete;
 
   /// Advances by whole steps to the first step at or after t. Throws std::runtime_error with a
-  /// diagnosis when the emulsion exceeds the convective limit or a bubble outgrows the column.
+  /// diagnosis when the emulsion exceeds the convective limit (with an adaptive step: after
+  /// kMaxStepRetakes shorter tries) or a bubble outgrows the column.
   void AdvanceTo(double t_s);
   void Step();
 
@@ -239,6 +246,11 @@ class DbmSimulation {
   DbmDiagnostics diag_;
   DbmAverages avg_;
   std::unique_ptr<Impl> impl_;
+
+  /// One step of dt (all but the time averages); returns the emulsion's CFL number reached.
+  double TakeStep(double dt);
+  /// The time averages and bubble samples of the step just taken.
+  void Accumulate(double dt);
 };
 
 }  // namespace consumers
