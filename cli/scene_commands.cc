@@ -223,11 +223,17 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
     // One run: the bound of the bubble boundary on the grid, one gas cell (the larger side). The
     // packing-realization spread adds in quadrature; `draglab sensitivity` measures it (0-0.5 mm
     // on the quick scene, 5 mm cells: the cell dominates).
-    out["numerical_uncertainty"] =
-        r.metrics.bubble_present ? nlohmann::json(cell_size_m) : nlohmann::json(nullptr);
-    out["numerical_uncertainty_method"] =
-        "one gas cell on the bubble boundary (the larger cell side); the packing-realization "
-        "spread is not included: draglab sensitivity adds it in quadrature";
+    // A model with its own estimate (the DBM's batch means of the hold-up) reports that.
+    if (r.headline_uncertainty >= 0.0) {
+      out["numerical_uncertainty"] = r.headline_uncertainty;
+      out["numerical_uncertainty_method"] = r.headline_uncertainty_method;
+    } else {
+      out["numerical_uncertainty"] =
+          r.metrics.bubble_present ? nlohmann::json(cell_size_m) : nlohmann::json(nullptr);
+      out["numerical_uncertainty_method"] =
+          "one gas cell on the bubble boundary (the larger cell side); the packing-realization "
+          "spread is not included: draglab sensitivity adds it in quadrature";
+    }
     ctx.print_json(out);
     return;
   }
@@ -246,8 +252,12 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
                                smp.pressure_drop_pa);
     }
   }
-  std::cout << "  numerical uncertainty: not estimated (one grid, one packing; see draglab "
-               "sensitivity)\n";
+  if (r.headline_uncertainty >= 0.0)
+    std::cout << "  numerical uncertainty: " << format_number(r.headline_uncertainty, 2) << " ("
+              << r.headline_uncertainty_method << ")\n";
+  else
+    std::cout << "  numerical uncertainty: not estimated (one grid, one packing; see draglab "
+                 "sensitivity)\n";
   for (const auto& file : r.output_files) std::cout << "  wrote " << file << "\n";
   if (result_id > 0) std::cout << "  stored as consumer result " << result_id << "\n";
 }

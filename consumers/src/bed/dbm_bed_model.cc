@@ -80,6 +80,29 @@ DbmOptions SceneDbmOptions(const Scene& s, double umf_m_s, std::uint64_t seed) {
   return o;
 }
 
+/// The batch-means standard error of the mean of a correlated series.
+struct BatchMeans {
+  double standard_error = 0.0;
+  int batches = 0;
+};
+constexpr int kBatches = 10;
+BatchMeans batch_means(const std::vector<double>& samples) {
+  BatchMeans out;
+  const int per_batch = static_cast<int>(samples.size()) / kBatches;
+  if (per_batch < 1) return out;  // too few samples: no estimate (0 batches)
+  std::vector<double> means(kBatches, 0.0);
+  for (int b = 0; b < kBatches; ++b) {
+    for (int s = 0; s < per_batch; ++s) means[b] += samples[b * per_batch + s];
+    means[b] /= per_batch;
+  }
+  double mean = 0.0, var = 0.0;
+  for (double m : means) mean += m / kBatches;
+  for (double m : means) var += (m - mean) * (m - mean) / (kBatches - 1);
+  out.standard_error = std::sqrt(var / kBatches);
+  out.batches = kBatches;
+  return out;
+}
+
 /// The injection seed a run starts from.
 class DbmInjectionSeed : public BedRealization {};
 
@@ -206,6 +229,7 @@ class DbmBedModel : public BedModel {
     out.eps_mf = scene.eps_mf;
     out.background_mode = "two_phase";
     nlohmann::json series = nlohmann::json::array();
+    std::vector<double> holdup_samples;  // after average_from_s, for the batch means
     const double interval = sd.sample_interval_s;
     const int samples = static_cast<int>(std::floor(duration / interval + 1e-9));
     try {
@@ -225,6 +249,7 @@ class DbmBedModel : public BedModel {
         smp.bubble_centroid_m = count > 0 ? z_sum / count : 0.0;
         smp.bed_height_m = o.height_m;
         out.series.push_back(smp);
+        if (smp.t_s > sd.average_from_s + 1e-12) holdup_samples.push_back(holdup);
         series.push_back({{"t_s", smp.t_s},
                           {"bubbles", bubbles.size()},
                           {"holdup", holdup},
@@ -395,6 +420,15 @@ class DbmBedModel : public BedModel {
     out.wall_s = wall_s;
     m.wall_s = wall_s;
     out.headline = headline;
+    // The hold-up's statistical error: the samples are correlated over a bubble's rise, so their
+    // standard error understates it; the means of kBatches consecutive batches, each far longer
+    // than a rise through the column, are close to independent.
+    const BatchMeans holdup_error = batch_means(holdup_samples);
+    out.headline_uncertainty = holdup_error.standard_error;
+    out.headline_uncertainty_method =
+        "hold-up: standard error of the means of " + std::to_string(holdup_error.batches) +
+        " consecutive batches of the samples after average_from_s (statistical; the grid's and "
+        "step's errors are measured by draglab sensitivity --work-precision)";
 
     nlohmann::json head = nlohmann::json::object();
     for (const auto& [name, value] : headline) head[name] = value;
@@ -425,6 +459,8 @@ class DbmBedModel : public BedModel {
          {{"mean", holdup_mean},
           {"two_phase_theory", holdup_theory},
           {"ratio_to_theory", holdup_theory > 0 ? holdup_mean / holdup_theory : 0.0},
+          {"standard_error", holdup_error.standard_error},
+          {"batches", holdup_error.batches},
           {"rise_velocity_davies_taylor_m_s", u_br}}},
         {"sizes", sizes},
         {"circulation",
@@ -470,7 +506,8 @@ class DbmBedModel : public BedModel {
           << " m bubbles from " << o.nozzles.size() << " nozzles; " << o.nx << " x " << o.ny
           << " x " << o.nz << " cells, " << dg.steps << " steps of " << Num(o.dt_s) << " s; wall "
           << Num(wall_s) << " s (" << Num(dg.bubble_steps / wall_s) << " bubble-steps/s, "
-          << Num(cells_steps / wall_s) << " cell-steps/s)\n  hold-up " << Num(holdup_mean)
+          << Num(cells_steps / wall_s) << " cell-steps/s)\n  hold-up " << Num(holdup_mean) << " +- "
+          << Num(holdup_error.standard_error) << " (batch means)"
           << " (two-phase theory " << Num(holdup_theory) << "), mean bubble "
           << Num(m.bubble_diameter_m) << " m, circulation: core " << Num(w_core) << " m/s, walls "
           << Num(w_wall) << " m/s, upflow " << Num(upflow) << " m/s\n  gas balance "

@@ -69,6 +69,11 @@ struct BedResult {
   /// bubble sizes at the report heights, circulation); empty for the jet-bubble models, whose
   /// headline is the bubble in `metrics`.
   std::vector<std::pair<std::string, double>> headline;
+  /// The model's own error estimate of its first headline number, in its unit, and how it was
+  /// made (DBM: the batch-means standard error of the time-averaged hold-up); negative: none
+  /// (the jet-bubble models, whose estimate is the grid's cell).
+  double headline_uncertainty = -1.0;
+  std::string headline_uncertainty_method;
   std::string result_json;  ///< The model's full result (a JSON object with "solver": key).
   std::string brief;        ///< One-line report.
 };
