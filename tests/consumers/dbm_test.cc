@@ -172,8 +172,7 @@ TEST(DbmValidation, CoalescenceConservesVolumeAndMomentum) {
   }
   // The emulsion still sees the gas where it was: lobes at the parents' centres.
   EXPECT_LT((m.x + m.lobe_offset - a.x).norm(), 1e-15);
-  const double rest = m.volume_m3 - m.lobe_volume_m3;
-  EXPECT_LT((m.x - m.lobe_volume_m3 / rest * m.lobe_offset - b.x).norm(), 1e-15);
+  EXPECT_LT((m.x + m.rest_offset - b.x).norm(), 1e-15);
   // A small bubble c merging with m before its lobes meet joins b's lobe (the nearer), and a's
   // lobe stays: the gas that moves is c's alone, and the lobes' centroid is the new centre.
   DbmBubble c;
@@ -184,8 +183,18 @@ TEST(DbmValidation, CoalescenceConservesVolumeAndMomentum) {
   EXPECT_LT((n.x + n.lobe_offset - a.x).norm(), 1e-15);
   EXPECT_NEAR(n.lobe_volume_m3, a.volume_m3, 1e-20);
   const Eigen::Vector3d bc = (b.volume_m3 * b.x + c.volume_m3 * c.x) / (b.volume_m3 + c.volume_m3);
-  const double n_rest = n.volume_m3 - n.lobe_volume_m3;
-  EXPECT_LT((n.x - n.lobe_volume_m3 / n_rest * n.lobe_offset - bc).norm(), 1e-15);
+  EXPECT_LT((n.x + n.rest_offset - bc).norm(), 1e-15);
+  // A centre pushed off a wall leaves its gas where it was, half relaxed or whole.
+  DbmBubble p = n;
+  p.lobe_remaining = 0.5;
+  const Eigen::Vector3d lobe = p.x + 0.5 * p.lobe_offset, rest_at = p.x + 0.5 * p.rest_offset;
+  move_bubble_centre(&p, {0.02, 0.0, -0.01});
+  EXPECT_LT((p.x + 0.5 * p.lobe_offset - lobe).norm(), 1e-15);
+  EXPECT_LT((p.x + 0.5 * p.rest_offset - rest_at).norm(), 1e-15);
+  DbmBubble q = a;
+  move_bubble_centre(&q, {0.02, 0.0, 0.0});
+  EXPECT_EQ(q.lobe_remaining, 1.0);
+  EXPECT_LT((q.x + q.lobe_offset - a.x).norm(), 1e-15);
 }
 
 TEST(DbmValidation, AMergerDisplacesTheEmulsionNoFasterThanARisingBubble) {

@@ -137,11 +137,11 @@ struct Blob {
 };
 
 void AppendBlobs(const DbmBubble& b, std::vector<Blob>* blobs) {
-  if (b.lobe_remaining > 0.0 && b.lobe_volume_m3 > 0.0 && b.lobe_volume_m3 < b.volume_m3) {
-    const Vec offset = b.lobe_remaining * b.lobe_offset;
+  if (b.lobe_remaining > 0.0) {
     const double rest = b.volume_m3 - b.lobe_volume_m3;
-    blobs->push_back({b.x + offset, b.lobe_volume_m3});
-    blobs->push_back({b.x - (b.lobe_volume_m3 / rest) * offset, rest});
+    if (b.lobe_volume_m3 > 0.0)
+      blobs->push_back({b.x + b.lobe_remaining * b.lobe_offset, b.lobe_volume_m3});
+    if (rest > 0.0) blobs->push_back({b.x + b.lobe_remaining * b.rest_offset, rest});
   } else {
     blobs->push_back({b.x, b.volume_m3});
   }
@@ -183,8 +183,22 @@ DbmBubble merge_bubbles(const DbmBubble& a, const DbmBubble& b) {
   }
   m.lobe_volume_m3 = blobs[0].volume;
   m.lobe_offset = blobs[0].x - m.x;
+  m.rest_offset = blobs.size() > 1 ? Vec(blobs[1].x - m.x) : Vec(-m.lobe_offset);
   m.lobe_remaining = 1.0;
   return m;
+}
+
+void move_bubble_centre(DbmBubble* b, const Eigen::Vector3d& delta) {
+  if (delta.squaredNorm() == 0.0) return;
+  b->x += delta;
+  if (b->lobe_remaining > 0.0) {
+    b->lobe_offset -= delta / b->lobe_remaining;
+    b->rest_offset -= delta / b->lobe_remaining;
+  } else {
+    b->lobe_remaining = 1.0;
+    b->lobe_volume_m3 = b->volume_m3;
+    b->lobe_offset = b->rest_offset = -delta;
+  }
 }
 
 bool DbmOptions::IsValid(std::string* error) const {
@@ -645,19 +659,23 @@ double DbmSimulation::TakeStep(double dt) {
   }
 
   // Walls: a bubble's centre stays a radius away; its velocity into a wall is dropped.
+  // A merged bubble can grow into a wall: its centre then jumps off it, and its gas follows as
+  // after a merger (move_bubble_centre), not within the step.
   auto KeepInside = [&](DbmBubble& bub) {
     const double r = 0.5 * bub.diameter_m;
     const double lo[3] = {r, r, r};
     const double hi[3] = {opt_.width_m - r, opt_.depth_m - r, 1e300};
+    Vec delta = Vec::Zero();
     for (int c = 0; c < 3; ++c) {
       if (bub.x(c) < lo[c]) {
-        bub.x(c) = lo[c];
+        delta(c) = lo[c] - bub.x(c);
         bub.v(c) = std::max(bub.v(c), 0.0);
       } else if (bub.x(c) > hi[c]) {
-        bub.x(c) = hi[c];
+        delta(c) = hi[c] - bub.x(c);
         bub.v(c) = std::min(bub.v(c), 0.0);
       }
     }
+    move_bubble_centre(&bub, delta);
   };  // 3. Bubble motion (drag implicit) and the force each exerts on the emulsion.
   const long nb = static_cast<long>(bubbles_.size());
   std::vector<Vec> reaction(static_cast<std::size_t>(nb));

@@ -140,13 +140,15 @@ struct DbmBubble {
   double diameter_m = 0.0;
   double volume_m3 = 0.0;
   std::uint64_t id = 0;
-  /// After a coalescence the emulsion still sees the gas where the two bubbles were, drawn to
-  /// the centre as lobe_remaining falls from 1 to 0 over the time the merged bubble takes to
-  /// rise its own diameter: a lobe of lobe_volume_m3 at x + lobe_remaining * lobe_offset and the
-  /// rest opposite, at the same centroid x. So a merger displaces the emulsion no faster than a
-  /// rising bubble does, not within one step (which no step can resolve: two 0.3 m bubbles
-  /// meeting move 0.3 m of gas). Only the mapped fraction uses the lobes.
+  /// Where the emulsion sees the gas after a jump of the bubble's centre (a coalescence, or a
+  /// merged bubble pushed off a wall it has grown into): still where it was, drawn to the centre
+  /// as lobe_remaining falls from 1 to 0 over the time the bubble takes to rise its own
+  /// diameter: lobe_volume_m3 at x + lobe_remaining * lobe_offset, the rest at x +
+  /// lobe_remaining * rest_offset. So such a jump displaces the emulsion no faster than a rising
+  /// bubble does, not within one step (which no step can resolve: two 0.3 m bubbles meeting
+  /// move 0.3 m of gas). Only the mapped fraction uses the lobes.
   Eigen::Vector3d lobe_offset = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rest_offset = Eigen::Vector3d::Zero();
   double lobe_volume_m3 = 0.0;
   double lobe_remaining = 0.0;
 };
@@ -156,6 +158,10 @@ struct DbmBubble {
 /// two lobes where the parents' gas was (lobe_remaining 1): the parents' centres, or, for a
 /// parent still relaxing from a merger, its lobes, joined to two so the least gas moves.
 DbmBubble merge_bubbles(const DbmBubble& a, const DbmBubble& b);
+
+/// Moves a bubble's centre by delta while the emulsion still sees its gas where it was (the
+/// lobes, relaxing to the centre as after a merger).
+void move_bubble_centre(DbmBubble* b, const Eigen::Vector3d& delta);
 
 /// Counters and balances of a run.
 struct DbmDiagnostics {
