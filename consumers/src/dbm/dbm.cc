@@ -508,7 +508,9 @@ void DbmSimulation::Step() {
   for (int attempt = 0;; ++attempt) {
     const double cfl = TakeStep(dt);
     if (cfl <= 1.0) break;
-    if (opt_.cfl > 0.0 && attempt < kMaxStepRetakes) {
+    // A sudden displacement passes the limit by a little; a run that passes it many times over
+    // is diverging, and a step shortened as much would only overflow.
+    if (opt_.cfl > 0.0 && attempt < kMaxStepRetakes && cfl < kRetakeAtMost) {
       m.Restore(saved, &time_, &bubbles_, &diag_);
       diag_.retaken_steps += 1;
       dt *= opt_.cfl / cfl;
@@ -524,10 +526,14 @@ void DbmSimulation::Step() {
         fmt((i + 0.5) * m.h[0]) + ", " + fmt((k + 0.5) * m.h[2]) + ", " + fmt((j + 0.5) * m.h[1]) +
         ") m, bubble fraction " + fmt(m.eps_b(c)) + ", largest bubble " + fmt(largest) +
         " m: the run is diverging" +
-        (opt_.cfl > 0.0 ? " (" + std::to_string(kMaxStepRetakes) + " shorter steps did not hold it)"
-                        : std::string()) +
-        "; remedy: [dbm] cfl (an adaptive step) or dt_s below " + fmt(dt / std::max(cfl, 1e-300)) +
-        " s");
+        (attempt > 0 ? " (" + std::to_string(attempt) + " shorter steps did not hold it)"
+                     : std::string()) +
+        (opt_.cfl > 0.0 ? "; remedy: the bubbles crowd beyond what the emulsion equations hold "
+                          "(max bubble fraction " +
+                              fmt(diag_.max_bubble_fraction) +
+                              "): a coarser grid, [dbm] collisions = true, or a lower gas flow"
+                        : "; remedy: [dbm] cfl (an adaptive step) or dt_s below " +
+                              fmt(dt / std::max(cfl, 1e-300)) + " s"));
   }
   Accumulate(dt);
 }
@@ -547,14 +553,17 @@ double DbmSimulation::TakeStep(double dt) {
   auto deposit_fractions = [&](bool count) {
     m.eps_b.setZero();
     for (const DbmBubble& b : bubbles_) {
-      // A bubble breaking through the surface displaces less emulsion as it leaves.
-      const double r = 0.5 * b.diameter_m;
-      const double inside = std::clamp((opt_.height_m - b.x(2)) / r, 0.0, 1.0);
+      // Gas breaking through the surface displaces less emulsion as it leaves, each lobe by
+      // its own height (by the bubble's, a merger with a bubble below would bring back gas
+      // that had left).
       blobs.clear();
       AppendBlobs(b, &blobs);
-      for (const Blob& blob : blobs)
-        internal::Deposit3(m.eps_b, m.StencilOf(blob.x, SphereDiameter(blob.volume)),
-                           inside * blob.volume / m.cell_volume, nx, nz);
+      for (const Blob& blob : blobs) {
+        const double d = SphereDiameter(blob.volume);
+        const double inside = std::clamp((opt_.height_m - blob.x(2)) / (0.5 * d), 0.0, 1.0);
+        internal::Deposit3(m.eps_b, m.StencilOf(blob.x, d), inside * blob.volume / m.cell_volume,
+                           nx, nz);
+      }
     }
     for (std::size_t k = 0; k < m.forming.size(); ++k) {
       const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
@@ -726,11 +735,20 @@ double DbmSimulation::TakeStep(double dt) {
                          -reaction[static_cast<std::size_t>(b)](c) / m.cell_volume, nx, nz);
   }
 
-  // 4. Bubbles leave at the bed surface.
+  // 4. Bubbles leave at the bed surface: when their centre, and the gas still relaxing to it
+  // after a jump (its lobes), have reached it.
   {
     std::size_t kept = 0;
+    std::vector<Blob> blobs;
+    auto left = [&](const DbmBubble& b) {
+      blobs.clear();
+      AppendBlobs(b, &blobs);
+      bool all = b.x(2) >= opt_.height_m;
+      for (const Blob& blob : blobs) all = all && blob.x(2) >= opt_.height_m;
+      return all;
+    };
     for (std::size_t b = 0; b < bubbles_.size(); ++b) {
-      if (bubbles_[b].x(2) >= opt_.height_m) {
+      if (left(bubbles_[b])) {
         diag_.bubbles_left += 1;
         diag_.gas_left_m3 += bubbles_[b].volume_m3;
       } else {

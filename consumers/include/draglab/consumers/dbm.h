@@ -71,6 +71,8 @@ constexpr double kCouplingWidthInDiameters = 5.0;
 /// With an adaptive step (DbmOptions::cfl > 0), how many times a step that passed the convective
 /// limit is taken again, shorter, before the run stops.
 constexpr int kMaxStepRetakes = 4;
+/// A step whose CFL number reaches this is diverging: it is not retaken.
+constexpr double kRetakeAtMost = 10.0;
 
 /// Everything a DBM run needs. Checked by IsValid (each message names the field and range).
 struct DbmOptions {
