@@ -964,8 +964,17 @@ double DbmSimulation::TakeStep(double dt) {
     }
   }
   const Eigen::VectorXd pressure_old = m.pressure;
-  m.pressure =
-      m.solver->Solve(coeff_total[0], coeff_total[2], coeff_total[1], residual, 0.0, m.pressure);
+  try {
+    m.pressure =
+        m.solver->Solve(coeff_total[0], coeff_total[2], coeff_total[1], residual, 0.0, m.pressure);
+  } catch (const Error& e) {
+    // A run-time failure (exit 1), with what the bubbles did to the pressure equation.
+    throw std::runtime_error("dbm: at t = " + fmt(t1) + " s " + e.what() +
+                             "; the bubble fraction reaches " + fmt(m.eps_b.maxCoeff()) +
+                             " (crowded bubbles make the equation ill-conditioned; remedy: "
+                             "[dbm] collisions = true, no film drainage, a coarser grid, or a "
+                             "lower gas flow)");
+  }
   diag_.max_continuity_residual =
       std::max(diag_.max_continuity_residual, m.solver->diagnostics().relative_residual);
   diag_.max_cg_iterations = std::max(diag_.max_cg_iterations, m.solver->diagnostics().iterations);
