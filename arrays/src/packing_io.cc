@@ -39,12 +39,19 @@ void silence_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
   throw Error(ErrorCode::kInvalidArgument, "packing file '" + path + "': " + what);
 }
 
+// Limits on what a file may declare, checked before anything is allocated for it: a damaged or
+// hostile file can declare any shape (an unallocated chunked dataset of 2^40 rows costs a few
+// bytes on disk). Packings have at most 10^7 spheres (RandomPackingOptions::n).
+constexpr hsize_t kMaxSpheres = 10000000;
+constexpr hsize_t kMaxValues = 3 * kMaxSpheres;   // centers [N, 3]
+constexpr std::size_t kMaxStringBytes = 1 << 20;  // generator, settings (JSON text)
+
 void write_dataset(hid_t group, const char* name, const std::vector<hsize_t>& dims,
                    const double* data, const std::string& path) {
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose);
-  Handle set(H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT,
-                        H5P_DEFAULT),
-             H5Dclose);
+  Handle set(
+      H5Dcreate2(group, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      H5Dclose);
   if (!space.ok() || !set.ok() ||
       H5Dwrite(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     fail(path, std::string("cannot write dataset ") + name);
@@ -54,8 +61,7 @@ void write_dataset(hid_t group, const char* name, const std::vector<hsize_t>& di
 void write_attribute(hid_t object, const char* name, hid_t file_type, hid_t mem_type,
                      const void* value, const std::string& path) {
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-  Handle attr(H5Acreate2(object, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-              H5Aclose);
+  Handle attr(H5Acreate2(object, name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   if (!attr.ok() || H5Awrite(attr.get(), mem_type, value) < 0) {
     fail(path, std::string("cannot write attribute ") + name);
   }
@@ -75,16 +81,30 @@ void write_string(hid_t o, const char* name, const std::string& value, const std
 
 std::vector<double> read_dataset(hid_t group, const char* name, std::vector<hsize_t>* dims,
                                  const std::string& path) {
-  if (H5Lexists(group, name, H5P_DEFAULT) <= 0) fail(path, std::string("no dataset /packing/") + name);
+  if (H5Lexists(group, name, H5P_DEFAULT) <= 0)
+    fail(path, std::string("no dataset /packing/") + name);
   Handle set(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
   Handle space(H5Dget_space(set.get()), H5Sclose);
   if (!set.ok() || !space.ok()) fail(path, std::string("cannot open dataset ") + name);
   const int rank = H5Sget_simple_extent_ndims(space.get());
-  if (rank < 1 || rank > 2) fail(path, std::string("dataset ") + name + " has rank " + std::to_string(rank));
+  if (rank < 1 || rank > 2)
+    fail(path, std::string("dataset ") + name + " has rank " + std::to_string(rank));
   dims->assign(static_cast<std::size_t>(rank), 0);
-  H5Sget_simple_extent_dims(space.get(), dims->data(), nullptr);
+  if (H5Sget_simple_extent_dims(space.get(), dims->data(), nullptr) != rank) {
+    fail(path, std::string("cannot read the shape of dataset ") + name);
+  }
   hsize_t count = 1;
-  for (hsize_t d : *dims) count *= d;
+  for (hsize_t d : *dims) {
+    // Each factor is checked before the product, so the product cannot overflow (rank <= 2).
+    if (d > kMaxValues || count * d > kMaxValues) {
+      std::string shape;
+      for (hsize_t e : *dims) shape += (shape.empty() ? "" : ", ") + std::to_string(e);
+      fail(path, std::string("dataset ") + name + " has shape [" + shape + "]: more than " +
+                     std::to_string(kMaxValues) + " values (a packing has at most " +
+                     std::to_string(kMaxSpheres) + " spheres)");
+    }
+    count *= d;
+  }
   std::vector<double> data(count);
   if (count > 0 &&
       H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0) {
@@ -93,11 +113,27 @@ std::vector<double> read_dataset(hid_t group, const char* name, std::vector<hsiz
   return data;
 }
 
-bool read_string(hid_t o, const char* name, std::string* out) {
+hssize_t attribute_elements(hid_t attr) {
+  Handle space(H5Aget_space(attr), H5Sclose);
+  if (!space.ok()) return -1;
+  return H5Sget_simple_extent_npoints(space.get());
+}
+
+/// H5Aread writes every element of the attribute: one value is read into one value only.
+void require_single_value(hid_t attr, const char* name, const std::string& path) {
+  const hssize_t n = attribute_elements(attr);
+  if (n != 1) {
+    fail(path, std::string("attribute /packing/") + name + " must hold one value, not " +
+                   (n < 0 ? std::string("an unreadable dataspace") : std::to_string(n)));
+  }
+}
+
+bool read_string(hid_t o, const char* name, std::string* out, const std::string& path) {
   if (H5Aexists(o, name) <= 0) return false;
   Handle attr(H5Aopen(o, name, H5P_DEFAULT), H5Aclose);
   Handle type(H5Aget_type(attr.get()), H5Tclose);
   if (!attr.ok() || !type.ok() || H5Tget_class(type.get()) != H5T_STRING) return false;
+  require_single_value(attr.get(), name, path);
   if (H5Tis_variable_str(type.get()) > 0) {
     char* value = nullptr;
     Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
@@ -110,6 +146,11 @@ bool read_string(hid_t o, const char* name, std::string* out) {
     return true;
   }
   const std::size_t size = H5Tget_size(type.get());
+  if (size == 0 || size > kMaxStringBytes) {
+    fail(path, std::string("attribute /packing/") + name + " is a string of " +
+                   std::to_string(size) + " bytes (at most " + std::to_string(kMaxStringBytes) +
+                   ")");
+  }
   std::string value(size, '\0');
   if (H5Aread(attr.get(), type.get(), value.data()) < 0) return false;
   value.resize(value.find('\0') == std::string::npos ? size : value.find('\0'));
@@ -117,10 +158,12 @@ bool read_string(hid_t o, const char* name, std::string* out) {
   return true;
 }
 
-bool read_number(hid_t o, const char* name, hid_t mem_type, void* out) {
+bool read_number(hid_t o, const char* name, hid_t mem_type, void* out, const std::string& path) {
   if (H5Aexists(o, name) <= 0) return false;
   Handle attr(H5Aopen(o, name, H5P_DEFAULT), H5Aclose);
-  return attr.ok() && H5Aread(attr.get(), mem_type, out) >= 0;
+  if (!attr.ok()) return false;
+  require_single_value(attr.get(), name, path);
+  return H5Aread(attr.get(), mem_type, out) >= 0;
 }
 
 }  // namespace
@@ -138,8 +181,8 @@ void write_packing_hdf5(const std::string& path, const Packing& packing,
                    H5Gclose);
       if (!group.ok()) fail(path, "cannot create group /packing");
       const hsize_t n = packing.size();
-      write_dataset(group.get(), "centers", {n, 3},
-                    n ? packing.centers.front().data() : nullptr, path);
+      write_dataset(group.get(), "centers", {n, 3}, n ? packing.centers.front().data() : nullptr,
+                    path);
       write_dataset(group.get(), "radii", {n}, packing.radii.data(), path);
       write_dataset(group.get(), "box_length", {3}, packing.box_length.data(), path);
       const long long count = static_cast<long long>(n);
@@ -187,7 +230,8 @@ Packing read_packing_hdf5(const std::string& path) {
   if (dims.size() != 2 || dims[1] != 3) fail(path, "centers must have shape [N, 3]");
   const std::size_t n = dims[0];
   const std::vector<double> radii = read_dataset(group.get(), "radii", &dims, path);
-  if (dims.size() != 1 || dims[0] != n) fail(path, "radii must have shape [N] with N = rows of centers");
+  if (dims.size() != 1 || dims[0] != n)
+    fail(path, "radii must have shape [N] with N = rows of centers");
   const std::vector<double> box = read_dataset(group.get(), "box_length", &dims, path);
   if (dims.size() != 1 || dims[0] != 3) fail(path, "box_length must have shape [3]");
   if (n == 0) fail(path, "contains no spheres");
@@ -207,10 +251,10 @@ Packing read_packing_hdf5(const std::string& path) {
       p.centers[i][a] = x;
     }
   }
-  read_string(group.get(), "generator", &p.generator);
-  read_string(group.get(), "settings", &p.settings_json);
+  read_string(group.get(), "generator", &p.generator, path);
+  read_string(group.get(), "settings", &p.settings_json, path);
   unsigned long long seed = 0;
-  if (read_number(group.get(), "seed", H5T_NATIVE_ULLONG, &seed)) p.seed = seed;
+  if (read_number(group.get(), "seed", H5T_NATIVE_ULLONG, &seed, path)) p.seed = seed;
   return p;
 }
 

@@ -19,7 +19,9 @@ void write_packing_hdf5(const std::string& path, const Packing& packing,
                         const PackingStatistics* statistics = nullptr);
 
 /// Reads a packing written by write_packing_hdf5 (or any file with the same layout). Throws
-/// draglab::Error(kInvalidArgument) naming the path and the missing/malformed item.
+/// draglab::Error(kInvalidArgument) naming the path and the missing/malformed item, also for
+/// datasets of more values than 10^7 spheres have (checked before any allocation) and for
+/// attributes (generator, settings, seed) that hold more than one value.
 Packing read_packing_hdf5(const std::string& path);
 
 }  // namespace arrays
