@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include <toml++/toml.h>
 #include <nlohmann/json.hpp>
+#include "draglab_toml.h"  // toml++, with a fix for its 3.3.0 release
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"

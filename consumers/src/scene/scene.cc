@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include <toml++/toml.h>
+#include "draglab_toml.h"  // toml++, with a fix for its 3.3.0 release
 
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/ktgf.h"
