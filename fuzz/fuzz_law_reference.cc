@@ -3,8 +3,9 @@
 // database seeded with the literature laws plus one law with published, draft and retracted
 // versions (so that versions, hash prefixes and warnings all have something to match).
 //
-// Properties checked beyond "no crash": a reference that loads resolves to that same version,
-// its reference() "name@N" loads the same content, and the law evaluates inside its box.
+// Properties checked beyond "no crash": a reference that loads names the law it loads (the text
+// before '@', byte for byte), resolves to that same version, its reference() "name@N" loads the
+// same content, and the law evaluates inside its box.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -48,6 +49,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::string warning;
     const auto law = db.load(reference, draglab::RangePolicy::kClamp, &warning);
     const draglab::LawRecord& record = law->record();
+    const std::string name = reference.substr(0, reference.find('@'));
+    if (record.name != name) {
+      draglab_fuzz::finding("'" + reference + "' loads " + record.reference() +
+                            ", a law of another name");
+    }
     const draglab::LawRecord resolved = db.resolve(reference);
     if (resolved.name != record.name || resolved.version != record.version) {
       draglab_fuzz::finding("load and resolve disagree on '" + reference + "'");

@@ -103,7 +103,7 @@ case "$target" in
     # The column names of the format (dataset.h), as dictionary entries.
     head -n 2 "$here/fuzz/seeds/dataset_csv/all_columns.csv" | tail -n 1 | tr ',' '\n' |
       sed -E 's/.*/"&"/' >>"$dict"
-    printf '%s\n' '","' '";"' '"#"' '"\r\n"' '"1e308"' '"nan"' '"inf"' '"-0"' '"0x1p-1074"' \
+    printf '%s\n' '","' '";"' '"#"' '"\x0D\x0A"' '"1e308"' '"nan"' '"inf"' '"-0"' '"0x1p-1074"' \
       >>"$dict"
     ;;
   packing_hdf5)
