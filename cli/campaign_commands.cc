@@ -19,6 +19,7 @@
 #include "cli/progress.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/files.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 
@@ -280,6 +281,7 @@ std::string csv_field(const std::string& s) {
 
 /// Every column of every unit, straight from the table.
 void run_export(const CliContext& ctx, const ExportCommand& c) {
+  if (!c.out.empty()) core::check_output_file(c.out, "--out");
   std::unique_ptr<Database> db = ctx.open_database(true);
   const campaign::CampaignStatus st = campaign::campaign_status(*db, c.id);
   sqlite3_stmt* stmt = nullptr;
@@ -339,17 +341,7 @@ void run_export(const CliContext& ctx, const ExportCommand& c) {
     std::cout << text;
     return;
   }
-  const std::string partial = c.out + ".partial";
-  {
-    std::ofstream f(partial);
-    if (!f) throw UsageError("--out '" + c.out + "' cannot be written");
-    f << text;
-    if (!f.flush()) throw std::runtime_error("writing '" + c.out + "' failed");
-  }
-  if (std::rename(partial.c_str(), c.out.c_str()) != 0) {
-    std::remove(partial.c_str());
-    throw std::runtime_error("writing '" + c.out + "' failed");
-  }
+  core::write_file_atomically(c.out, text, "--out");
   ctx.info(fmt::format("wrote {} units of campaign {} to {}", units.size(), st.name, c.out));
 }
 
@@ -401,6 +393,7 @@ void run_dataset_show(const CliContext& ctx, const std::string& id) {
 }
 
 void run_dataset_export(const CliContext& ctx, const std::string& id, const std::string& out) {
+  if (!out.empty()) core::check_output_file(out, "--out");
   std::unique_ptr<Database> db = ctx.open_database(true);
   const Dataset d = load_dataset(*db, id);
   // Provenance travels with the file: how it was built, from which campaign spec, by which code.
@@ -425,9 +418,8 @@ void run_dataset_export(const CliContext& ctx, const std::string& id, const std:
     std::cout << dataset_csv_text(d, provenance);
     return;
   }
-  write_dataset_csv(d, out, provenance);
-  if (!out.empty())
-    ctx.info(fmt::format("wrote dataset {} ({} points) to {}", d.id, d.points.size(), out));
+  core::write_file_atomically(out, dataset_csv_text(d, provenance), "--out");
+  ctx.info(fmt::format("wrote dataset {} ({} points) to {}", d.id, d.points.size(), out));
 }
 
 void run_dataset_import(const CliContext& ctx, const std::string& file) {

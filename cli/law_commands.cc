@@ -8,8 +8,9 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
-#include "draglab/drag_db/export.h"
+#include "draglab/core/files.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/drag_db/export.h"
 
 namespace draglab {
 namespace cli {
@@ -65,8 +66,8 @@ void check_physical_inputs(const std::vector<double>& phis, const std::vector<do
                            const std::string& phi_field, const std::string& re_field) {
   for (double phi : phis) {
     if (!std::isfinite(phi) || phi < 0.0 || phi >= 1.0) {
-      throw UsageError(fmt::format("{} = {} is outside [0, 1) (phi is the solids fraction)",
-                                   phi_field, phi));
+      throw UsageError(
+          fmt::format("{} = {} is outside [0, 1) (phi is the solids fraction)", phi_field, phi));
     }
   }
   for (double re : res) {
@@ -88,9 +89,10 @@ void run_list(const CliContext& ctx, bool published_only) {
   auto db = ctx.open_database();
   std::vector<LawRecord> records = db->list("", !published_only);
   if (published_only) {
-    records.erase(std::remove_if(records.begin(), records.end(),
-                                 [](const LawRecord& r) { return r.status != LawStatus::kPublished; }),
-                  records.end());
+    records.erase(
+        std::remove_if(records.begin(), records.end(),
+                       [](const LawRecord& r) { return r.status != LawStatus::kPublished; }),
+        records.end());
   }
   if (ctx.json) {
     nlohmann::json out = nlohmann::json::array();
@@ -140,8 +142,7 @@ void run_show(const CliContext& ctx, const std::string& ref) {
                            format_number(r.validity.re.min), format_number(r.validity.re.max));
   for (const ExtraInputSpec& e : r.validity.extra) {
     std::cout << fmt::format("              {} in [{}, {}]: {}\n", e.name,
-                             format_number(e.range.min), format_number(e.range.max),
-                             e.description);
+                             format_number(e.range.min), format_number(e.range.max), e.description);
   }
   std::cout << "  parameters\n";
   const std::size_t n = r.parameters.size();
@@ -189,16 +190,22 @@ void run_eval(const CliContext& ctx, const EvalOptions& o) {
     res = parse_double_list(o.re_list, "--re-list");
     check_physical_inputs(phis, res, "--phi-list", "--re-list");
   } else {
-    if (!o.phi_given || !o.re_given) throw UsageError("--phi and --re are required (or use --grid)");
+    if (!o.phi_given || !o.re_given)
+      throw UsageError("--phi and --re are required (or use --grid)");
     check_physical_inputs({o.phi}, {o.re}, "--phi", "--re");
   }
   auto db = ctx.open_database();
   std::string warning;
   auto law = db->load(o.ref, range_policy_from_string(o.policy), &warning);
   if (law->num_extra_inputs() != static_cast<int>(o.extra.size())) {
+    if (law->num_extra_inputs() == 0) {
+      throw UsageError(fmt::format("--y: {} is monodisperse and takes no size ratio; {} given",
+                                   law->reference(), o.extra.size()));
+    }
     std::string names;
-    for (const auto& e : law->record().validity.extra) names += " --" + e.name;
-    throw UsageError(fmt::format("{} takes {} extra input(s){}; {} given", law->reference(),
+    for (const auto& e : law->record().validity.extra)
+      names += (names.empty() ? "" : ", ") + e.name;
+    throw UsageError(fmt::format("--y: {} takes {} extra input(s) ({}); {} given", law->reference(),
                                  law->num_extra_inputs(), names, o.extra.size()));
   }
   print_law_header(*law, warning, ctx);
@@ -211,12 +218,14 @@ void run_eval(const CliContext& ctx, const EvalOptions& o) {
       ctx.print_json(j);
       return;
     }
-    std::cout << fmt::format("phi = {}  Re = {}{}\n", format_number(e.phi), format_number(e.re),
-                             e.outside_validity ? "  (outside validity box: " + o.policy + ")" : "");
+    std::cout << fmt::format(
+        "phi = {}  Re = {}{}\n", format_number(e.phi), format_number(e.re),
+        e.outside_validity ? "  (outside validity box: " + o.policy + ")" : "");
     if (e.phi_evaluated != e.phi || e.re_evaluated != e.re) {
-      std::cout << fmt::format("  F evaluated at the clamped point phi = {}, Re = {}; beta and K "
-                               "use the actual phi\n",
-                               format_number(e.phi_evaluated), format_number(e.re_evaluated));
+      std::cout << fmt::format(
+          "  F evaluated at the clamped point phi = {}, Re = {}; beta and K "
+          "use the actual phi\n",
+          format_number(e.phi_evaluated), format_number(e.re_evaluated));
     }
     std::cout << fmt::format("  F              = {}\n", format_number(e.F, 10));
     std::cout << fmt::format("  beta d^2/mu    = {}\n", format_number(e.beta_d2_over_mu, 10));
@@ -282,8 +291,8 @@ void run_diff(const CliContext& ctx, const std::string& ref_a, const std::string
     throw UsageError(fmt::format(
         "the validity boxes of {} and {} do not overlap (phi [{}, {}] vs [{}, {}], Re [{}, {}] vs "
         "[{}, {}])",
-        a->reference(), b->reference(), va.phi.min, va.phi.max, vb.phi.min, vb.phi.max,
-        va.re.min, va.re.max, vb.re.min, vb.re.max));
+        a->reference(), b->reference(), va.phi.min, va.phi.max, vb.phi.min, vb.phi.max, va.re.min,
+        va.re.max, vb.re.min, vb.re.max));
   }
   // Grid: phi uniform; Re = the lower bound plus log-spaced points up to the upper bound.
   std::vector<double> phis, res;
@@ -314,30 +323,33 @@ void run_diff(const CliContext& ctx, const std::string& ref_a, const std::string
   const double rms = std::sqrt(sum_sq / static_cast<double>(n));
   const bool same_content = a->record().content_hash == b->record().content_hash;
   if (ctx.json) {
-    ctx.print_json({{"a", a->reference()},
-                    {"b", b->reference()},
-                    {"same_content", same_content},
-                    {"grid", {{"phi", {phi.min, phi.max}}, {"re", {re.min, re.max}}, {"points", n}}},
-                    {"max_relative_difference", max_rel},
-                    {"at", {{"phi", at_phi}, {"re", at_re}, {"F_a", fa_at}, {"F_b", fb_at}}},
-                    {"rms_relative_difference", rms}});
+    ctx.print_json(
+        {{"a", a->reference()},
+         {"b", b->reference()},
+         {"same_content", same_content},
+         {"grid", {{"phi", {phi.min, phi.max}}, {"re", {re.min, re.max}}, {"points", n}}},
+         {"max_relative_difference", max_rel},
+         {"at", {{"phi", at_phi}, {"re", at_re}, {"F_a", fa_at}, {"F_b", fb_at}}},
+         {"rms_relative_difference", rms}});
     return;
   }
   std::cout << fmt::format("{} vs {}{}\n", a->reference(), b->reference(),
                            same_content ? "  (identical content hash)" : "");
   std::cout << fmt::format("  grid: {} points, phi in [{}, {}], Re in [{}, {}] (common validity)\n",
-                           n, format_number(phi.min), format_number(phi.max),
-                           format_number(re.min), format_number(re.max));
-  std::cout << fmt::format("  largest |F_b - F_a|/F_a = {:.4g} % at phi = {}, Re = {} "
-                           "(F_a = {}, F_b = {})\n",
-                           100 * max_rel, format_number(at_phi), format_number(at_re),
-                           format_number(fa_at), format_number(fb_at));
+                           n, format_number(phi.min), format_number(phi.max), format_number(re.min),
+                           format_number(re.max));
+  std::cout << fmt::format(
+      "  largest |F_b - F_a|/F_a = {:.4g} % at phi = {}, Re = {} "
+      "(F_a = {}, F_b = {})\n",
+      100 * max_rel, format_number(at_phi), format_number(at_re), format_number(fa_at),
+      format_number(fb_at));
   std::cout << fmt::format("  rms relative difference  = {:.4g} %\n", 100 * rms);
 }
 
 // ---- law export -----------------------------------------------------------------------------
 void run_export(const CliContext& ctx, const std::string& ref, const std::string& format,
                 const std::string& output) {
+  if (!output.empty() && output != "-") core::check_output_file(output, "--output");
   auto db = ctx.open_database();
   const LawRecord r = db->resolve(ref);
   const std::string text = export_law(r, export_format_from_string(format));
@@ -345,41 +357,28 @@ void run_export(const CliContext& ctx, const std::string& ref, const std::string
     std::cout << text;
     return;
   }
-  const std::string tmp = output + ".partial";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) {
-      throw UsageError("--output '" + output + "': cannot create the file (does the directory "
-                       "exist and is it writable?)");
-    }
-    out << text;
-    if (!out.flush()) {
-      out.close();
-      std::remove(tmp.c_str());
-      throw std::runtime_error("--output '" + output + "': write failed (disk full?)");
-    }
-  }
-  if (std::rename(tmp.c_str(), output.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("--output '" + output + "': cannot move the file into place");
-  }
+  core::write_file_atomically(output, text, "--output");
   ctx.info(fmt::format("wrote {} ({} export of {})", output, format, r.reference()));
 }
 
 // ---- law retract ----------------------------------------------------------------------------
 void run_retract(const CliContext& ctx, const std::string& ref, const std::string& reason) {
-  if (reason.size() < 3) throw UsageError("--reason is required (say why the law is retracted)");
   const std::size_t at = ref.find('@');
   if (at == std::string::npos || ref.find_first_not_of("0123456789", at + 1) != std::string::npos ||
       at + 1 == ref.size()) {
-    throw UsageError("law retract needs an explicit NAME@VERSION (e.g. " +
-                     ref.substr(0, at) + "@1), got '" + ref + "'");
+    throw UsageError("law retract needs an explicit NAME@VERSION (e.g. " + ref.substr(0, at) +
+                     "@1), got '" + ref + "'");
+  }
+  if (reason.find_first_not_of(" \t") == std::string::npos || reason.size() < 3) {
+    throw UsageError("--reason '" + reason +
+                     "' is too short: say why the law is retracted (at least 3 characters)");
   }
   auto db = ctx.open_database();
   const LawRecord r = db->resolve(ref);
   const LawRecord out = db->retract(r.name, r.version, reason);
   if (ctx.json) {
-    ctx.print_json({{"law", out.name}, {"version", out.version}, {"status", to_string(out.status)}});
+    ctx.print_json(
+        {{"law", out.name}, {"version", out.version}, {"status", to_string(out.status)}});
     return;
   }
   std::cout << fmt::format("{} retracted: {}\n", out.reference(), reason);
@@ -408,8 +407,11 @@ void run_compare(const CliContext& ctx, const std::string& phi_list, const std::
             out.push_back(evaluation_json(*law, evaluate(*law, phi, re, {})));
           } catch (const Error& e) {
             if (e.code() != ErrorCode::kOutOfValidity) throw;
-            out.push_back({{"law", law->record().name}, {"version", law->record().version},
-                           {"phi", phi}, {"re", re}, {"error", e.what()}});
+            out.push_back({{"law", law->record().name},
+                           {"version", law->record().version},
+                           {"phi", phi},
+                           {"re", re},
+                           {"error", e.what()}});
           }
         }
       }
@@ -420,7 +422,8 @@ void run_compare(const CliContext& ctx, const std::string& phi_list, const std::
   std::string table =
       "Published drag laws side by side: canonical drag-only F = F_d/(3 pi mu d eps u),\n"
       "Re = rho eps d u/mu (u interstitial slip). Values in parentheses lie outside the\n"
-      "law's validity box (extrapolated). Database: " + db->path() + "\n";
+      "law's validity box (extrapolated). Database: " +
+      db->path() + "\n";
   for (double re : res) {
     table += fmt::format("\nRe = {}\n{:<22}", format_number(re), "law \\ phi");
     for (double phi : phis) table += fmt::format(" {:>9}", format_number(phi));
@@ -460,13 +463,14 @@ void add_law_commands(CLI::App& app, CliContext& ctx) {
     auto published_only = std::make_shared<bool>(false);
     cmd->add_flag("--published", *published_only, "Only published versions");
     cmd->footer("Examples:\n  draglab law list\n  draglab law list --published --json");
-    cmd->callback([&ctx, published_only] { ctx.action = [&ctx, published_only] {
-                                              run_list(ctx, *published_only);
-                                            }; });
+    cmd->callback([&ctx, published_only] {
+      ctx.action = [&ctx, published_only] { run_list(ctx, *published_only); };
+    });
   }
   {
-    auto* cmd = law->add_subcommand("show", "Show one law version: parameters, conventions, "
-                                            "validity, provenance");
+    auto* cmd = law->add_subcommand("show",
+                                    "Show one law version: parameters, conventions, "
+                                    "validity, provenance");
     auto ref = std::make_shared<std::string>();
     cmd->add_option("law", *ref, "NAME, NAME@VERSION, NAME@latest or NAME@<hash prefix>")
         ->required();
@@ -485,10 +489,13 @@ void add_law_commands(CLI::App& app, CliContext& ctx) {
     cmd->add_option("--y", o->extra,
                     "Extra inputs of polydisperse forms: size ratio y = d_i/<d> (Sauter mean)");
     cmd->add_flag("--grid", o->grid, "Evaluate on a phi x Re grid");
-    cmd->add_option("--phi-list", o->phi_list, "Grid values of phi (comma separated)")->capture_default_str();
-    cmd->add_option("--re-list", o->re_list, "Grid values of Re (comma separated)")->capture_default_str();
+    cmd->add_option("--phi-list", o->phi_list, "Grid values of phi (comma separated)")
+        ->capture_default_str();
+    cmd->add_option("--re-list", o->re_list, "Grid values of Re (comma separated)")
+        ->capture_default_str();
     cmd->add_option("--range-policy", o->policy,
-                    "Outside the validity box: error, clamp or extrapolate")->capture_default_str()
+                    "Outside the validity box: error, clamp or extrapolate")
+        ->capture_default_str()
         ->check(CLI::IsMember({"error", "clamp", "extrapolate"}));
     cmd->footer(
         "Examples:\n  draglab law eval bvk2007 --phi 0.3 --re 50\n"
@@ -506,8 +513,9 @@ void add_law_commands(CLI::App& app, CliContext& ctx) {
     cmd->add_option("a", *a, "Reference law NAME[@VERSION]")->required();
     cmd->add_option("b", *b, "Other law NAME[@VERSION]")->required();
     cmd->add_option("--points", *points, "Grid points per axis")->capture_default_str();
-    cmd->footer("Examples:\n  draglab law diff bvk2007 tang2015\n  draglab law diff vdh2004 "
-                "bvk2007 --json");
+    cmd->footer(
+        "Examples:\n  draglab law diff bvk2007 tang2015\n  draglab law diff vdh2004 "
+        "bvk2007 --json");
     cmd->callback([&ctx, a, b, points] {
       ctx.action = [&ctx, a, b, points] { run_diff(ctx, *a, *b, *points); };
     });
@@ -519,7 +527,8 @@ void add_law_commands(CLI::App& app, CliContext& ctx) {
     auto format = std::make_shared<std::string>("c");
     auto output = std::make_shared<std::string>();
     cmd->add_option("law", *ref, "NAME[@VERSION]")->required();
-    cmd->add_option("--format", *format, "c, fortran or json")->capture_default_str()
+    cmd->add_option("--format", *format, "c, fortran or json")
+        ->capture_default_str()
         ->check(CLI::IsMember({"c", "fortran", "json"}));
     cmd->add_option("-o,--output", *output, "Output file (default: stdout)");
     cmd->footer(
@@ -543,11 +552,12 @@ void add_law_commands(CLI::App& app, CliContext& ctx) {
     });
   }
   {
-    auto* cmd = law->add_subcommand(
-        "compare", "Side-by-side table of F for every published monodisperse law");
+    auto* cmd = law->add_subcommand("compare",
+                                    "Side-by-side table of F for every published monodisperse law");
     auto phi_list = std::make_shared<std::string>("0.05,0.1,0.2,0.3,0.4,0.5,0.6");
     auto re_list = std::make_shared<std::string>("0,10,100,1000");
-    cmd->add_option("--phi-list", *phi_list, "Values of phi (comma separated)")->capture_default_str();
+    cmd->add_option("--phi-list", *phi_list, "Values of phi (comma separated)")
+        ->capture_default_str();
     cmd->add_option("--re-list", *re_list, "Values of Re (comma separated)")->capture_default_str();
     cmd->footer("Examples:\n  draglab law compare\n  draglab law compare --re-list 0,50 --json");
     cmd->callback([&ctx, phi_list, re_list] {

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <sstream>
 
 #include <fmt/core.h>
 
@@ -19,6 +20,7 @@
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
 #include "draglab/arrays/voxelization.h"
+#include "draglab/core/files.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/calibration.h"
 #include "draglab/lbm/convergence.h"
@@ -195,17 +197,6 @@ lbm::RunOptions run_options(const SolverOptions& s) {
   return r;
 }
 
-void ensure_writable_parent(const std::string& path, const std::string& field) {
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
-  const std::string d = dir.empty() ? "/" : dir;
-  struct stat st {};
-  if (::stat(d.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || access(d.c_str(), W_OK) != 0) {
-    throw UsageError(field + " '" + path + "': directory '" + dir +
-                     "' does not exist or is not writable");
-  }
-}
-
 /// Converged value or JSON null.
 nlohmann::json number_or_null(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
@@ -258,7 +249,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
   if (std::isnan(c.d)) throw UsageError("--d is required (lattice units per sphere diameter)");
   const Case the_case = load_case(c.case_options);
   check_resolution(the_case.packing, c.d, "--d", options, c.solver.precision);
-  if (!c.fields.empty()) ensure_writable_parent(c.fields, "--fields");
+  if (!c.fields.empty()) core::check_output_file(c.fields, "--fields");
   if (c.d_hydro != 0.0 && c.calibrate) throw UsageError("give --d-hydro or --calibrate, not both");
   if (c.d_hydro != 0.0) {
     if (!std::isfinite(c.d_hydro) || c.d_hydro < 0.5 * c.d || c.d_hydro > 1.5 * c.d) {
@@ -339,13 +330,22 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
                          : "Sangani-Acrivos series (SC, Stokes)";
     j["error"] = number_or_null(r.F / reference - 1.0);
   }
+  // A field file that fails after the run (disk full) must not cost the drag: the result is
+  // printed all the same, and the command then fails (exit 1) with the file error.
+  std::string fields_error;
   if (!c.fields.empty()) {
     lbm::FieldsWriteOptions fo;
     fo.dx = grid.dx;
     fo.run_json = j.dump();
-    lbm::write_fields(c.fields, fields, fo);
-    j["fields"] = c.fields;
-    j["fields_xdmf"] = lbm::xdmf_path_for(c.fields);
+    try {
+      lbm::write_fields(c.fields, fields, fo);
+      j["fields"] = c.fields;
+      j["fields_xdmf"] = lbm::xdmf_path_for(c.fields);
+    } catch (const std::exception& e) {
+      fields_error = e.what();
+      j["fields"] = nullptr;
+      j["fields_error"] = fields_error;
+    }
   }
 
   if (ctx.json) {
@@ -388,7 +388,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     std::cout << fmt::format("run              {}, {} steps, {:.2f} s, {:.1f} MFLUPS\n",
                              r.converged ? "converged" : "NOT CONVERGED", r.steps, r.wall_s,
                              r.mflups);
-    if (!c.fields.empty()) {
+    if (!c.fields.empty() && fields_error.empty()) {
       std::cout << fmt::format("fields           {} + {} (ParaView: XDMF Reader)\n", c.fields,
                                lbm::xdmf_path_for(c.fields));
     }
@@ -397,6 +397,12 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
   if (!r.converged) {
     throw std::runtime_error("the run did not converge: " + r.diagnosis +
                              " (no drag value reported)");
+  }
+  if (!fields_error.empty()) {
+    throw std::runtime_error(
+        "--fields: the result above is complete, but the field file was not "
+        "written: " +
+        fields_error);
   }
 }
 
@@ -459,7 +465,9 @@ void write_plot(const std::string& path, const std::string& tool,
   if (!mkdtemp(tmpl.data()))
     throw std::runtime_error("--plot: cannot create a temporary directory");
   const std::string dir = tmpl;
-  const std::string partial = path + ".partial.png";
+  // The tool writes into the temporary directory; the PNG is checked whole (a full disk leaves
+  // gnuplot a truncated file and exit status 0) and then written atomically in place.
+  const std::string partial = dir + "/plot.png";
   std::string command;
   if (tool == "gnuplot") {
     std::ofstream s(dir + "/plot.gp");
@@ -538,11 +546,26 @@ void write_plot(const std::string& path, const std::string& tool,
     std::ifstream e(dir + "/err.txt");
     std::getline(e, err, '\0');
   }
-  std::system(("rm -rf " + shell_quote(dir)).c_str());
-  if (status != 0 || std::rename(partial.c_str(), path.c_str()) != 0) {
-    std::remove(partial.c_str());
-    throw std::runtime_error("--plot: " + tool + " failed to write '" + path + "': " + err);
+  std::string png;
+  {
+    std::ifstream in(partial, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    png = bytes.str();
   }
+  std::system(("rm -rf " + shell_quote(dir)).c_str());
+  // A PNG starts with its 8-byte signature and ends with the IEND chunk (length 0, type, CRC).
+  static const std::string kSignature("\x89PNG\r\n\x1a\n", 8);
+  static const std::string kEnd("IEND\xae\x42\x60\x82", 8);
+  const bool whole = png.size() > kSignature.size() + kEnd.size() &&
+                     png.compare(0, kSignature.size(), kSignature) == 0 &&
+                     png.compare(png.size() - kEnd.size(), kEnd.size(), kEnd) == 0;
+  if (status != 0 || !whole) {
+    throw Error(ErrorCode::kIo,
+                "--plot: " + tool + " failed to write '" + path + "'" +
+                    (status == 0 ? ": the PNG it wrote is incomplete (disk full?)" : ": " + err));
+  }
+  core::write_file_atomically(path, png, "--plot");
 }
 
 void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c) {
@@ -576,7 +599,7 @@ void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c)
   if (!co.IsValid(&error)) throw UsageError(error);
   std::string tool;
   if (!c.plot.empty()) {
-    ensure_writable_parent(c.plot, "--plot");
+    core::check_output_file(c.plot, "--plot");
     tool = plot_tool();
     if (tool.empty()) {
       throw std::runtime_error(
@@ -592,7 +615,15 @@ void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c)
 
   const std::string title = fmt::format("{}, Re = {}: error vs wall time (reference: {})",
                                         the_case.description, c.solver.re, r.reference_source);
-  if (!c.plot.empty()) write_plot(c.plot, tool, r, title);
+  // As with lbm run's fields: a plot that fails is reported after the table, never instead.
+  std::string plot_error;
+  if (!c.plot.empty()) {
+    try {
+      write_plot(c.plot, tool, r, title);
+    } catch (const std::exception& e) {
+      plot_error = e.what();
+    }
+  }
 
   if (ctx.json) {
     nlohmann::json schemes = nlohmann::json::array();
@@ -628,11 +659,17 @@ void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c)
                         {"reference_spread", number_or_null(r.reference_spread)},
                         {"wall_s", r.wall_s},
                         {"schemes", schemes}};
-    if (!c.plot.empty()) j["plot"] = c.plot;
+    if (!c.plot.empty()) j["plot"] = plot_error.empty() ? nlohmann::json(c.plot) : nullptr;
+    if (!plot_error.empty()) j["plot_error"] = plot_error;
     ctx.print_json(j);
   } else {
     std::cout << the_case.description << "\n" << r.Table();
-    if (!c.plot.empty()) std::cout << fmt::format("plot: {} ({})\n", c.plot, tool);
+    if (!c.plot.empty() && plot_error.empty())
+      std::cout << fmt::format("plot: {} ({})\n", c.plot, tool);
+  }
+  if (!plot_error.empty()) {
+    throw std::runtime_error("the table above is complete, but the plot was not written: " +
+                             plot_error);
   }
 }
 

@@ -119,6 +119,28 @@ int main(int argc, char** argv) {
   draglab::cli::add_sensitivity_commands(app, ctx);
   draglab::cli::add_regress_commands(app, ctx);
 
+  // CLI11 answers a mistyped command with "A subcommand is required": name it instead.
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--db") {
+      ++i;
+      continue;
+    }
+    if (arg.empty() || arg[0] == '-') continue;
+    bool known = false;
+    std::string names;
+    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+      known = known || sub->get_name() == arg;
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "error: unknown command '" << arg << "' (commands: " << names
+                << "; draglab --help)\n";
+      return 2;
+    }
+    break;
+  }
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

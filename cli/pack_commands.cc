@@ -12,10 +12,12 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "cli/file_util.h"
 #include "cli/progress.h"
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
 #include "draglab/arrays/voxelization.h"
+#include "draglab/core/files.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -25,6 +27,7 @@ namespace {
 struct PackOptions {
   // random
   double phi = std::nan("");
+  bool phi_given = false;
   int n = 0;
   std::string dist = "mono";
   double size_ratio = 2.0;
@@ -44,6 +47,24 @@ struct PackOptions {
   std::string out_dir;
 };
 
+/// The library names its fields (size_ratio = 9 is outside ...); the user typed options.
+std::string with_option_names(const std::string& message) {
+  static const std::pair<const char*, const char*> kOptions[] = {
+      {"large_volume_fraction", "--large-fraction"},
+      {"size_ratio", "--size-ratio"},
+      {"lognormal_sigma", "--sigma"},
+      {"min_gap", "--min-gap"},
+      {"equilibration_sweeps", "--sweeps"},
+      {"aspect", "--aspect"},
+      {"phi", "--phi"},
+      {"n ", "--n"},
+      {"cells", "--cells"}};
+  for (const auto& [field, option] : kOptions) {
+    if (message.rfind(field, 0) == 0) return std::string(option) + ": " + message;
+  }
+  return message;
+}
+
 arrays::RandomPackingOptions random_options(const PackOptions& o) {
   arrays::RandomPackingOptions r;
   r.phi = o.phi;
@@ -58,7 +79,7 @@ arrays::RandomPackingOptions random_options(const PackOptions& o) {
   if (o.aspect.size() != 3) throw UsageError("--aspect takes three values, e.g. 1,1,2");
   r.aspect = {o.aspect[0], o.aspect[1], o.aspect[2]};
   std::string error;
-  if (!r.IsValid(&error)) throw UsageError(error);
+  if (!r.IsValid(&error)) throw UsageError(with_option_names(error));
   return r;
 }
 
@@ -91,15 +112,11 @@ void print_statistics(const arrays::Packing& p, const arrays::PackingStatistics&
                            100.0 * s.crystalline_fraction, s.mean_neighbours);
 }
 
-void ensure_writable_parent(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash);
-  struct stat st {};
-  if (::stat(dir.empty() ? "/" : dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) ||
-      access(dir.empty() ? "/" : dir.c_str(), W_OK) != 0) {
-    throw UsageError("--out '" + path + "': directory '" + dir +
-                     "' does not exist or is not "
-                     "writable");
+void check_phi_given(const PackOptions& o) {
+  if (!o.phi_given) throw UsageError("--phi is required");
+  if (!std::isfinite(o.phi)) {
+    throw UsageError("--phi: '" + std::to_string(o.phi) +
+                     "' is not a finite number (random packings: (0, 0.64])");
   }
 }
 
@@ -111,7 +128,7 @@ arrays::Packing generate(const PackOptions& o, const CliContext& ctx,
     oo.phi = o.phi;
     oo.cells = o.cells;
     std::string error;
-    if (!oo.IsValid(&error)) throw UsageError(error);
+    if (!oo.IsValid(&error)) throw UsageError(with_option_names(error));
     return arrays::generate_ordered_packing(oo);
   }
   if (o.n == 0) throw UsageError("--n is required for random packings (or use --ordered)");
@@ -124,9 +141,9 @@ arrays::Packing generate(const PackOptions& o, const CliContext& ctx,
 }
 
 void run_pack(const CliContext& ctx, const PackOptions& o) {
-  if (std::isnan(o.phi)) throw UsageError("--phi is required");
+  check_phi_given(o);
   if (o.out.empty()) throw UsageError("--out FILE.h5 is required");
-  ensure_writable_parent(o.out);
+  core::check_output_file(o.out, "--out");
   arrays::GenerationSummary summary;
   const auto start = std::chrono::steady_clock::now();
   const arrays::Packing p = generate(o, ctx, &summary);
@@ -155,15 +172,13 @@ void run_pack(const CliContext& ctx, const PackOptions& o) {
 }
 
 void run_ensemble(const CliContext& ctx, const PackOptions& o) {
-  if (std::isnan(o.phi)) throw UsageError("--phi is required");
+  check_phi_given(o);
   if (o.realizations < 1 || o.realizations > 10000) {
     throw UsageError("--realizations must lie in [1, 10000]");
   }
   if (o.out_dir.empty()) throw UsageError("--out-dir DIR is required");
-  if (::mkdir(o.out_dir.c_str(), 0777) != 0 && errno != EEXIST) {
-    throw UsageError("--out-dir '" + o.out_dir + "' cannot be created");
-  }
-  ensure_writable_parent(o.out_dir + "/x");
+  core::check_output_directory(o.out_dir, "--out-dir");
+  make_directories(o.out_dir, "--out-dir");
   nlohmann::json out = nlohmann::json::array();
   double sum_g = 0, sum_g2 = 0;
   for (int r = 0; r < o.realizations; ++r) {
@@ -258,7 +273,8 @@ void add_pack_commands(CLI::App& app, CliContext& ctx) {
   auto add_generation_options = [o](CLI::App* cmd) {
     cmd->add_option("--phi", o->phi,
                     "Solids fraction: random (0, 0.64], ordered up to close "
-                    "packing");
+                    "packing")
+        ->each([o](const std::string&) { o->phi_given = true; });
     cmd->add_option("--n", o->n, "Number of spheres (random), >= 1");
     cmd->add_option("--dist", o->dist, "Size distribution: mono, bi or lognormal")
         ->capture_default_str()

@@ -3,6 +3,7 @@
 //   draglab scene umf data/scenes/dpm_bubble.toml [--law ergun@1,bvk2007@1] [--json]
 //   draglab scene check data/scenes/dpm_bubble.toml [--json]
 //   draglab scene run data/scenes/dpm_bubble_quick.toml [--law ergun@1] [--duration S] [--json]
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -29,7 +30,8 @@ using consumers::Scene;
 struct SceneArgs {
   std::string scene_path;
   std::string laws;       // --law a,b,c
-  double duration_s = 0;  // scene run --duration (0: the scene's)
+  double duration_s = 0;  // scene run --duration (not given: the scene's)
+  bool duration_given = false;
   bool no_store = false;  // scene run --no-store
 };
 
@@ -177,8 +179,12 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
 }
 
 void run_run(const CliContext& ctx, const SceneArgs& args) {
+  if (args.duration_given && !(args.duration_s > 0.0 && std::isfinite(args.duration_s)))
+    throw UsageError(
+        fmt::format("--duration = {} must be a time > 0 s (leave it out for the "
+                    "scene's [time] duration_s)",
+                    format_number(args.duration_s)));
   const Scene scene = consumers::load_scene(args.scene_path);
-  if (args.duration_s < 0.0) throw UsageError("--duration must be >= 0 (0: the scene's)");
   const std::string ref = args.laws.empty() ? scene.laws.front() : args.laws;
   if (ref.find(',') != std::string::npos)
     throw UsageError("--law: `scene run` takes one NAME@V (use `draglab sensitivity` for several)");
@@ -188,7 +194,7 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
       db->load(ref, range_policy_from_string(scene.range_policy), &warning);
   if (!warning.empty()) ctx.warn(warning);
   consumers::BedRunOptions options;
-  options.duration_s = args.duration_s;
+  options.duration_s = args.duration_given ? args.duration_s : 0.0;  // 0: the scene's
   ProgressLine progress(!ctx.quiet);
   const consumers::BedResult r = consumers::run_bed_model(
       scene, law, options, [&](double f, const std::string& stage) { progress.update(f, stage); });
@@ -304,7 +310,8 @@ void add_scene_commands(CLI::App& app, CliContext& ctx) {
   run->add_option("SCENE", run_args->scene_path, "Scene file (TOML)")->required();
   run->add_option("--law", run_args->laws, "One law NAME@V (default: the scene's first)");
   run->add_option("--duration", run_args->duration_s,
-                  "Simulated time after the flow starts [s] (default: the scene's)");
+                  "Simulated time after the flow starts [s] (default: the scene's)")
+      ->each([run_args](const std::string&) { run_args->duration_given = true; });
   run->add_flag("--no-store", run_args->no_store,
                 "Do not store the result in the database (stored by default: scene text, law "
                 "content hash, code version, metrics)");

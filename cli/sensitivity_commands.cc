@@ -61,8 +61,10 @@ struct SensitivityArgs {
   std::string laws;  // --laws a@1,b@1
   std::string uncertainty = "realizations";
   int realizations = 2;
-  double duration_s = 0.0;
-  double t_ref_s = -1.0;  // --t-ref: the snapshot time after injection (< 0: the scene's)
+  double duration_s = 0.0;  // --duration (not given: the scene's)
+  bool duration_given = false;
+  double t_ref_s = -1.0;  // --t-ref: the snapshot time after injection (not given: the scene's)
+  bool t_ref_given = false;
   std::string out_dir;
   bool no_figure = false;
   std::string beside;  // --beside OTHER/sensitivity.json: fig5.png, OTHER's panels above these
@@ -487,21 +489,27 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
         "--law, --grids, --contact-steps, --cfl and --dt belong to --work-precision (the law "
         "table takes --laws a@1,b@1)");
   }
-  if (args.duration_s < 0.0 || !std::isfinite(args.duration_s))
-    throw UsageError("--duration must be >= 0 s (0: the scene's)");
+  if (args.duration_given && !(args.duration_s > 0.0 && std::isfinite(args.duration_s)))
+    throw UsageError(
+        fmt::format("--duration = {} must be a time > 0 s (leave it out for the "
+                    "scene's [time] duration_s)",
+                    format_number(args.duration_s)));
+  if (args.t_ref_given && !(args.t_ref_s >= 0.0 && std::isfinite(args.t_ref_s)))
+    throw UsageError(
+        fmt::format("--t-ref = {} must be a time >= 0 s after the jet start (leave "
+                    "it out for the scene's [time] t_ref_s)",
+                    format_number(args.t_ref_s)));
 
   Scene scene = consumers::load_scene(args.scene_path);
-  if (args.t_ref_s >= 0.0) {
+  if (args.t_ref_given) {
     // Another snapshot time of the same bed (the seed's Fig. 5 compares at 0.2 s, its Fig. 4 at
     // 0.3 s); the scene's checks apply (t_ref within the duration).
     scene.time.t_ref_s = args.t_ref_s;
     std::string why;
     if (!scene.IsValid(&why)) throw UsageError("--t-ref: " + why);
-  } else if (args.t_ref_s != -1.0) {
-    throw UsageError("--t-ref must be >= 0 s (the snapshot time after the jet start)");
   }
   consumers::BedRunOptions run;
-  run.duration_s = args.duration_s;
+  run.duration_s = args.duration_given ? args.duration_s : 0.0;  // 0: the scene's
 
   consumers::SensitivityOptions sens;
   consumers::WorkPrecisionOptions wp;
@@ -526,6 +534,9 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
       for (double v : parse_double_list(list, flag)) {
         if (step.whole_number && v != std::floor(v))
           throw UsageError(fmt::format("{}: {} is not a whole number ({}, {})", flag,
+                                       format_number(v), step.description, step.range));
+        if (!(v > 0.0 && std::isfinite(v)))
+          throw UsageError(fmt::format("{}: {} is not a positive number ({}, {})", flag,
                                        format_number(v), step.description, step.range));
         wp.time_resolutions.push_back(v);
       }
@@ -695,9 +706,11 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
                   "Realizations (packings, injection seeds) for --uncertainty realizations or "
                   "both, [2, 32] (default 2)");
   cmd->add_option("--t-ref", args->t_ref_s,
-                  "Snapshot time after the jet start [s] (default: the scene's [time] t_ref_s)");
+                  "Snapshot time after the jet start [s] (default: the scene's [time] t_ref_s)")
+      ->each([args](const std::string&) { args->t_ref_given = true; });
   cmd->add_option("--duration", args->duration_s,
-                  "Simulated time after the flow starts [s] (default: the scene's)");
+                  "Simulated time after the flow starts [s] (default: the scene's)")
+      ->each([args](const std::string&) { args->duration_given = true; });
   cmd->add_option("--out", args->out_dir,
                   "Output folder for the JSON data and the PNG (default out/<scene>_sensitivity)");
   cmd->add_flag("--no-figure", args->no_figure,

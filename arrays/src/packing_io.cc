@@ -5,10 +5,12 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "drag_db_version.h"
+#include "draglab/core/hdf5_file.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -172,46 +174,37 @@ void write_packing_hdf5(const std::string& path, const Packing& packing,
                         const PackingStatistics* statistics) {
   silence_hdf5();
   if (path.empty()) fail(path, "empty output path");
-  const std::string tmp = path + ".partial";
-  try {
-    {
-      Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-      if (!file.ok()) fail(path, "cannot create the file (is the directory writable?)");
-      Handle group(H5Gcreate2(file.get(), "packing", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                   H5Gclose);
-      if (!group.ok()) fail(path, "cannot create group /packing");
-      const hsize_t n = packing.size();
-      write_dataset(group.get(), "centers", {n, 3}, n ? packing.centers.front().data() : nullptr,
-                    path);
-      write_dataset(group.get(), "radii", {n}, packing.radii.data(), path);
-      write_dataset(group.get(), "box_length", {3}, packing.box_length.data(), path);
-      const long long count = static_cast<long long>(n);
-      const unsigned long long seed = packing.seed;
-      write_double(group.get(), "phi", packing.phi(), path);
-      write_attribute(group.get(), "n", H5T_STD_I64LE, H5T_NATIVE_LLONG, &count, path);
-      write_attribute(group.get(), "seed", H5T_STD_U64LE, H5T_NATIVE_ULLONG, &seed, path);
-      write_string(group.get(), "generator", packing.generator, path);
-      write_string(group.get(), "settings", packing.settings_json, path);
-      write_string(group.get(), "length_unit",
-                   "reference diameter d_ref (Sauter mean diameter; the diameter if monodisperse)",
-                   path);
-      write_string(group.get(), "draglab_version", kDragDbVersion, path);
-      if (statistics) {
-        write_double(group.get(), "min_gap", statistics->min_gap, path);
-        write_double(group.get(), "q6", statistics->q6, path);
-        write_double(group.get(), "g_contact", statistics->g_contact, path);
-        write_double(group.get(), "crystalline_fraction", statistics->crystalline_fraction, path);
-        write_double(group.get(), "mean_neighbours", statistics->mean_neighbours, path);
-      }
-      if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) fail(path, "cannot flush the file");
+  // Built in memory and saved whole: a failed write (disk full) leaves no file and no half-closed
+  // HDF5 handle behind (core/hdf5_file.h).
+  core::Hdf5MemoryFile file("packing file");
+  {
+    Handle group(H5Gcreate2(file.id(), "packing", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    if (!group.ok()) fail(path, "cannot create group /packing");
+    const hsize_t n = packing.size();
+    write_dataset(group.get(), "centers", {n, 3}, n ? packing.centers.front().data() : nullptr,
+                  path);
+    write_dataset(group.get(), "radii", {n}, packing.radii.data(), path);
+    write_dataset(group.get(), "box_length", {3}, packing.box_length.data(), path);
+    const long long count = static_cast<long long>(n);
+    const unsigned long long seed = packing.seed;
+    write_double(group.get(), "phi", packing.phi(), path);
+    write_attribute(group.get(), "n", H5T_STD_I64LE, H5T_NATIVE_LLONG, &count, path);
+    write_attribute(group.get(), "seed", H5T_STD_U64LE, H5T_NATIVE_ULLONG, &seed, path);
+    write_string(group.get(), "generator", packing.generator, path);
+    write_string(group.get(), "settings", packing.settings_json, path);
+    write_string(group.get(), "length_unit",
+                 "reference diameter d_ref (Sauter mean diameter; the diameter if monodisperse)",
+                 path);
+    write_string(group.get(), "draglab_version", kDragDbVersion, path);
+    if (statistics) {
+      write_double(group.get(), "min_gap", statistics->min_gap, path);
+      write_double(group.get(), "q6", statistics->q6, path);
+      write_double(group.get(), "g_contact", statistics->g_contact, path);
+      write_double(group.get(), "crystalline_fraction", statistics->crystalline_fraction, path);
+      write_double(group.get(), "mean_neighbours", statistics->mean_neighbours, path);
     }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-      fail(path, "cannot move the finished file into place");
-    }
-  } catch (...) {
-    std::remove(tmp.c_str());
-    throw;
   }
+  file.save(path);
 }
 
 Packing read_packing_hdf5(const std::string& path) {

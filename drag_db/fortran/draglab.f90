@@ -32,6 +32,7 @@ module draglab_mod
   integer(c_int), parameter, public :: DRAGLAB_SCHEMA_TOO_NEW = 6
   integer(c_int), parameter, public :: DRAGLAB_NOT_A_DATABASE = 7
   integer(c_int), parameter, public :: DRAGLAB_INTERNAL = 8
+  integer(c_int), parameter, public :: DRAGLAB_IO_ERROR = 9
   ! Range policies for inputs outside the law's validity box.
   integer(c_int), parameter, public :: DRAGLAB_RANGE_ERROR = 0
   integer(c_int), parameter, public :: DRAGLAB_RANGE_CLAMP = 1

@@ -41,6 +41,7 @@ DATABASE_ERROR = 5
 SCHEMA_TOO_NEW = 6
 NOT_A_DATABASE = 7
 INTERNAL = 8
+IO_ERROR = 9
 
 # Range policies for inputs outside a law's validity box.
 RANGE_ERROR = 0

@@ -6,12 +6,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "drag_db_version.h"
+#include "draglab/core/files.h"
+#include "draglab/core/hdf5_file.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -206,54 +209,41 @@ void write_fields(const std::string& h5_path, const Fields& fields,
   if (!(options.dx > 0.0) || !std::isfinite(options.dx)) fail(path, "dx must be finite and > 0");
   check_fields(fields, path);
   const std::string xmf = xdmf_path_for(path);
-  const std::string tmp = path + ".partial";
-  const std::string xmf_tmp = xmf + ".partial";
+  // Built in memory and saved whole: a failed write (disk full) leaves no file and no half-closed
+  // HDF5 handle behind (core/hdf5_file.h).
+  core::Hdf5MemoryFile file("fields file");
+  {
+    Handle group(H5Gcreate2(file.id(), "fields", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+    if (!group.ok()) fail(path, "cannot create group /fields");
+    const hsize_t nx = static_cast<hsize_t>(fields.dims[0]);
+    const hsize_t ny = static_cast<hsize_t>(fields.dims[1]);
+    const hsize_t nz = static_cast<hsize_t>(fields.dims[2]);
+    write_dataset(group.get(), "velocity", {nz, ny, nx, 3}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT,
+                  fields.velocity.data(), path);
+    write_dataset(group.get(), "density", {nz, ny, nx}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT,
+                  fields.density.data(), path);
+    write_dataset(group.get(), "solid", {nz, ny, nx}, H5T_STD_U8LE, H5T_NATIVE_UINT8,
+                  fields.solid.data(), path);
+    const long long dims[3] = {fields.dims[0], fields.dims[1], fields.dims[2]};
+    write_attribute(group.get(), "dims", H5T_STD_I64LE, H5T_NATIVE_LLONG, {3}, dims, path);
+    write_attribute(group.get(), "dx", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, &options.dx, path);
+    write_string(group.get(), "layout",
+                 "C order [nz, ny, nx(, 3)]: x fastest; node (i, j, k) at ((i + 1/2) dx, "
+                 "(j + 1/2) dx, (k + 1/2) dx)",
+                 path);
+    write_string(group.get(), "length_unit", "reference diameter d_ref (dx = d_ref/resolution)",
+                 path);
+    write_string(group.get(), "velocity_unit", "lattice units (dx/dt)", path);
+    write_string(group.get(), "draglab_version", kDragDbVersion, path);
+    if (!options.run_json.empty()) write_string(group.get(), "run", options.run_json, path);
+  }
+  file.save(path);
+  // The XDMF file describes the HDF5 file: without it the pair is incomplete, so a failure
+  // removes the HDF5 file too.
   try {
-    {
-      Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-      if (!file.ok()) fail(path, "cannot create the file (is the directory writable?)");
-      Handle group(H5Gcreate2(file.get(), "fields", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                   H5Gclose);
-      if (!group.ok()) fail(path, "cannot create group /fields");
-      const hsize_t nx = static_cast<hsize_t>(fields.dims[0]);
-      const hsize_t ny = static_cast<hsize_t>(fields.dims[1]);
-      const hsize_t nz = static_cast<hsize_t>(fields.dims[2]);
-      write_dataset(group.get(), "velocity", {nz, ny, nx, 3}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT,
-                    fields.velocity.data(), path);
-      write_dataset(group.get(), "density", {nz, ny, nx}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT,
-                    fields.density.data(), path);
-      write_dataset(group.get(), "solid", {nz, ny, nx}, H5T_STD_U8LE, H5T_NATIVE_UINT8,
-                    fields.solid.data(), path);
-      const long long dims[3] = {fields.dims[0], fields.dims[1], fields.dims[2]};
-      write_attribute(group.get(), "dims", H5T_STD_I64LE, H5T_NATIVE_LLONG, {3}, dims, path);
-      write_attribute(group.get(), "dx", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, {}, &options.dx, path);
-      write_string(group.get(), "layout",
-                   "C order [nz, ny, nx(, 3)]: x fastest; node (i, j, k) at ((i + 1/2) dx, "
-                   "(j + 1/2) dx, (k + 1/2) dx)",
-                   path);
-      write_string(group.get(), "length_unit", "reference diameter d_ref (dx = d_ref/resolution)",
-                   path);
-      write_string(group.get(), "velocity_unit", "lattice units (dx/dt)", path);
-      write_string(group.get(), "draglab_version", kDragDbVersion, path);
-      if (!options.run_json.empty()) write_string(group.get(), "run", options.run_json, path);
-      if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0) fail(path, "cannot flush the file");
-    }
-    {
-      std::ofstream out(xmf_tmp, std::ios::trunc);
-      out << xdmf_text(base_name(path), fields, options.dx);
-      out.close();
-      if (!out) fail(xmf, "cannot write the XDMF file (is the directory writable?)");
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-      fail(path, "cannot move the finished file into place");
-    }
-    if (std::rename(xmf_tmp.c_str(), xmf.c_str()) != 0) {
-      std::remove(path.c_str());
-      fail(xmf, "cannot move the finished file into place");
-    }
+    core::write_file_atomically(xmf, xdmf_text(base_name(path), fields, options.dx), "XDMF file");
   } catch (...) {
-    std::remove(tmp.c_str());
-    std::remove(xmf_tmp.c_str());
+    std::remove(path.c_str());
     throw;
   }
 }

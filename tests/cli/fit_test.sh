@@ -71,7 +71,7 @@ C1 = -1.0 + 1.5 * phi - 1.2 * phi * phi
 truth = 180 * phi / (18 * e * e) + 20 / 18 * e * (1 + 1.2 * math.sqrt(phi)) + (1.75 + C1) * 20 / (18 * e * e)
 assert abs(F / truth - 1) < 1e-8, (F, truth)
 '
-check "publishing twice is refused (immutable: exit 1)" 1 "$draglab" --db "$db" law publish eq6_test@1
+check "publishing twice is refused (immutable: bad input, exit 2)" 2 "$draglab" --db "$db" law publish eq6_test@1
 if grep -q immutable "$work/err"; then passed=$((passed + 1)); else
   echo "FAIL publishing twice: no 'immutable' in the message"; failures=$((failures + 1)); fi
 

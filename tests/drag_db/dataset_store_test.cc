@@ -198,7 +198,17 @@ TEST(DatasetStore, CsvRoundTripAndMalformedFiles) {
              "0.3,0,5,0.1,10;20,5\n",
              "one F per resolution"},
         Case{"phi,re,F,F_uncertainty\n0.3,0,1e300,0.1\n", "F = "},
-        Case{"phi,re,F,F_uncertainty\n0.3,1e300,5,0.1\n", "re = "}}) {
+        Case{"phi,re,F,F_uncertainty\n0.3,1e300,5,0.1\n", "re = "},
+        // Stored without complaint before the hardening: a misspelt optional column was dropped,
+        // an order or extrapolation outside what the builder writes was kept forever.
+        Case{"phi,re,F,F_uncertainty,realisations\n0.3,0,5,0.1,3\n", "unknown column"},
+        Case{"phi,re,F,F_uncertainty,order\n0.3,0,5,0.1,-1\n", "order = "},
+        Case{"phi,re,F,F_uncertainty,extrapolation\n0.3,0,5,0.1,magic\n", "extrapolation = "},
+        // fuzz/fuzz_dataset_csv: a byte that is not UTF-8 in the free-text extrapolation column
+        // reached the hash's JSON dump and left read_dataset_csv as nlohmann's type_error.
+        Case{"phi,re,F,F_uncertainty,extrapolation\n0.3,0,5,0.1,\xDEinverse_d\n",
+             "extrapolation = "},
+        Case{"phi,(e_target,re,F,F_uncertainty\n0.3,0,0,5,0.1\n", "unknown column '(e_target'"}}) {
     try {
       read_dataset_csv(write(c.text));
       FAIL() << "accepted: " << c.text;
@@ -208,6 +218,9 @@ TEST(DatasetStore, CsvRoundTripAndMalformedFiles) {
     }
   }
   EXPECT_THROW(read_dataset_csv(dir.file("missing.csv")), Error);
+  // A file name that is not UTF-8 still imports (its name is kept with the bad byte replaced).
+  std::ofstream(dir.file("bad\xDEname.csv")) << "phi,re,F,F_uncertainty\n0.3,0,5.1,0.1\n";
+  EXPECT_NO_THROW(read_dataset_csv(dir.file("bad\xDEname.csv")));
 }
 
 }  // namespace

@@ -41,6 +41,7 @@ extern "C" {
 #define DRAGLAB_SCHEMA_TOO_NEW 6    /* database written by a newer draglab */
 #define DRAGLAB_NOT_A_DATABASE 7    /* corrupt or non-SQLite file */
 #define DRAGLAB_INTERNAL 8
+#define DRAGLAB_IO_ERROR 9          /* a file could not be written or read (disk full, ...) */
 
 /* Range policies for inputs inside physical bounds but outside the law's validity box. */
 #define DRAGLAB_RANGE_ERROR 0       /* default: return DRAGLAB_OUT_OF_VALIDITY */

@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "draglab/drag_db/export.h"
 #include "drag_db_version.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/drag_db/export.h"
 #include "draglab/drag_db/law.h"
 
 struct draglab_db {
@@ -49,6 +49,7 @@ static_assert(DRAGLAB_DATABASE_ERROR == static_cast<int>(ErrorCode::kDatabase), 
 static_assert(DRAGLAB_SCHEMA_TOO_NEW == static_cast<int>(ErrorCode::kSchemaTooNew), "");
 static_assert(DRAGLAB_NOT_A_DATABASE == static_cast<int>(ErrorCode::kNotADatabase), "");
 static_assert(DRAGLAB_INTERNAL == static_cast<int>(ErrorCode::kInternal), "");
+static_assert(DRAGLAB_IO_ERROR == static_cast<int>(ErrorCode::kIo), "");
 
 /// Records `message` for draglab_last_error(); never throws (an allocation failure leaves the
 /// previous message, which is still better than an exception across the ABI).

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -146,7 +147,14 @@ void validate_point(const DatasetPoint& p, const std::string& where) {
   if (p.realizations < 0 || p.realizations > kMaxRealizations) {
     fail("realizations", p.realizations, "an integer in [0, 100000] (0 = not stated)");
   }
-  if (!std::isfinite(p.order)) fail("order", p.order, "finite");
+  // A convergence order in d beyond 10 is no measured order (Richardson's is kept in [0.25, 6]).
+  if (!(p.order >= 0.0 && p.order <= 10.0)) fail("order", p.order, "[0, 10] (0 = not measured)");
+  if (!p.extrapolation.empty() && p.extrapolation != "richardson" &&
+      p.extrapolation != "inverse_d" && p.extrapolation != "finest") {
+    throw Error(ErrorCode::kInvalidArgument,
+                where + ": extrapolation = '" + p.extrapolation +
+                    "' is not one of richardson, inverse_d, finest (or empty: not stated)");
+  }
   if (!(p.wall_s >= 0.0 && std::isfinite(p.wall_s))) fail("wall_s", p.wall_s, "finite, >= 0");
   if (p.resolutions.size() != p.F_at_resolution.size()) {
     throw Error(ErrorCode::kInvalidArgument, where + ": " + std::to_string(p.resolutions.size()) +
@@ -301,6 +309,12 @@ Dataset read_dataset_csv(const std::string& path) {
   if (dataset.name.size() > 4 && dataset.name.substr(dataset.name.size() - 4) == ".csv") {
     dataset.name.resize(dataset.name.size() - 4);
   }
+  // A file name need not be UTF-8, but the stored name is printed as JSON: bad bytes become
+  // U+FFFD.
+  dataset.name =
+      nlohmann::json::parse(nlohmann::json(dataset.name)
+                                .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace))
+          .get<std::string>();
   while (std::getline(in, line)) {
     ++line_number;
     const auto first = line.find_first_not_of(" \t\r");
@@ -308,10 +322,31 @@ Dataset read_dataset_csv(const std::string& path) {
     const std::string where = "'" + path + "' line " + std::to_string(line_number);
     if (header.empty()) {
       header = split(line, ',');
+      static const std::set<std::string> kKnownColumns = {"phi",
+                                                          "re",
+                                                          "re_target",
+                                                          "F",
+                                                          "F_uncertainty",
+                                                          "F_standard_error",
+                                                          "F_discretisation_error",
+                                                          "realizations",
+                                                          "resolutions",
+                                                          "F_at_resolution",
+                                                          "order",
+                                                          "extrapolation",
+                                                          "wall_s"};
       for (std::size_t c = 0; c < header.size(); ++c) {
         if (!column.emplace(header[c], c).second) {
           throw Error(ErrorCode::kInvalidArgument,
                       where + ": the header names column '" + header[c] + "' twice");
+        }
+        // A misspelt optional column would be dropped silently and stored without it forever.
+        if (!kKnownColumns.count(header[c])) {
+          throw Error(ErrorCode::kInvalidArgument,
+                      where + ": unknown column '" + header[c] +
+                          "' (required: phi,re,F,F_uncertainty; optional: re_target, "
+                          "F_standard_error, F_discretisation_error, realizations, resolutions, "
+                          "F_at_resolution, order, extrapolation, wall_s)");
         }
       }
       for (const char* required : {"phi", "re", "F", "F_uncertainty"}) {
@@ -424,22 +459,22 @@ std::string dataset_csv_text(const Dataset& dataset, const std::vector<std::stri
 void write_dataset_csv(const Dataset& dataset, const std::string& path,
                        const std::vector<std::string>& provenance) {
   const std::string text = dataset_csv_text(dataset, provenance);
-  // Write to a temporary name and rename, so a reader never sees half a file.
+  // Write to a temporary name and rename, so a reader never sees half a file; a failure leaves
+  // neither the temporary nor a partial file behind.
   const std::string temporary = path + ".tmp";
+  const auto fail = [&](ErrorCode code, const std::string& what, int error) {
+    std::remove(temporary.c_str());
+    throw Error(code, what + " '" + path + "' failed: " + std::strerror(error));
+  };
   {
     std::ofstream file(temporary, std::ios::trunc);
-    if (!file) {
-      throw Error(ErrorCode::kInvalidArgument,
-                  "cannot write '" + path + "': " + std::strerror(errno));
-    }
+    if (!file) fail(ErrorCode::kInvalidArgument, "creating", errno);
     file << text;
-    if (!file.flush()) {
-      throw Error(ErrorCode::kDatabase, "writing '" + path + "' failed: " + std::strerror(errno));
-    }
+    if (!file.flush()) fail(ErrorCode::kDatabase, "writing", errno);
   }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    throw Error(ErrorCode::kDatabase,
-                "renaming '" + temporary + "' to '" + path + "' failed: " + std::strerror(errno));
+    fail(errno == EISDIR ? ErrorCode::kInvalidArgument : ErrorCode::kDatabase, "moving into place",
+         errno);
   }
 }
 

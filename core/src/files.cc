@@ -1,0 +1,137 @@
+// core/src/files.cc: see draglab/core/files.h.
+#include "draglab/core/files.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace core {
+namespace {
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+std::string parent_directory(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+[[noreturn]] void bad_path(const std::string& field, const std::string& path,
+                           const std::string& what) {
+  throw Error(ErrorCode::kInvalidArgument, field + " " + quoted(path) + ": " + what);
+}
+
+/// Whether a file can be created in `dir`: a probe file is made and removed (access(2) says yes
+/// to root on read-only mounts and in /proc).
+bool can_create_in(const std::string& dir, int* error) {
+  std::string probe = dir + "/.draglab_probe_XXXXXX";
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) {
+    *error = errno;
+    return false;
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return true;
+}
+
+void check_can_create_in(const std::string& dir, const std::string& path,
+                         const std::string& field) {
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0) {
+    bad_path(field, path, "directory " + quoted(dir) + " does not exist (create it first)");
+  }
+  if (!S_ISDIR(st.st_mode)) bad_path(field, path, quoted(dir) + " is not a directory");
+  int error = 0;
+  if (!can_create_in(dir, &error)) {
+    bad_path(field, path,
+             "cannot create files in directory " + quoted(dir) + ": " + std::strerror(error));
+  }
+}
+
+/// errno values that mean the path itself cannot be written (the caller's input), not that the
+/// system failed while writing.
+bool is_path_error(int error) {
+  return error == ENOENT || error == EACCES || error == EPERM || error == EISDIR ||
+         error == ENOTDIR || error == EROFS || error == ENAMETOOLONG || error == ELOOP;
+}
+
+}  // namespace
+
+void check_output_file(const std::string& path, const std::string& field) {
+  if (path.empty()) throw Error(ErrorCode::kInvalidArgument, field + ": empty path (give a file)");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) bad_path(field, path, "is a directory (give a file name inside it)");
+    if (!S_ISREG(st.st_mode)) bad_path(field, path, "exists and is not a regular file");
+  }
+  check_can_create_in(parent_directory(path), path, field);
+}
+
+void check_output_directory(const std::string& path, const std::string& field) {
+  if (path.empty()) {
+    throw Error(ErrorCode::kInvalidArgument, field + ": empty path (give a folder)");
+  }
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    if (!S_ISDIR(st.st_mode)) bad_path(field, path, "exists and is not a directory");
+    check_can_create_in(path, path, field);
+    return;
+  }
+  // A missing folder is created with its missing parents: the nearest existing ancestor must be
+  // a directory where folders can be created.
+  std::string ancestor = parent_directory(path);
+  while (::stat(ancestor.c_str(), &st) != 0 && ancestor != "/" && ancestor != ".") {
+    ancestor = parent_directory(ancestor);
+  }
+  check_can_create_in(ancestor, path, field);
+}
+
+void write_file_atomically(const std::string& path, const void* data, std::size_t size,
+                           const std::string& field) {
+  if (path.empty()) throw Error(ErrorCode::kInvalidArgument, field + ": empty path (give a file)");
+  std::string temporary = path + ".tmp_XXXXXX";
+  const int fd = ::mkstemp(temporary.data());
+  if (fd < 0) {
+    const int error = errno;
+    throw Error(
+        is_path_error(error) ? ErrorCode::kInvalidArgument : ErrorCode::kIo,
+        field + " " + quoted(path) + ": cannot create a file there: " + std::strerror(error));
+  }
+  ::fchmod(fd, 0644);  // mkstemp makes 0600; outputs are ordinary files
+  const auto fail = [&](const std::string& step, int error) {
+    ::unlink(temporary.c_str());
+    throw Error(error == EISDIR ? ErrorCode::kInvalidArgument : ErrorCode::kIo,
+                field + " " + quoted(path) + ": " + step + " failed: " + std::strerror(error) +
+                    " (nothing was written)");
+  };
+  const char* bytes = static_cast<const char*>(data);
+  std::size_t written = 0;
+  while (written < size) {
+    const ssize_t n = ::write(fd, bytes + written, size - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int error = errno;
+      ::close(fd);
+      fail("writing", error);
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
+    const int error = errno;
+    ::close(fd);
+    fail("writing", error);
+  }
+  if (::close(fd) != 0) fail("writing", errno);
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) fail("moving the file into place", errno);
+}
+
+}  // namespace core
+}  // namespace draglab

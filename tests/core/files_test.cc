@@ -1,0 +1,195 @@
+// core: output files written whole or not at all.
+//
+// Set-up: a temporary directory. Checks:
+//  - check_output_file / check_output_directory refuse, before any work, an empty path, a
+//    directory where a file is expected (and the reverse), a missing directory and a directory
+//    where nothing can be created (/proc: access(2) says yes to root there, the probe file
+//    does not), and accept ordinary paths;
+//  - write_file_atomically writes the bytes exactly and replaces a file whole;
+//  - a write that fails part-way (disk full, simulated by a file-size limit RLIMIT_FSIZE: the
+//    kernel answers EFBIG as it answers ENOSPC on a full disk) throws Error(kIo) naming the
+//    system's reason, leaves the old file as it was and no temporary file;
+//  - an HDF5 file built in memory saves to a file HDF5 reads back, and fails the same clean way
+//    (libhdf5 1.10 writing to disk directly crashed at exit after such a failure).
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+
+#include "draglab/core/files.h"
+#include "draglab/core/hdf5_file.h"
+#include "draglab/drag_db/error.h"
+
+namespace draglab {
+namespace core {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "draglab_core_test_XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (fs::path(path_) / name).string(); }
+  std::size_t entries() const {
+    return static_cast<std::size_t>(std::distance(fs::directory_iterator(path_), {}));
+  }
+
+ private:
+  std::string path_;
+};
+
+/// Limits the size of files this process may write while it lives (writes past it fail with
+/// EFBIG; SIGXFSZ is ignored so that the failure is an error code, as on a full disk).
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &saved_);
+    previous_handler_ = signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &saved_);
+    signal(SIGXFSZ, previous_handler_);
+  }
+
+ private:
+  rlimit saved_{};
+  void (*previous_handler_)(int) = nullptr;
+};
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+ErrorCode code_of(const std::function<void()>& f, std::string* message = nullptr) {
+  try {
+    f();
+  } catch (const Error& e) {
+    if (message) *message = e.what();
+    return e.code();
+  }
+  return ErrorCode::kOk;
+}
+
+TEST(CoreFiles, OutputPathsAreCheckedBeforeAnyWork) {
+  TempDir dir;
+  std::string message;
+  EXPECT_EQ(code_of([&] { check_output_file("", "--out"); }, &message),
+            ErrorCode::kInvalidArgument);
+  EXPECT_NE(message.find("--out"), std::string::npos) << message;
+  EXPECT_EQ(code_of([&] { check_output_file(dir.file(""), "--out"); }, &message),
+            ErrorCode::kInvalidArgument);
+  EXPECT_NE(message.find("is a directory"), std::string::npos) << message;
+  EXPECT_EQ(code_of([&] { check_output_file(dir.file("missing/x.h5"), "--fields"); }, &message),
+            ErrorCode::kInvalidArgument);
+  EXPECT_NE(message.find("does not exist"), std::string::npos) << message;
+  EXPECT_NE(message.find("--fields"), std::string::npos) << message;
+  EXPECT_EQ(code_of([&] { check_output_file("/proc/draglab_test.h5", "--plot"); }, &message),
+            ErrorCode::kInvalidArgument);
+  EXPECT_NE(message.find("cannot create files"), std::string::npos) << message;
+  EXPECT_EQ(code_of([&] { check_output_file("/dev/null", "--out"); }, &message),
+            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_of([&] { check_output_file(dir.file("ok.csv"), "--out"); }), ErrorCode::kOk);
+  std::ofstream(dir.file("existing.csv")) << "x";
+  EXPECT_EQ(code_of([&] { check_output_file(dir.file("existing.csv"), "--out"); }), ErrorCode::kOk);
+  EXPECT_EQ(code_of([&] { check_output_directory(dir.file("existing.csv"), "--out"); }),
+            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_of([&] { check_output_directory(dir.file("new/nested"), "--out"); }),
+            ErrorCode::kOk);
+  EXPECT_EQ(code_of([&] { check_output_directory("/proc/draglab_test_dir", "--out"); }),
+            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(dir.entries(), 1u);  // the probes left nothing; nothing was created
+}
+
+TEST(CoreFiles, AtomicWriteReplacesWholeOrLeavesTheOldFile) {
+  TempDir dir;
+  const std::string path = dir.file("out.txt");
+  write_file_atomically(path, std::string("first"), "--out");
+  EXPECT_EQ(read_all(path), "first");
+  const std::string big(64 * 1024, 'x');
+  write_file_atomically(path, big, "--out");
+  EXPECT_EQ(read_all(path), big);
+  write_file_atomically(path, std::string("short"), "--out");
+  EXPECT_EQ(read_all(path), "short");
+  {
+    FileSizeLimit limit(8 * 1024);
+    std::string message;
+    EXPECT_EQ(code_of([&] { write_file_atomically(path, big, "--out"); }, &message),
+              ErrorCode::kIo);
+    EXPECT_NE(message.find(std::strerror(EFBIG)), std::string::npos) << message;
+    EXPECT_NE(message.find("nothing was written"), std::string::npos) << message;
+  }
+  EXPECT_EQ(read_all(path), "short");  // the old file, whole
+  EXPECT_EQ(dir.entries(), 1u);        // no temporary file left
+  fs::create_directory(dir.file("a_dir"));
+  EXPECT_EQ(code_of([&] { write_file_atomically(dir.file("a_dir"), big, "--out"); }),
+            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(dir.entries(), 2u);
+}
+
+void write_example(Hdf5MemoryFile& file, std::size_t n) {
+  std::vector<double> values(n);
+  for (std::size_t i = 0; i < n; ++i) values[i] = 0.5 * static_cast<double>(i);
+  const hsize_t dims[1] = {n};
+  const hid_t space = H5Screate_simple(1, dims, nullptr);
+  const hid_t set =
+      H5Dcreate2(file.id(), "values", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  ASSERT_GE(set, 0);
+  ASSERT_GE(H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0);
+  H5Dclose(set);
+  H5Sclose(space);
+}
+
+TEST(CoreFiles, InMemoryHdf5FileSavesWholeOrNotAtAll) {
+  TempDir dir;
+  const std::string path = dir.file("values.h5");
+  {
+    Hdf5MemoryFile file("test file");
+    write_example(file, 1000);
+    file.save(path);
+  }
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  const hid_t set = H5Dopen2(f, "values", H5P_DEFAULT);
+  std::vector<double> back(1000);
+  ASSERT_GE(H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, back.data()), 0);
+  EXPECT_EQ(back[999], 499.5);
+  H5Dclose(set);
+  H5Fclose(f);
+
+  const std::string failed = dir.file("failed.h5");
+  {
+    Hdf5MemoryFile file("test file");
+    write_example(file, 100000);  // 800 kB
+    FileSizeLimit limit(64 * 1024);
+    EXPECT_EQ(code_of([&] { file.save(failed); }), ErrorCode::kIo);
+  }
+  EXPECT_FALSE(fs::exists(failed));
+  EXPECT_EQ(dir.entries(), 1u);
+}
+
+}  // namespace
+}  // namespace core
+}  // namespace draglab
