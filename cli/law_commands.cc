@@ -56,7 +56,13 @@ nlohmann::json evaluation_json(const Law& law, const Evaluation& e) {
                       {"K", e.K},
                       {"outside_validity", e.outside_validity}};
   if (e.phi_evaluated != e.phi || e.re_evaluated != e.re) {
+    // One closure evaluation (at the clamped point); beta and K convert that F with the cell's
+    // own phi, as a solver does (law.h): each quantity says where it comes from.
     j["F_evaluated_at"] = {{"phi", e.phi_evaluated}, {"re", e.re_evaluated}};
+    j["conversions_at"] = {{"phi", e.phi},
+                           {"note",
+                            "beta_d2_over_mu = 18 phi (1 - phi) F and K = F/(1 - phi) "
+                            "with the requested phi and F from F_evaluated_at"}};
   }
   return j;
 }

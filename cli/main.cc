@@ -27,10 +27,21 @@ namespace cli {
 
 std::unique_ptr<Database> CliContext::open_database(bool read_only) const {
   const std::string path = resolved_db_path();
-  // A shared, installed database the user cannot write: read it read-only rather than fail
+  // A shared, installed database the user cannot write (the file, or its directory, where SQLite
+  // keeps its -wal and -shm files): read it read-only rather than fail, and say so once
   // (commands that write then fail with a clear message from the database).
-  if (!read_only && ::access(path.c_str(), F_OK) == 0 && ::access(path.c_str(), W_OK) != 0) {
-    read_only = true;
+  if (!read_only && ::access(path.c_str(), F_OK) == 0) {
+    const std::size_t slash = path.find_last_of('/');
+    const std::string dir =
+        slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+    const bool file_writable = ::access(path.c_str(), W_OK) == 0;
+    const bool dir_writable = ::access(dir.c_str(), W_OK) == 0;
+    if (!file_writable || !dir_writable) {
+      read_only = true;
+      info("note: database '" + path + "' opened read-only (" +
+           (file_writable ? "its directory '" + dir + "' is" : "the file is") +
+           " not writable for this user): commands that change it will fail");
+    }
   }
   DatabaseOptions options;
   options.read_only = read_only;

@@ -58,6 +58,10 @@ check "negative Re" 2 "$draglab" law eval bvk2007 --phi 0.3 --re -1
 check "NaN phi" 2 "$draglab" law eval bvk2007 --phi nan --re 1
 check "outside validity" 2 "$draglab" law eval bvk2007 --phi 0.05 --re 1
 check "clamp policy" 0 "$draglab" law eval bvk2007 --phi 0.05 --re 1 --range-policy clamp --json
+# Under clamp every quantity says where it comes from: F at the clamped point, beta and K
+# converting that F with the requested phi.
+json_check "clamp: F's point and the conversions' phi reported" \
+  "j['F_evaluated_at']['phi'] > 0.05 and j['conversions_at']['phi'] == 0.05 and abs(j['K'] - j['F']/0.95) < 1e-12*j['K'] and abs(j['beta_d2_over_mu'] - 18*0.05*0.95*j['F']) < 1e-9*j['beta_d2_over_mu']"
 json_check "clamped value equals phi=0.1" "abs(j['F'] - 2.49816) < 1e-5"
 check "unknown law" 2 "$draglab" law eval no_such_law --phi 0.3 --re 1
 grep -q "bvk2007" "$work/err" || { echo "FAIL: unknown law does not list known names"; failures=$((failures + 1)); }
@@ -176,6 +180,29 @@ check "lbm fields unwritable" 2 "$draglab" lbm run --array sc --phi 0.1 --d 6 --
 ls "$work/no" >/dev/null 2>&1 && { echo "FAIL: lbm left files"; failures=$((failures + 1)); }
 check "lbm calibrate d too small" 2 "$draglab" lbm calibrate --d 2
 check "lbm bench repeat" 2 "$draglab" lbm bench --repeat 0
+
+# A database whose directory (where SQLite keeps its -wal and -shm files) the user cannot write:
+# read-only, said once on stderr, and reads still work; a change fails with a clear message.
+# Root writes everywhere, so as root the check runs as the user nobody.
+shared="$(mktemp -d)"
+cp "$DRAGLAB_DB" "$shared/shared.db"
+chmod 644 "$shared/shared.db"
+chmod 755 "$shared"
+as_user=()
+if [ "$(id -u)" -eq 0 ]; then
+  id nobody >/dev/null 2>&1 && chmod 666 "$shared/shared.db" && as_user=(setpriv --reuid=nobody --regid=nogroup --clear-groups)
+else
+  chmod 555 "$shared"
+fi
+if [ "$(id -u)" -ne 0 ] || [ ${#as_user[@]} -gt 0 ]; then
+  check "read-only directory: eval" 0 "${as_user[@]}" "$draglab" --db "$shared/shared.db" law eval bvk2007 --phi 0.4 --re 100 --json
+  json_check "read-only directory: value" "abs(j['F'] - 30.7416) / 30.7416 < 2e-6"
+  [ "$(grep -c 'opened read-only' "$work/err")" -eq 1 ] || { echo "FAIL: read-only note not said once"; failures=$((failures + 1)); }
+  check "read-only directory: change refused" 1 "${as_user[@]}" "$draglab" --db "$shared/shared.db" law retract ergun@1 --reason "read-only test"
+  grep -q "read-only" "$work/err" || { echo "FAIL: read-only change message"; failures=$((failures + 1)); }
+fi
+chmod 755 "$shared"
+rm -rf "$shared"
 
 # The main job.
 check "law compare" 0 "$draglab" law compare
