@@ -126,6 +126,10 @@ case "$target" in
     printf '%s\n' '"@"' '"latest"' '"fuzzlaw"' '"gidaspow"' '"bvk2007"' >>"$dict"
     ;;
 esac
+# Inputs of earlier findings (fuzz/regressions/TARGET_*) are seeds too: they must stay clean.
+for f in "$here/fuzz/regressions/${target}"_*; do
+  [ -f "$f" ] && cp "$f" "$seeds/"
+done
 echo "fuzz: $(find "$seeds" -type f | wc -l) seed files, corpus $corpus" >&2
 
 # ---- run ------------------------------------------------------------------------------------------
