@@ -3,8 +3,20 @@
 #   ./test.sh                      # everything CI runs
 #   ./test.sh -L validation        # the long physics validations (extra ctest arguments are
 #                                  # passed through; without any, validations are left out)
+#   ./test.sh --sanitize [ARGS]    # the same suite built with ASan + UBSan (RelWithDebInfo) in
+#                                  # build-sanitize/ (DRAGLAB_BUILD_DIR overrides); any report
+#                                  # fails the test. Tests that cannot run instrumented are
+#                                  # disabled there, each with the reason (tests/*/CMakeLists.txt).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+if [ "${1:-}" = "--sanitize" ]; then
+  shift
+  export DRAGLAB_SANITIZE=1
+  export DRAGLAB_BUILD_DIR="${DRAGLAB_BUILD_DIR:-$here/build-sanitize}"
+  # Every report stops the process with a stack trace (UB included); leaks are reports too.
+  export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}"
+  export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+fi
 "$here/scripts/setup.sh"
 jobs="$(nproc 2>/dev/null || echo 2)"
 if [ "$#" -eq 0 ]; then set -- -LE validation; fi

@@ -4,10 +4,20 @@
 #
 #   scripts/setup.sh            # install what is missing, configure, build
 #   scripts/setup.sh --no-build # install only
+#
+# DRAGLAB_BUILD_DIR: another build directory. DRAGLAB_SANITIZE=1: build with ASan + UBSan
+# (-DDRAGLAB_SANITIZE=ON, RelWithDebInfo) into build-sanitize/ unless DRAGLAB_BUILD_DIR says.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build_dir="${DRAGLAB_BUILD_DIR:-$here/build}"
+sanitize="${DRAGLAB_SANITIZE:-0}"
+if [ "$sanitize" = 1 ]; then
+  build_dir="${DRAGLAB_BUILD_DIR:-$here/build-sanitize}"
+  cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRAGLAB_SANITIZE=ON)
+else
+  build_dir="${DRAGLAB_BUILD_DIR:-$here/build}"
+  cmake_args=(-DCMAKE_BUILD_TYPE=Release)
+fi
 
 # Why each package is here: see README.md, section "Dependencies".
 packages=(
@@ -53,5 +63,9 @@ fi
 [ "${1:-}" = "--no-build" ] && exit 0
 
 jobs="$(nproc 2>/dev/null || echo 2)"
-cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+if [ "$sanitize" != 1 ] && [ -f "$build_dir/CMakeCache.txt" ] &&
+   grep -q '^DRAGLAB_SANITIZE:BOOL=ON' "$build_dir/CMakeCache.txt"; then
+  cmake_args+=(-DDRAGLAB_SANITIZE=OFF)  # a sanitizer build directory reused for a plain build
+fi
+cmake -S "$here" -B "$build_dir" "${cmake_args[@]}" >/dev/null
 cmake --build "$build_dir" -j "$jobs"
