@@ -11,6 +11,8 @@
 namespace draglab {
 namespace core {
 
+void silence_hdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
 Hdf5MemoryFile::Hdf5MemoryFile(std::string label) : label_(std::move(label)) {
   const hid_t access = H5Pcreate(H5P_FILE_ACCESS);
   // Grow the image 1 MiB at a time; never write it to disk by itself (backing_store = 0).

@@ -15,26 +15,13 @@
 
 #include "draglab/arrays/packing_io.h"
 #include "draglab/drag_db/error.h"
+#include "support/temp_dir.h"
 
 namespace draglab {
 namespace arrays {
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/draglab_io_fuzz_XXXXXX";
-    path_ = mkdtemp(tmpl);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
+using TempDir = test::TempDir;
 
 void write_doubles(hid_t group, const char* name, const std::vector<hsize_t>& dims,
                    const std::vector<double>& values) {

@@ -15,23 +15,13 @@
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
 #include "draglab/drag_db/error.h"
+#include "support/temp_dir.h"
 
 namespace draglab {
 namespace arrays {
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/draglab_io_XXXXXX";
-    path_ = mkdtemp(tmpl);
-  }
-  ~TempDir() { std::system(("rm -rf '" + path_ + "'").c_str()); }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
+using TempDir = test::TempDir;
 
 std::string run(const std::string& command, int* status) {
   std::string out;
@@ -101,7 +91,9 @@ TEST(PackingIo, ReadableByH5py) {
   if (status != 0) GTEST_SKIP() << "h5py not importable by /usr/bin/python3";
   const std::string script =
       "import h5py, math\n"
-      "f = h5py.File('" + dir.file("p.h5") + "', 'r')\n"
+      "f = h5py.File('" +
+      dir.file("p.h5") +
+      "', 'r')\n"
       "g = f['packing']\n"
       "c, r, b = g['centers'][()], g['radii'][()], g['box_length'][()]\n"
       "assert c.shape == (3, 3) and r.shape == (3,) and b.shape == (3,)\n"

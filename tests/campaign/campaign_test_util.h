@@ -14,25 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "support/temp_dir.h"
+
 namespace draglab {
 namespace campaign_test {
 
 /// A fresh temporary directory, removed with its contents on destruction.
-class TempDir {
- public:
-  TempDir() {
-    const char* root = std::getenv("TMPDIR");
-    std::string tmpl = std::string(root && *root ? root : "/tmp") + "/draglab_campaign_XXXXXX";
-    if (!mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = tmpl;
-  }
-  ~TempDir() { std::system(("rm -rf '" + path_ + "'").c_str()); }
-  const std::string& path() const { return path_; }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
+using TempDir = test::TempDir;
 
 inline void write_file(const std::string& path, const std::string& text) {
   std::ofstream f(path);

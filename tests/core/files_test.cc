@@ -28,6 +28,7 @@
 #include "draglab/core/files.h"
 #include "draglab/core/hdf5_file.h"
 #include "draglab/drag_db/error.h"
+#include "support/temp_dir.h"
 
 namespace draglab {
 namespace core {
@@ -35,25 +36,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "draglab_core_test_XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (fs::path(path_) / name).string(); }
-  std::size_t entries() const {
-    return static_cast<std::size_t>(std::distance(fs::directory_iterator(path_), {}));
-  }
-
- private:
-  std::string path_;
-};
+using TempDir = test::TempDir;
 
 /// Limits the size of files this process may write while it lives (writes past it fail with
 /// EFBIG; SIGXFSZ is ignored so that the failure is an error code, as on a full disk).

@@ -31,6 +31,7 @@
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/drag_db/law_form.h"
+#include "support/temp_dir.h"
 
 #ifndef DRAGLAB_SQLITE3_SHELL
 #define DRAGLAB_SQLITE3_SHELL "sqlite3"
@@ -41,24 +42,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "draglab_dbsql_test_XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::permissions(path_, fs::perms::owner_all, fs::perm_options::add, ignored);
-    fs::remove_all(path_, ignored);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using TempDir = test::TempDir;
 
 Error error_of(const std::function<void()>& f) {
   try {
@@ -558,10 +542,10 @@ TEST(DatabaseFiles, ForeignSqliteDatabaseIsRefused) {
 TEST(DatabaseFiles, DirectoryMissingParentAndMissingFileGiveClearErrors) {
   TempDir dir;
   // Bad input (kInvalidArgument), naming the path: a directory, a directory that does not exist.
-  Error e = error_of([&] { Database db(dir.path().string()); });
+  Error e = error_of([&] { Database db(dir.path()); });
   EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
-  EXPECT_NE(std::string(e.what()).find(dir.path().string()), std::string::npos) << e.what();
+  EXPECT_NE(std::string(e.what()).find(dir.path()), std::string::npos) << e.what();
 
   for (bool read_only : {false, true}) {
     DatabaseOptions o;

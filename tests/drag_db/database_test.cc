@@ -26,6 +26,7 @@
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/drag_db/law_form.h"
+#include "support/temp_dir.h"
 
 namespace draglab {
 namespace {
@@ -33,22 +34,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh temporary directory, removed with everything in it at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "draglab_db_test_XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using TempDir = test::TempDir;
 
 ErrorCode code_of(const std::function<void()>& f) {
   try {

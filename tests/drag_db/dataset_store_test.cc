@@ -19,28 +19,14 @@
 
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
+#include "support/temp_dir.h"
 
 namespace draglab {
 namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "draglab_dataset_test_XXXXXX").string();
-    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (fs::path(path_) / name).string(); }
-
- private:
-  std::string path_;
-};
+using TempDir = test::TempDir;
 
 Dataset sample(double scale = 1.0) {
   Dataset d;

@@ -20,24 +20,13 @@
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/fields_io.h"
 #include "draglab/lbm/lbm.h"
+#include "support/temp_dir.h"
 
 namespace draglab {
 namespace lbm {
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    char tmpl[] = "/tmp/draglab_fields_XXXXXX";
-    path_ = mkdtemp(tmpl);
-  }
-  ~TempDir() { std::system(("rm -rf '" + path_ + "'").c_str()); }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
+using TempDir = test::TempDir;
 
 std::string run(const std::string& command, int* status) {
   std::string out;

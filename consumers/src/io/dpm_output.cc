@@ -18,31 +18,14 @@
 #include <vector>
 
 #include "drag_db_version.h"
+#include "draglab/core/hdf5_file.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
 
-/// Closes an HDF5 identifier on scope exit (close() to see the status, e.g. of the file).
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  ~Handle() { close(); }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  hid_t get() const { return id_; }
-  bool ok() const { return id_ >= 0; }
-  herr_t close() {
-    const herr_t status = id_ >= 0 ? close_(id_) : 0;
-    id_ = -1;
-    return status;
-  }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
+using Handle = core::Hdf5Handle;
 
 [[noreturn]] void Fail(const std::string& path, const std::string& what) {
   throw Error(ErrorCode::kInvalidArgument, "DPM output '" + path + "': " + what);
@@ -423,7 +406,7 @@ void DpmOutputWriter::Impl::Append(double t_s, const CellFields* cells,
   }
 
   // HDF5 prints its own error stack by default; our messages name the path instead.
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  core::silence_hdf5();
   // The file is opened for each output time and closed after it, so what a crashed or killed
   // run leaves behind is a complete file holding every finished output time.
   const bool create = !m.h5_created;

@@ -1,4 +1,5 @@
-// draglab/core/hdf5_file.h: an HDF5 file built in memory and saved whole.
+// draglab/core/hdf5_file.h: HDF5 identifiers closed on scope exit, and an HDF5 file built in
+// memory and saved whole.
 //
 // The HDF5 library writes a file in many small pieces; when one fails (disk full), libhdf5
 // 1.10 leaves the file half closed and can crash at exit while closing it again. Building the
@@ -14,6 +15,30 @@
 
 namespace draglab {
 namespace core {
+
+/// HDF5 prints its own error stack by default; draglab reports its own messages instead.
+void silence_hdf5();
+
+/// Closes an HDF5 identifier (file, group, dataset, space, type, attribute) on scope exit;
+/// close() closes it earlier and returns the status (e.g. of a file, whose close flushes it).
+class Hdf5Handle {
+ public:
+  Hdf5Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  ~Hdf5Handle() { close(); }
+  Hdf5Handle(const Hdf5Handle&) = delete;
+  Hdf5Handle& operator=(const Hdf5Handle&) = delete;
+  hid_t get() const { return id_; }
+  bool ok() const { return id_ >= 0; }
+  herr_t close() {
+    const herr_t status = id_ >= 0 ? close_(id_) : 0;
+    id_ = H5I_INVALID_HID;
+    return status;
+  }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
 
 class Hdf5MemoryFile {
  public:
