@@ -71,8 +71,6 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx);
 /// `draglab regress`: consumer predictions of changed law versions against stored baselines.
 void add_regress_commands(CLI::App& app, CliContext& ctx);
 
-/// Parses "a,b,c" into doubles; throws UsageError naming `field`.
-std::vector<double> parse_double_list(const std::string& text, const std::string& field);
 /// Formats a double with `digits` significant digits.
 std::string format_number(double x, int digits = 6);
 

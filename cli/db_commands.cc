@@ -7,8 +7,8 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
-#include "draglab/drag_db/error.h"
 #include "drag_db_version.h"
+#include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace cli {
@@ -61,7 +61,8 @@ void run_check(const CliContext& ctx) {
   } else {
     std::cout << report.FullReport();
   }
-  if (!report.ok) throw Error(ErrorCode::kDatabase, "database check failed: " + report.BriefReport());
+  if (!report.ok)
+    throw Error(ErrorCode::kDatabase, "database check failed: " + report.BriefReport());
 }
 
 void run_migrate(const CliContext& ctx) {
@@ -72,14 +73,13 @@ void run_migrate(const CliContext& ctx) {
   const int before = db.schema_version();
   const std::vector<int> applied = db.migrate();
   if (ctx.json) {
-    ctx.print_json({{"path", db.path()},
-                    {"from", before},
-                    {"to", db.schema_version()},
-                    {"applied", applied}});
+    ctx.print_json(
+        {{"path", db.path()}, {"from", before}, {"to", db.schema_version()}, {"applied", applied}});
     return;
   }
   if (applied.empty()) {
-    std::cout << fmt::format("{}: schema version {} is current; nothing to do\n", db.path(), before);
+    std::cout << fmt::format("{}: schema version {} is current; nothing to do\n", db.path(),
+                             before);
   } else {
     std::cout << fmt::format("{}: migrated schema {} -> {}\n", db.path(), before,
                              db.schema_version());
@@ -91,13 +91,15 @@ void run_migrate(const CliContext& ctx) {
 void add_db_commands(CLI::App& app, CliContext& ctx) {
   CLI::App* db = app.add_subcommand("db", "Database information, integrity check, migrations");
   db->require_subcommand(1);
-  db->footer("Examples:\n  draglab db info\n  draglab db check --json\n  draglab db migrate --db old.db");
+  db->footer(
+      "Examples:\n  draglab db info\n  draglab db check --json\n  draglab db migrate --db old.db");
   auto* info = db->add_subcommand("info", "Path, schema version, number of law versions");
   info->footer("Examples:\n  draglab db info\n  draglab db info --db other.db --json");
   info->callback([&ctx] { ctx.action = [&ctx] { run_info(ctx); }; });
   auto* check = db->add_subcommand(
-      "check", "SQLite integrity check, schema version, recomputed content hashes (exit 1 on a "
-               "problem)");
+      "check",
+      "SQLite integrity check, schema version, recomputed content hashes (exit 1 on a "
+      "problem)");
   check->footer("Example:\n  draglab db check --json");
   check->callback([&ctx] { ctx.action = [&ctx] { run_check(ctx); }; });
   auto* migrate = db->add_subcommand("migrate", "Apply forward schema migrations");

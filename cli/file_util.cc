@@ -51,8 +51,7 @@ std::string executable_dir() {
 }
 
 std::string find_script(const std::string& name) {
-  const std::string installed =
-      executable_dir() + "/../" + DRAGLAB_INSTALL_SHARE_DIR + "/" + name;
+  const std::string installed = executable_dir() + "/../" + DRAGLAB_INSTALL_SHARE_DIR + "/" + name;
   if (file_exists(installed)) return installed;
   const std::string source = std::string(DRAGLAB_SOURCE_SCRIPTS_DIR) + "/" + name;
   if (file_exists(source)) return source;

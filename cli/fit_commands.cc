@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/fitter/fit.h"
@@ -37,22 +38,6 @@ struct FitArgs {
   std::string publish;
 };
 
-std::vector<std::string> split_names(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (item.empty())
-      throw UsageError("--free: empty name in '" + text + "' (e.g. --free a,b,c0,c1,c2)");
-    out.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
 std::vector<std::pair<std::string, double>> parse_assignments(const std::string& text) {
   std::vector<std::pair<std::string, double>> out;
   if (text.empty()) return out;
@@ -66,7 +51,7 @@ std::vector<std::pair<std::string, double>> parse_assignments(const std::string&
       throw UsageError("--set: '" + item + "' is not name=value (e.g. --set n=4,A=180)");
     }
     const std::vector<double> value =
-        parse_double_list(item.substr(eq + 1), "--set " + item.substr(0, eq));
+        core::parse_number_list(item.substr(eq + 1), "--set " + item.substr(0, eq));
     if (!std::isfinite(value[0])) throw UsageError("--set " + item + ": value must be finite");
     out.push_back({item.substr(0, eq), value[0]});
     if (comma == std::string::npos) break;
@@ -101,7 +86,7 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
   }
   fitter::FitOptions options;
   options.form = args.form;
-  if (!args.free.empty()) options.free = split_names(args.free);
+  if (!args.free.empty()) options.free = core::split_list(args.free, "--free", "a,b,c0,c1,c2");
   options.initial = parse_assignments(args.set);
   options.objective = fitter::objective_from_string(args.objective);
   options.loss = fitter::robust_loss_from_string(args.loss);

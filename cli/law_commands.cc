@@ -9,6 +9,7 @@
 
 #include "cli/cli_context.h"
 #include "draglab/core/files.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/export.h"
 
@@ -192,8 +193,8 @@ struct EvalOptions {
 void run_eval(const CliContext& ctx, const EvalOptions& o) {
   std::vector<double> phis, res;
   if (o.grid) {
-    phis = parse_double_list(o.phi_list, "--phi-list");
-    res = parse_double_list(o.re_list, "--re-list");
+    phis = core::parse_number_list(o.phi_list, "--phi-list");
+    res = core::parse_number_list(o.re_list, "--re-list");
     check_physical_inputs(phis, res, "--phi-list", "--re-list");
   } else {
     if (!o.phi_given || !o.re_given)
@@ -392,8 +393,8 @@ void run_retract(const CliContext& ctx, const std::string& ref, const std::strin
 
 // ---- law compare (the default job of run.sh) ------------------------------------------------
 void run_compare(const CliContext& ctx, const std::string& phi_list, const std::string& re_list) {
-  const std::vector<double> phis = parse_double_list(phi_list, "--phi-list");
-  const std::vector<double> res = parse_double_list(re_list, "--re-list");
+  const std::vector<double> phis = core::parse_number_list(phi_list, "--phi-list");
+  const std::vector<double> res = core::parse_number_list(re_list, "--re-list");
   check_physical_inputs(phis, res, "--phi-list", "--re-list");
   auto db = ctx.open_database();
   std::vector<std::shared_ptr<Law>> laws;

@@ -21,6 +21,7 @@
 #include "draglab/arrays/packing_io.h"
 #include "draglab/arrays/voxelization.h"
 #include "draglab/core/files.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/calibration.h"
 #include "draglab/lbm/convergence.h"
@@ -574,7 +575,7 @@ void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c)
   lbm::ConvergenceOptions co;
   co.packing = the_case.packing;
   co.run = options;
-  co.resolutions = parse_double_list(c.d_list, "--d");
+  co.resolutions = core::parse_number_list(c.d_list, "--d");
   co.schemes.clear();
   {
     std::size_t start = 0;

@@ -59,27 +59,6 @@ void CliContext::warn(const std::string& message) const {
 
 void CliContext::print_json(const nlohmann::json& j) const { std::cout << j.dump(2) << '\n'; }
 
-std::vector<double> parse_double_list(const std::string& text, const std::string& field) {
-  std::vector<double> values;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    try {
-      std::size_t used = 0;
-      const double v = std::stod(item, &used);
-      if (used != item.size()) throw std::invalid_argument(item);
-      values.push_back(v);
-    } catch (const std::exception&) {
-      throw UsageError(field + ": '" + item + "' is not a number (expected e.g. 0.1,0.2,0.3)");
-    }
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return values;
-}
-
 std::string format_number(double x, int digits) { return fmt::format("{:.{}g}", x, digits); }
 
 }  // namespace cli

@@ -29,6 +29,7 @@
 #include "cli/file_util.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/fitter/fit.h"
@@ -64,20 +65,6 @@ struct ReportLaw {
   std::string role;  ///< "fit" or "reference"
   std::string label;
 };
-
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> items;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = text.find(',', start);
-    std::string item =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (!item.empty()) items.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return items;
-}
 
 std::string utc_now() {
   const std::time_t t = std::time(nullptr);
@@ -369,8 +356,8 @@ ReportInputs load_inputs(const CliContext& ctx, const Database& db, const Report
     in.laws.push_back({law, role, law_label(law->record(), role)});
   };
   for (const std::string& ref : c.laws) add_law(ref, "fit", true);
-  const std::vector<std::string> compare =
-      split_list(c.compare_given ? c.compare : kDefaultComparisons);
+  const std::vector<std::string> compare = core::split_list(
+      c.compare_given ? c.compare : kDefaultComparisons, "--compare", "vdh2004@1,ergun@1");
   for (const std::string& ref : compare) add_law(ref, "reference", c.compare_given);
   if (in.laws.empty()) {
     throw UsageError("no law to compare with: give --law NAME@V or --compare REF,...");

@@ -18,6 +18,7 @@
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/error.h"
 
@@ -35,25 +36,10 @@ struct SceneArgs {
   bool no_store = false;  // scene run --no-store
 };
 
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (item.empty()) throw UsageError("--law: empty entry in '" + text + "' (expected a,b,c)");
-    out.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
 /// The laws to evaluate: --law, else the scene's plus the five reference laws' version 1 that
 /// exist in the database.
 std::vector<std::string> laws_for(const Scene& scene, const SceneArgs& args, const Database& db) {
-  if (!args.laws.empty()) return split_list(args.laws);
+  if (!args.laws.empty()) return core::split_list(args.laws, "--law", "gidaspow@1,ergun@1");
   std::vector<std::string> laws = scene.laws;
   for (const char* name : {"gidaspow", "ergun", "hill_koch_ladd", "vdh2004", "bvk2007"}) {
     const std::string ref = std::string(name) + "@1";
@@ -113,7 +99,9 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
   auto db = ctx.open_database();  // created and seeded on first use, as every command
   nlohmann::json per_law = nlohmann::json::array();
   std::vector<consumers::SceneDerived> derived;
-  for (const auto& ref : args.laws.empty() ? scene.laws : split_list(args.laws)) {
+  for (const auto& ref : args.laws.empty()
+                             ? scene.laws
+                             : core::split_list(args.laws, "--law", "gidaspow@1,ergun@1")) {
     std::string warning;
     auto law = db->load(ref, RangePolicy::kError, &warning);
     if (!warning.empty()) ctx.warn(warning);

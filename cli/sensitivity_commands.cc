@@ -44,6 +44,7 @@
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/consumers/sensitivity.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -84,21 +85,6 @@ std::string time_resolution_flag(const std::string& name) {
   for (const auto& [key, flag] : kTimeResolutionFlags)
     if (key == name) return flag;
   return "--" + name;
-}
-
-std::vector<std::string> split_list(const std::string& text, const std::string& field) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item =
-        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (item.empty()) throw UsageError(field + ": empty entry in '" + text + "' (expected a,b,c)");
-    out.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
 }
 
 /// Writes JSON to `path` through a temporary file and a rename, so a reader never sees half.
@@ -531,7 +517,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
         throw UsageError(fmt::format(
             "{}: this scene's model ({}) sets its time step by {} ({}): use {}", flag, scene.solver,
             step.name, step.description, time_resolution_flag(step.name)));
-      for (double v : parse_double_list(list, flag)) {
+      for (double v : core::parse_number_list(list, flag)) {
         if (step.whole_number && v != std::floor(v))
           throw UsageError(fmt::format("{}: {} is not a whole number ({}, {})", flag,
                                        format_number(v), step.description, step.range));
@@ -544,7 +530,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     wp.run = run;
     if (!wp.IsValid(&why)) throw UsageError(why);
   } else {
-    if (!args.laws.empty()) sens.laws = split_list(args.laws, "--laws");
+    if (!args.laws.empty()) sens.laws = core::split_list(args.laws, "--laws", "gidaspow@1,ergun@1");
     sens.uncertainty = consumers::uncertainty_method_from_string(args.uncertainty);
     if (args.realizations < 2 || args.realizations > 32)
       throw UsageError(fmt::format("--realizations must be in [2, 32], got {}", args.realizations));

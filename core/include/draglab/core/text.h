@@ -1,0 +1,22 @@
+// draglab/core/text.h: the comma-separated lists of the command line and the scene and campaign
+// files (laws a@1,b@1, parameters a,b,c0, numbers 0.1,0.2), parsed one way everywhere.
+// Errors: draglab::Error(kInvalidArgument) naming `field`, the offending item and an example.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace draglab {
+namespace core {
+
+/// The items of "a,b,c". An empty item ("a,,b", a trailing comma, an empty text) is refused.
+std::vector<std::string> split_list(const std::string& text, const std::string& field,
+                                    const std::string& example = "a,b,c");
+
+/// The numbers of "0.1,0.2,0.3": each item a whole decimal number (strtod reads all of it);
+/// nan and inf are numbers here, ranges are the caller's to check.
+std::vector<double> parse_number_list(const std::string& text, const std::string& field,
+                                      const std::string& example = "0.1,0.2,0.3");
+
+}  // namespace core
+}  // namespace draglab
