@@ -17,7 +17,6 @@
 // is registered if none is; --regress-scene FILE checks that scene instead; --no-regress skips
 // the check). A brand-new law name registers its baseline; a prediction that moved beyond the
 // baseline's tolerance is printed and the pipeline exits 1 (the law stays published).
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,6 +31,7 @@
 #include "cli/cli_context.h"
 #include "cli/progress.h"
 #include "cli/regress_report.h"
+#include "cli/report.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
@@ -119,33 +119,6 @@ LawRecord publish_fit(Database& db, const LawRecord& draft_record) {
     }
   }
   return db.add_published(draft_record);
-}
-
-int run_report(const CliContext& ctx, const std::string& dataset_id, const std::string& law,
-               std::int64_t campaign_id, const std::string& out_dir) {
-  std::vector<std::string> args = {executable_path(), "report",   "--db",  ctx.resolved_db_path(),
-                                   "--dataset",       dataset_id, "--law", law,
-                                   "--out",           out_dir};
-  if (campaign_id > 0) {
-    args.push_back("--campaign");
-    args.push_back(std::to_string(campaign_id));
-  }
-  if (ctx.quiet) args.push_back("-q");
-  std::cout.flush();
-  const pid_t child = fork();
-  if (child < 0) return -1;
-  if (child == 0) {
-    // The report's own stdout (its file list) goes to stderr: stdout carries our summary/JSON.
-    dup2(STDERR_FILENO, STDOUT_FILENO);
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(child, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 struct PipelineArgs {
@@ -283,14 +256,18 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
   // 5. Report.
   std::string report_file;
   if (!args.no_report) {
-    const int rc = run_report(ctx, dataset.id, record.reference(), status.id, out_dir);
-    if (rc == 0) {
-      report_file = (fs::path(out_dir) / "report.md").string();
-    } else {
-      ctx.warn(
-          "draglab report exited with " + std::to_string(rc) +
-          ": no figures (the dataset and the law are stored; rerun `draglab report --dataset " +
-          dataset.id + " --law " + record.reference() + " --out " + out_dir + "`)");
+    ReportRequest request;
+    request.dataset_id = dataset.id;
+    request.laws = {record.reference()};
+    if (status.id > 0) request.campaign = std::to_string(status.id);
+    request.out_dir = out_dir;
+    try {
+      auto report_db = ctx.open_database(/*read_only=*/true);
+      report_file = write_report(ctx, *report_db, request)["report"].get<std::string>();
+    } catch (const std::exception& e) {
+      ctx.warn(std::string("the report failed: ") + e.what() +
+               " (the dataset and the law are stored; rerun `draglab report --dataset " +
+               dataset.id + " --law " + record.reference() + " --out " + out_dir + "`)");
     }
   }
   // 6. Regression check of the published law on the registered consumer scenes.

@@ -27,8 +27,10 @@
 
 #include "cli/cli_context.h"
 #include "cli/file_util.h"
+#include "cli/report.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
@@ -49,15 +51,7 @@ constexpr int kStokesCurvePoints = 81;  // F(phi, 0) over the data's phi range
 const char* const kFigures[] = {"fig3_seed.png", "parity.png", "residuals.png",
                                 "work_precision.png"};
 
-struct ReportCommand {
-  std::string dataset_id;
-  std::string data_csv;
-  std::vector<std::string> laws;
-  std::string compare;
-  bool compare_given = false;
-  std::string campaign;
-  std::string out_dir;
-};
+using ReportCommand = ReportRequest;
 
 /// A law of the report: fitted (--law) or a comparison (--compare / the default list).
 struct ReportLaw {
@@ -396,20 +390,6 @@ nlohmann::json conventions_json() {
       {"ci95", "parameter value +- 1.959964 sqrt(covariance diagonal) (normal quantile)"}};
 }
 
-/// Writes `text` to `path` through a temporary file, so a reader never sees half a bundle.
-void write_file_atomically(const std::string& path, const std::string& text) {
-  const std::string partial = path + ".partial";
-  {
-    std::ofstream out(partial);
-    out << text;
-    if (!out) throw std::runtime_error(fmt::format("cannot write '{}'", partial));
-  }
-  if (std::rename(partial.c_str(), path.c_str()) != 0) {
-    std::remove(partial.c_str());
-    throw std::runtime_error(fmt::format("cannot write '{}'", path));
-  }
-}
-
 struct ReportOutcome {
   nlohmann::json json;
   std::vector<std::pair<std::string, LawStats>> stats;
@@ -465,7 +445,7 @@ ReportOutcome make_report(const CliContext& ctx, const Database& db, ReportComma
   // Outputs of an earlier report in the same directory must not pass for this one's.
   for (const char* name : kFigures) std::remove((c.out_dir + "/" + name).c_str());
   std::remove(report_path.c_str());
-  write_file_atomically(bundle_path, bundle.dump(1) + "\n");
+  core::write_file_atomically(bundle_path, bundle.dump(1) + "\n", "report bundle");
   ctx.info("report: bundle written to " + bundle_path);
 
   const std::string python = python_interpreter();
@@ -521,6 +501,11 @@ void print_outcome(const CliContext& ctx, const ReportOutcome& o) {
 }
 
 }  // namespace
+
+nlohmann::json write_report(const CliContext& ctx, const Database& db,
+                            const ReportRequest& request) {
+  return make_report(ctx, db, request).json;
+}
 
 void add_report_commands(CLI::App& app, CliContext& ctx) {
   auto c = std::make_shared<ReportCommand>();
