@@ -44,6 +44,7 @@
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/consumers/sensitivity.h"
+#include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
@@ -89,15 +90,7 @@ std::string time_resolution_flag(const std::string& name) {
 
 /// Writes JSON to `path` through a temporary file and a rename, so a reader never sees half.
 void write_json_file(const std::string& path, const nlohmann::json& j) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-    out << j.dump(1) << '\n';
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    throw std::runtime_error("cannot rename " + tmp + " to " + path);
+  core::write_file_atomically(path, j.dump(1) + "\n", "sensitivity data");
 }
 
 /// Runs the figure script on `bundle`; it writes `figure` into out_dir.

@@ -21,6 +21,7 @@
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
 #include "draglab/consumers/dbm.h"
+#include "draglab/core/files.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -390,13 +391,7 @@ class DbmBedModel : public BedModel {
           {"size_histogram_by_row", hist},
           {"bubbles", {{"x_m", bx}, {"y_m", by}, {"z_m", bz}, {"diameter_m", bd}}}};
       const std::string path = dir + "/" + scene.name + "_" + law->record().name + "_dbm.json";
-      const std::string tmp = path + ".tmp";
-      {
-        std::ofstream f(tmp);
-        f << fig.dump();
-        if (!f) throw std::runtime_error("dbm: cannot write " + tmp);
-      }
-      std::filesystem::rename(tmp, path);
+      core::write_file_atomically(path, fig.dump(), "DBM figure data");
       out.output_files.push_back(path);
     }
 
