@@ -80,9 +80,12 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
   if (args.dataset_id.empty() == args.data_csv.empty()) {
     throw UsageError("give exactly one of --dataset ID (stored) or --data FILE.csv");
   }
-  if (args.publish.find_first_of("@ \t") != std::string::npos) {
-    throw UsageError("--publish " + args.publish +
-                     ": a law name has no '@' or spaces (e.g. vdh2004_refit)");
+  if (!args.publish.empty()) {
+    try {
+      check_law_name(args.publish);
+    } catch (const Error& e) {
+      throw UsageError(std::string("--publish: ") + e.what());
+    }
   }
   fitter::FitOptions options;
   options.form = args.form;

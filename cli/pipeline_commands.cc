@@ -170,12 +170,11 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
   const std::string law_name = args.law_name.empty() ? "eq6_" + spec.name : args.law_name;
   const std::string out_dir = args.out_dir.empty() ? "out/" + spec.name : args.out_dir;
   {
-    // Validate the law name before hours of LBM (the database would refuse it only at the end).
-    const bool ok = !law_name.empty() && law_name.find_first_not_of(
-                                             "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                             "0123456789_-.") == std::string::npos;
-    if (!ok) {
-      throw UsageError("--law-name '" + law_name + "': use letters, digits, '_', '-' and '.' only");
+    // The law name is checked before hours of LBM (the database would refuse it at the end).
+    try {
+      check_law_name(law_name);
+    } catch (const Error& e) {
+      throw UsageError(std::string("--law-name: ") + e.what());
     }
   }
   // The check's scene is read before hours of LBM too (a bad file exits 2 here).

@@ -596,5 +596,22 @@ TEST(DatabaseOptionsAndPaths, ReadOnlyOpenReadsButRefusesWrites) {
   EXPECT_FALSE(fs::exists(dir.file("missing.db")));
 }
 
+TEST(LawNames, OneRuleForEveryCaller) {
+  for (const char* ok : {"vdh2004", "eq6_quick", "a", "Law-2.b", "9lives"}) {
+    EXPECT_NO_THROW(check_law_name(ok)) << ok;
+  }
+  for (const std::string bad :
+       {std::string(""), std::string("_x"), std::string("a b"), std::string("a@1"),
+        std::string(".hidden"), std::string(101, 'a'), std::string("caf\xC3\xA9")}) {
+    try {
+      check_law_name(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+      EXPECT_NE(std::string(e.what()).find("A-Z a-z 0-9"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace draglab

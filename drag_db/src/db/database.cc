@@ -26,12 +26,24 @@
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
+void check_law_name(const std::string& name) {
+  const bool charset_ok = std::all_of(name.begin(), name.end(), [](unsigned char c) {
+    return std::isalnum(c) != 0 || c == '_' || c == '-' || c == '.';
+  });
+  constexpr std::size_t kMaxLength = 100;
+  if (name.empty() || name.size() > kMaxLength || !charset_ok ||
+      std::isalnum(static_cast<unsigned char>(name[0])) == 0) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "law name '" + name + "' is invalid: use 1 to " + std::to_string(kMaxLength) +
+                    " characters from A-Z a-z 0-9 _ . - starting with a letter or digit (no '@')");
+  }
+}
+
 namespace {
 
 using db::Statement;
 using db::Transaction;
 
-constexpr std::size_t kMaxNameLength = 100;
 constexpr std::size_t kMinHashPrefix = 4;
 // Known names listed in a "no such law" error before it is shortened.
 constexpr std::size_t kMaxNamesInError = 40;
@@ -230,18 +242,7 @@ void invalid(const std::string& who, const std::string& what) {
   throw Error(ErrorCode::kInvalidArgument, who + ": " + what);
 }
 
-void validate_name(const std::string& name) {
-  const bool charset_ok = std::all_of(name.begin(), name.end(), [](unsigned char c) {
-    return std::isalnum(c) != 0 || c == '_' || c == '-' || c == '.';
-  });
-  if (name.empty() || name.size() > kMaxNameLength || !charset_ok ||
-      std::isalnum(static_cast<unsigned char>(name[0])) == 0) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "law name " + in_quotes(name) + " is invalid: use 1 to " +
-                    std::to_string(kMaxNameLength) +
-                    " characters from A-Z a-z 0-9 _ . - starting with a letter or digit (no '@')");
-  }
-}
+void validate_name(const std::string& name) { check_law_name(name); }
 
 void validate_range(const std::string& who, const std::string& what, const InputRange& r) {
   if (std::isnan(r.min) || std::isnan(r.max) || r.min > r.max) {

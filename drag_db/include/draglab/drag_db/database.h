@@ -24,6 +24,12 @@ struct sqlite3;
 
 namespace draglab {
 
+/// The rule for law names, in one place (the database applies it to every stored version; the
+/// command line applies it before long work, e.g. the pipeline before its LBM campaign): 1 to
+/// 100 characters from A-Z a-z 0-9 _ . -, starting with a letter or digit (so no '@', which
+/// separates name and version). Throws Error(kInvalidArgument) naming the name and the rule.
+void check_law_name(const std::string& name);
+
 /// Options for Database::open.
 struct DatabaseOptions {
   bool create_if_missing = true;  ///< Create (and seed) a new file if none exists.
