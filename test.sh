@@ -7,8 +7,17 @@
 #                                  # build-sanitize/ (DRAGLAB_BUILD_DIR overrides); any report
 #                                  # fails the test. Tests that cannot run instrumented are
 #                                  # disabled there, each with the reason (tests/*/CMakeLists.txt).
+#   ./test.sh --sanitize-fast      # the same, for the input-handling tests only (ctest label
+#                                  # `inputs`: parsers, database, bindings, bad-input matrix),
+#                                  # building only what they need; CI runs it after the suite.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+if [ "${1:-}" = "--sanitize-fast" ]; then
+  shift
+  export DRAGLAB_BUILD_TARGET=input_tests
+  if [ "$#" -eq 0 ]; then set -- -L inputs -LE validation; fi
+  set -- --sanitize "$@"
+fi
 if [ "${1:-}" = "--sanitize" ]; then
   shift
   export DRAGLAB_SANITIZE=1

@@ -7,6 +7,7 @@
 #
 # DRAGLAB_BUILD_DIR: another build directory. DRAGLAB_SANITIZE=1: build with ASan + UBSan
 # (-DDRAGLAB_SANITIZE=ON, RelWithDebInfo) into build-sanitize/ unless DRAGLAB_BUILD_DIR says.
+# DRAGLAB_BUILD_TARGET: build only this target (e.g. input_tests) instead of everything.
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -68,4 +69,6 @@ if [ "$sanitize" != 1 ] && [ -f "$build_dir/CMakeCache.txt" ] &&
   cmake_args+=(-DDRAGLAB_SANITIZE=OFF)  # a sanitizer build directory reused for a plain build
 fi
 cmake -S "$here" -B "$build_dir" "${cmake_args[@]}" >/dev/null
-cmake --build "$build_dir" -j "$jobs"
+target_args=()
+[ -n "${DRAGLAB_BUILD_TARGET:-}" ] && target_args=(--target "$DRAGLAB_BUILD_TARGET")
+cmake --build "$build_dir" -j "$jobs" "${target_args[@]}"
