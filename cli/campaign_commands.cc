@@ -15,7 +15,6 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
-#include "cli/file_util.h"
 #include "cli/progress.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
@@ -41,7 +40,7 @@ struct ExportCommand {
 
 /// A spec path, or a preset name ("quick", "standard", "paper") from data/campaigns.
 std::string resolve_spec_path(const std::string& spec) {
-  if (file_exists(spec) || spec.find('/') != std::string::npos ||
+  if (core::file_exists(spec) || spec.find('/') != std::string::npos ||
       spec.find(".toml") != std::string::npos) {
     return spec;
   }
@@ -49,7 +48,7 @@ std::string resolve_spec_path(const std::string& spec) {
        {std::string(DRAGLAB_SOURCE_DATA_DIR) + "/campaigns",
         std::string("/usr/local/") + DRAGLAB_INSTALL_SHARE_DIR + "/campaigns",
         std::string("/usr/") + DRAGLAB_INSTALL_SHARE_DIR + "/campaigns"}) {
-    if (file_exists(dir + "/" + spec + ".toml")) return dir + "/" + spec + ".toml";
+    if (core::file_exists(dir + "/" + spec + ".toml")) return dir + "/" + spec + ".toml";
   }
   return spec;
 }

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/drag_db/database.h"
+#include "draglab/workflows/messages.h"
 
 namespace draglab {
 namespace cli {
@@ -42,6 +43,10 @@ struct CliContext {
   void info(const std::string& message) const;
   /// Warning on stderr (always shown).
   void warn(const std::string& message) const;
+  /// info() and warn() for a workflow (draglab/workflows/messages.h).
+  workflows::Messages messages() const {
+    return {[this](const std::string& m) { info(m); }, [this](const std::string& m) { warn(m); }};
+  }
   /// Prints JSON on stdout (indent 2).
   void print_json(const nlohmann::json& j) const;
 };

@@ -12,7 +12,6 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
-#include "cli/file_util.h"
 #include "cli/progress.h"
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
@@ -178,7 +177,7 @@ void run_ensemble(const CliContext& ctx, const PackOptions& o) {
   }
   if (o.out_dir.empty()) throw UsageError("--out-dir DIR is required");
   core::check_output_directory(o.out_dir, "--out-dir");
-  make_directories(o.out_dir, "--out-dir");
+  core::make_directories(o.out_dir, "--out-dir");
   nlohmann::json out = nlohmann::json::array();
   double sum_g = 0, sum_g2 = 0;
   for (int r = 0; r < o.realizations; ++r) {

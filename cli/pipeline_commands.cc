@@ -31,7 +31,6 @@
 #include "cli/cli_context.h"
 #include "cli/progress.h"
 #include "cli/regress_report.h"
-#include "cli/report.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
@@ -39,6 +38,8 @@
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/fitter/fit.h"
+#include "draglab/workflows/bed_results.h"
+#include "draglab/workflows/report.h"
 
 namespace draglab {
 namespace cli {
@@ -255,14 +256,15 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
   // 5. Report.
   std::string report_file;
   if (!args.no_report) {
-    ReportRequest request;
+    workflows::ReportOptions request;
     request.dataset_id = dataset.id;
     request.laws = {record.reference()};
     if (status.id > 0) request.campaign = std::to_string(status.id);
     request.out_dir = out_dir;
+    request.quiet = ctx.quiet;
     try {
       auto report_db = ctx.open_database(/*read_only=*/true);
-      report_file = write_report(ctx, *report_db, request)["report"].get<std::string>();
+      report_file = workflows::write_report(*report_db, request, ctx.messages()).report_path;
     } catch (const std::exception& e) {
       ctx.warn(std::string("the report failed: ") + e.what() +
                " (the dataset and the law are stored; rerun `draglab report --dataset " +
@@ -318,7 +320,7 @@ void run_pipeline(const CliContext& ctx, const PipelineArgs& args) {
                     {"undetermined", fit.undetermined()},
                     {"comparison", comparison},
                     {"report", report_file},
-                    {"regress", checked ? regress_json(check) : nlohmann::json(nullptr)},
+                    {"regress", checked ? workflows::regress_json(check) : nlohmann::json(nullptr)},
                     {"campaign_s", campaign_s},
                     {"wall_s", wall_s}});
     if (checked) finish_regress(ctx, check);

@@ -22,6 +22,7 @@
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/workflows/bed_results.h"
 
 namespace draglab {
 namespace cli {
@@ -40,28 +41,9 @@ struct RegressArgs {
   bool all = false;
 };
 
-nlohmann::json tolerances_json(const RegressionTolerances& t) {
-  return {{"diameter_abs_m", t.diameter_abs_m},
-          {"diameter_rel", t.diameter_rel},
-          {"umf_rel", t.umf_rel}};
-}
-
-nlohmann::json metrics_json(const ConsumerMetrics& m) {
-  return {{"umf_m_s", m.umf_m_s},
-          {"background_m_s", m.background_m_s},
-          {"t_ref_s", m.t_ref_s},
-          {"bubble_present", m.bubble_present},
-          {"bubble_diameter_m",
-           m.bubble_present ? nlohmann::json(m.bubble_diameter_m) : nlohmann::json(nullptr)},
-          {"bubble_centroid_m",
-           m.bubble_present ? nlohmann::json(m.bubble_centroid_m) : nlohmann::json(nullptr)},
-          {"max_bed_height_m", m.max_bed_height_m},
-          {"wall_s", m.wall_s}};
-}
-
 void print_summary(const CliContext& ctx, const consumers::RegressSummary& summary) {
   if (ctx.json) {
-    ctx.print_json(regress_json(summary));
+    ctx.print_json(workflows::regress_json(summary));
   } else {
     std::cout << summary.FullReport();
   }
@@ -122,8 +104,8 @@ void run_list(const CliContext& ctx, const RegressArgs& args) {
                    {"law_name", baseline.law_name},
                    {"law", baseline.result.law_reference()},
                    {"result_id", baseline.result_id},
-                   {"tolerances", tolerances_json(baseline.tolerances)},
-                   {"metrics", metrics_json(baseline.result.metrics)},
+                   {"tolerances", workflows::tolerances_json(baseline.tolerances)},
+                   {"metrics", workflows::metrics_json(baseline.result.metrics)},
                    {"registered_at", baseline.registered_at},
                    {"active", baseline.active()},
                    {"superseded_at", baseline.active() ? nlohmann::json(nullptr)
@@ -159,57 +141,6 @@ void run_list(const CliContext& ctx, const RegressArgs& args) {
 }
 
 }  // namespace
-
-nlohmann::json regress_json(const consumers::RegressSummary& summary) {
-  using consumers::RegressOutcome;
-  nlohmann::json entries = nlohmann::json::array();
-  for (const consumers::RegressEntry& e : summary.entries) {
-    nlohmann::json comparisons = nlohmann::json::array();
-    for (const consumers::MetricComparison& c : e.comparisons) {
-      const auto number = [](double x) {
-        return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
-      };
-      comparisons.push_back({{"metric", c.metric},
-                             {"baseline", number(c.baseline)},
-                             {"new", number(c.value)},
-                             {"delta", number(c.delta)},
-                             {"tolerance", c.tolerance},
-                             {"moved", c.moved}});
-    }
-    const bool failed =
-        e.outcome == RegressOutcome::kFailed || e.outcome == RegressOutcome::kOutsideValidity;
-    nlohmann::json headline = nlohmann::json::object();
-    for (const auto& [name, value] : e.headline)
-      headline[name] = std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-    entries.push_back(
-        {{"scene", e.scene_name},
-         {"scene_hash", e.scene_hash},
-         {"law", e.law},
-         {"baseline",
-          e.baseline_law.empty() ? nlohmann::json(nullptr) : nlohmann::json(e.baseline_law)},
-         {"outcome", consumers::to_string(e.outcome)},
-         {"ran", e.ran},
-         {"result_id", failed ? nlohmann::json(nullptr) : nlohmann::json(e.result_id)},
-         {"baseline_result_id", e.baseline_result_id > 0 ? nlohmann::json(e.baseline_result_id)
-                                                         : nlohmann::json(nullptr)},
-         {"tolerances", tolerances_json(e.tolerances)},
-         {"metrics", failed ? nlohmann::json(nullptr) : metrics_json(e.metrics)},
-         {"headline", headline},
-         {"comparisons", comparisons},
-         {"error", failed ? nlohmann::json(e.error) : nlohmann::json(nullptr)},
-         {"warnings", e.warnings},
-         {"wall_s", e.wall_s}});
-  }
-  return {{"moved", summary.count(RegressOutcome::kMoved)},
-          {"ok", summary.count(RegressOutcome::kOk)},
-          {"failed", summary.count(RegressOutcome::kFailed)},
-          {"outside_validity", summary.count(RegressOutcome::kOutsideValidity)},
-          {"baselines_registered", summary.count(RegressOutcome::kBaselineRegistered)},
-          {"no_baseline", summary.count(RegressOutcome::kNoBaseline)},
-          {"runs", summary.runs},
-          {"wall_s", summary.wall_s},
-          {"entries", entries}};
-}
 
 consumers::RegressProgress regress_progress(ProgressLine& line) {
   return [&line](int run, int runs, double fraction, const std::string& stage) {

@@ -21,6 +21,7 @@
 #include "draglab/core/text.h"
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/workflows/bed_results.h"
 
 namespace draglab {
 namespace cli {
@@ -208,27 +209,7 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
     ctx.warn(
         fmt::format("{} cell void fractions were raised to the minimum (dense packing)", clamps));
   if (ctx.json) {
-    // The model's full result, with what this command adds.
-    nlohmann::json out = full;
-    const double cell_size_m = std::max(scene.geometry.width_m / scene.grid.cells_x,
-                                        scene.geometry.height_m / scene.grid.cells_y);
-    out["result_id"] = result_id > 0 ? nlohmann::json(result_id) : nlohmann::json(nullptr);
-    out["model"] = r.model;
-    // One run: the bound of the bubble boundary on the grid, one gas cell (the larger side). The
-    // packing-realization spread adds in quadrature; `draglab sensitivity` measures it (0-0.5 mm
-    // on the quick scene, 5 mm cells: the cell dominates).
-    // A model with its own estimate (the DBM's batch means of the hold-up) reports that.
-    if (r.headline_uncertainty >= 0.0) {
-      out["numerical_uncertainty"] = r.headline_uncertainty;
-      out["numerical_uncertainty_method"] = r.headline_uncertainty_method;
-    } else {
-      out["numerical_uncertainty"] =
-          r.metrics.bubble_present ? nlohmann::json(cell_size_m) : nlohmann::json(nullptr);
-      out["numerical_uncertainty_method"] =
-          "one gas cell on the bubble boundary (the larger cell side); the packing-realization "
-          "spread is not included: draglab sensitivity adds it in quadrature";
-    }
-    ctx.print_json(out);
+    ctx.print_json(workflows::scene_run_json(scene, r, result_id));
     return;
   }
   std::cout << r.brief << "\n";

@@ -38,7 +38,6 @@
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
-#include "cli/file_util.h"
 #include "cli/progress.h"
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
@@ -47,6 +46,8 @@
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/workflows/bed_results.h"
+#include "draglab/workflows/scripts.h"
 
 namespace draglab {
 namespace cli {
@@ -54,8 +55,6 @@ namespace {
 
 using consumers::Scene;
 
-const char* const kBundleFormat = "draglab_sensitivity";
-const char* const kWorkPrecisionFormat = "draglab_work_precision";
 const char* const kFigureScript = "draglab_fig4.py";
 
 struct SensitivityArgs {
@@ -96,229 +95,11 @@ void write_json_file(const std::string& path, const nlohmann::json& j) {
 /// Runs the figure script on `bundle`; it writes `figure` into out_dir.
 void render(const CliContext& ctx, const std::string& bundle, const std::string& out_dir,
             const std::string& figure, const std::string& beside = "") {
-  const std::string python = python_interpreter();
-  const std::string probe = shell_quote(python) + " -c 'import matplotlib' >/dev/null 2>&1";
-  if (std::system(probe.c_str()) != 0) {
-    throw std::runtime_error(fmt::format(
-        "{} cannot import matplotlib: install the Debian package python3-matplotlib and rerun, "
-        "or draw the figure later with '/usr/bin/python3 {} {} {}'. The data {} were written.",
-        python, find_script(kFigureScript), bundle, out_dir, bundle));
-  }
   std::remove(figure.c_str());  // so a stale figure is never taken for a new one
-  const std::string command = shell_quote(python) + " " + shell_quote(find_script(kFigureScript)) +
-                              " " + shell_quote(bundle) + " " + shell_quote(out_dir) +
-                              (beside.empty() ? "" : " --beside " + shell_quote(beside)) +
-                              (ctx.quiet ? " --quiet" : "") + " 1>&2";
-  const int status = std::system(command.c_str());
-  if (status != 0 || !file_exists(figure)) {
-    throw std::runtime_error(
-        fmt::format("the figure script failed (exit status {}): '{}'; the data {} were kept",
-                    status, command, bundle));
-  }
-}
-
-nlohmann::json number_or_null(double x) {
-  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
-}
-
-nlohmann::json bubble_json(const consumers::BubbleMetrics& b) {
-  return {{"found", b.found},
-          {"diameter_m", b.diameter_m},
-          {"area_m2", b.area_m2},
-          {"cells", b.cells},
-          {"centroid_x_m", b.centroid_x_m},
-          {"centroid_y_m", b.centroid_y_m},
-          {"top_m", b.top_m},
-          {"bottom_m", b.bottom_m},
-          {"touches_surface", b.touches_surface},
-          {"regions_above_threshold", b.regions_above_threshold},
-          {"bed_height_m", b.bed_height_m}};
-}
-
-nlohmann::json snapshot_json(const consumers::BedSnapshot& s) {
-  const auto& f = s.void_fraction;
-  return {{"t_s", s.t_s},
-          {"layers", consumers::kInitialLayers},
-          {"x", s.x},
-          {"y", s.y},
-          {"diameter", s.diameter},
-          {"layer", s.layer},
-          {"void_fraction",
-           {{"nx", f.nx},
-            {"ny", f.ny},
-            {"width_m", f.width_m},
-            {"height_m", f.height_m},
-            {"values", f.values}}},
-          {"bubble", bubble_json(s.bubble)}};
-}
-
-/// Headline numbers as an object by name (their order: "headline_names" beside it).
-nlohmann::json headline_object(const consumers::HeadlineNumbers& numbers) {
-  nlohmann::json j = nlohmann::json::object();
-  for (const auto& [name, value] : numbers) j[name] = number_or_null(value);
-  return j;
-}
-
-/// [cells_x, cells_y], or [cells_x, cells_y, cells_z] on a 3-D grid (as the grid text).
-nlohmann::json grid_json(int cells_x, int cells_y, int cells_z) {
-  return cells_z > 1 ? nlohmann::json{cells_x, cells_y, cells_z} : nlohmann::json{cells_x, cells_y};
-}
-
-nlohmann::json summary_json(const Scene& scene, const consumers::SensitivitySummary& s,
-                            bool with_snapshots) {
-  nlohmann::json grids = nlohmann::json::array();
-  for (const auto& g : s.grids) grids.push_back(grid_json(g.cells_x, g.cells_y, g.cells_z));
-  nlohmann::json headline_names = nlohmann::json::array();
-  if (s.has_headline())
-    for (const auto& h : s.laws.front().headline) headline_names.push_back(h.name);
-  nlohmann::json packings = nlohmann::json::array();
-  for (const auto& p : s.packings) {
-    packings.push_back({{"seed", p.seed},
-                        {"particles", p.particles},
-                        {"settled_bed_height_m", p.settled_bed_height_m},
-                        {"settle_wall_s", p.settle_wall_s}});
-  }
-  nlohmann::json laws = nlohmann::json::array();
-  for (const auto& lr : s.laws) {
-    nlohmann::json runs = nlohmann::json::array();
-    for (const auto& r : lr.runs) {
-      // Column arrays: a few hundred samples per run stay readable and small.
-      nlohmann::json t = nlohmann::json::array(), d = nlohmann::json::array(),
-                     centroid = nlohmann::json::array(), bed = nlohmann::json::array();
-      for (const consumers::DpmSample& smp : r.series) {
-        t.push_back(smp.t_s);
-        d.push_back(smp.bubble_diameter_m);
-        centroid.push_back(smp.bubble_centroid_m);
-        bed.push_back(smp.bed_height_m);
-      }
-      runs.push_back({{"seed", r.seed},
-                      {"cells_x", r.cells_x},
-                      {"cells_y", r.cells_y},
-                      {"cells_z", r.cells_z},
-                      {"cell_size_m", r.cell_size_m},
-                      {"bubble_diameter_m", r.bubble_diameter_m},
-                      {"bubble_found", r.bubble_found},
-                      {"reached_t_ref", r.reached_t_ref},
-                      {"background_m_s", r.background_m_s},
-                      {"wall_s", r.wall_s},
-                      {"gas_steps", r.gas_steps},
-                      {"dem_steps", r.dem_steps},
-                      {"gas_dt_s", r.gas_dt_s},
-                      {"dem_dt_s", r.dem_dt_s},
-                      {"momentum_mismatch", r.momentum_mismatch},
-                      {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
-                      {"void_fraction_clamps", r.void_fraction_clamps},
-                      {"drag_out_of_range", r.drag_out_of_range},
-                      {"headline", headline_object(r.headline)},
-                      {"series",
-                       {{"t_s", t},
-                        {"bubble_diameter_m", d},
-                        {"bubble_centroid_m", centroid},
-                        {"bed_height_m", bed}}}});
-    }
-    nlohmann::json law = {{"law", lr.law},
-                          {"umf_m_s", lr.umf_m_s},
-                          {"background_m_s", lr.background_m_s},
-                          {"background", lr.background_mode},
-                          {"d_mean_m", lr.diameter.mean_m},
-                          {"d_estimate_m", lr.diameter.estimate_m},
-                          {"uncertainty_m", lr.diameter.total_m},
-                          {"spread_m", lr.diameter.spread_m},
-                          {"grid_m", lr.diameter.grid_m},
-                          {"boundary_m", lr.diameter.boundary_m},
-                          {"bubbles_found", lr.bubbles_found},
-                          {"bubble_found", lr.bubbles_found == static_cast<int>(lr.runs.size())},
-                          {"runs", runs},
-                          {"wall_s", lr.wall_s},
-                          {"has_snapshot", lr.has_snapshot}};
-    // Each headline number: the value, its total uncertainty and the parts, per-run values.
-    nlohmann::json headline = nlohmann::json::array();
-    for (std::size_t n = 0; n < lr.headline.size(); ++n) {
-      const auto& h = lr.headline[n];
-      nlohmann::json per_run = nlohmann::json::array();
-      for (const auto& r : lr.runs)
-        per_run.push_back(n < r.headline.size() ? number_or_null(r.headline[n].second) : nullptr);
-      headline.push_back({{"name", h.name},
-                          {"estimate", h.estimate},
-                          {"uncertainty", h.total},
-                          {"spread", h.spread},
-                          {"grid", h.grid},
-                          {"per_run", per_run}});
-    }
-    law["headline"] = headline;
-    if (with_snapshots) {
-      law["snapshot"] = lr.has_snapshot ? snapshot_json(lr.snapshot) : nlohmann::json(nullptr);
-    }
-    laws.push_back(law);
-  }
-  return {{"format", kBundleFormat},
-          {"version", 1},
-          {"scene", s.scene},
-          {"scene_hash", s.scene_hash},
-          {"t_ref_s", s.t_ref_s},
-          {"eps_threshold", s.eps_threshold},
-          {"geometry",
-           {{"width_m", scene.geometry.width_m},
-            {"height_m", scene.geometry.height_m},
-            {"depth_m", scene.geometry.depth_m}}},
-          {"uncertainty",
-           {{"method", consumers::to_string(s.method)},
-            {"description", s.method_description},
-            {"grids", grids}}},
-          {"realization_kind", s.realization_kind},
-          {"headline_names", headline_names},
-          {"packings", packings},
-          {"laws", laws},
-          {"wall_s", s.wall_s}};
-}
-
-nlohmann::json work_precision_json(const consumers::WorkPrecisionResult& w) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (const auto& r : w.rows) {
-    nlohmann::json difference = nlohmann::json::object();
-    for (std::size_t n = 0; n < r.headline.size() && n < r.headline_difference.size(); ++n)
-      difference[r.headline[n].first] = number_or_null(r.headline_difference[n]);
-    rows.push_back({{"cells_x", r.cells_x},
-                    {"cells_y", r.cells_y},
-                    {"cells_z", r.cells_z},
-                    {"time_resolution", r.time_resolution},
-                    {w.time_resolution_name, r.time_resolution},
-                    {"cell_size_m", r.cell_size_m},
-                    {"bubble_diameter_m", r.bubble_diameter_m},
-                    {"bubble_found", r.bubble_found},
-                    {"reached_t_ref", r.reached_t_ref},
-                    {"error_m", number_or_null(r.error_m)},
-                    {"is_reference", r.is_reference},
-                    {"wall_s", r.wall_s},
-                    {"gas_steps", r.gas_steps},
-                    {"dem_steps", r.dem_steps},
-                    {"gas_dt_s", r.gas_dt_s},
-                    {"dem_dt_s", r.dem_dt_s},
-                    {"headline", headline_object(r.headline)},
-                    {"headline_difference", difference}});
-  }
-  nlohmann::json headline_names = nlohmann::json::array();
-  for (const auto& [name, value] : w.reference_headline) headline_names.push_back(name);
-  return {{"format", kWorkPrecisionFormat},
-          {"version", 1},
-          {"scene", w.scene},
-          {"scene_hash", w.scene_hash},
-          {"law", w.law},
-          {"seed", w.seed},
-          {"time_resolution_name", w.time_resolution_name},
-          {"umf_m_s", w.umf_m_s},
-          {"background_m_s", w.background_m_s},
-          {"t_ref_s", w.t_ref_s},
-          {"reference_method", w.reference_method},
-          {"reference_diameter_m", w.reference_diameter_m},
-          {"observed_order", w.reference_method == "richardson" ? nlohmann::json(w.observed_order)
-                                                                : nlohmann::json(nullptr)},
-          {"reference_note", w.reference_note},
-          {"headline_names", headline_names},
-          {"reference_headline", headline_object(w.reference_headline)},
-          {"settle_wall_s", w.settle_wall_s},
-          {"rows", rows},
-          {"wall_s", w.wall_s}};
+  std::vector<std::string> args = {bundle, out_dir};
+  if (!beside.empty()) args.insert(args.end(), {"--beside", beside});
+  if (ctx.quiet) args.push_back("--quiet");
+  workflows::run_figure_script(kFigureScript, args, bundle, figure);
 }
 
 std::string cm(double metres) { return fmt::format("{:.2f}", 100.0 * metres); }
@@ -449,7 +230,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (args.work_precision)
       throw UsageError("--beside is for the law study, not --work-precision");
     if (args.no_figure) throw UsageError("--beside draws a figure: drop --no-figure");
-    if (!file_exists(args.beside))
+    if (!core::file_exists(args.beside))
       throw UsageError("--beside: '" + args.beside +
                        "' does not exist (give another study's sensitivity.json)");
   }
@@ -562,7 +343,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   bool out_dir_made = false;
   const auto on_progress = [&](double f, const std::string& stage) {
     if (!out_dir_made) {
-      make_directories(out_dir);
+      core::make_directories(out_dir, "--out");
       out_dir_made = true;
     }
     if (stage != current) {
@@ -588,10 +369,10 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
                                              : ": the run ended before t_ref (duration rounded "
                                                "to whole gas steps; raise [time] duration_s)"));
     }
-    make_directories(out_dir);
+    core::make_directories(out_dir, "--out");
     const std::string bundle = out_dir + "/work_precision.json";
     const std::string figure = out_dir + "/work_precision.png";
-    nlohmann::json j = work_precision_json(w);
+    nlohmann::json j = workflows::work_precision_bundle_json(w);
     write_json_file(bundle, j);
     if (!no_figure) render(ctx, bundle, out_dir, figure);
     if (ctx.json) {
@@ -634,20 +415,20 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
                       "its mean and uncertainty mix bubble and no bubble",
                       lr.law, lr.runs.size() - lr.bubbles_found, lr.runs.size()));
   }
-  make_directories(out_dir);
+  core::make_directories(out_dir, "--out");
   const std::string bundle = out_dir + "/sensitivity.json";
   const std::string figure = out_dir + "/fig4.png";
-  write_json_file(bundle, summary_json(scene, s, /*with_snapshots=*/true));
+  write_json_file(bundle, workflows::sensitivity_bundle_json(scene, s, /*with_snapshots=*/true));
   const std::string fig5 = out_dir + "/fig5.png";
   if (!no_figure) {
     render(ctx, bundle, out_dir, figure, args.beside);
-    if (!args.beside.empty() && !file_exists(fig5))
+    if (!args.beside.empty() && !core::file_exists(fig5))
       throw std::runtime_error("the figure script wrote no " + fig5 + " (--beside " + args.beside +
                                ")");
   }
   const bool with_fig5 = !no_figure && !args.beside.empty();
   if (ctx.json) {
-    nlohmann::json j = summary_json(scene, s, /*with_snapshots=*/false);
+    nlohmann::json j = workflows::sensitivity_bundle_json(scene, s, /*with_snapshots=*/false);
     j["out_dir"] = out_dir;
     j["data"] = bundle;
     j["figure"] = no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);

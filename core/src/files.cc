@@ -65,6 +65,30 @@ bool is_path_error(int error) {
 
 }  // namespace
 
+bool file_exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool directory_exists(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+void make_directories(const std::string& path, const std::string& field) {
+  std::size_t pos = 0;
+  while (pos != std::string::npos) {
+    pos = path.find('/', pos + 1);
+    const std::string partial = path.substr(0, pos);
+    if (partial.empty() || directory_exists(partial)) continue;
+    if (::mkdir(partial.c_str(), 0777) != 0 && !directory_exists(partial)) {
+      const int error = errno;
+      bad_path(field, path,
+               "cannot create directory " + quoted(partial) + ": " + std::strerror(error));
+    }
+  }
+}
+
 void check_output_file(const std::string& path, const std::string& field) {
   if (path.empty()) throw Error(ErrorCode::kInvalidArgument, field + ": empty path (give a file)");
   struct stat st {};

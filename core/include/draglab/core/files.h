@@ -16,6 +16,14 @@
 namespace draglab {
 namespace core {
 
+/// Whether `path` is a regular file (after symbolic links).
+bool file_exists(const std::string& path);
+/// Whether `path` is a directory (after symbolic links).
+bool directory_exists(const std::string& path);
+/// mkdir -p: creates `path` and its missing parents; an existing directory is fine. Throws
+/// Error(kInvalidArgument) naming `field` (e.g. "--out") and the component that cannot be made.
+void make_directories(const std::string& path, const std::string& field);
+
 /// Checks that `path` can be written as a file: not empty, not a directory or a device, its
 /// directory exists and a file can be created there (tried with a probe file, so read-only
 /// mounts and /proc are caught even for root). `field` names the option in the message.

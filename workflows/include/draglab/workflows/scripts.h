@@ -1,0 +1,39 @@
+// draglab/workflows/scripts.h: the Python figure scripts shipped with draglab (report, Fig. 4/5,
+// Fig. 6) and the interpreter that runs them.
+//
+// The C++ side computes every number and writes a JSON bundle; a script only draws from it, so a
+// figure can be redrawn without rerunning. Scripts need matplotlib, which Debian's
+// /usr/bin/python3 sees (python3-matplotlib); it may not be the python3 first on PATH.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace draglab {
+namespace workflows {
+
+/// Quotes a path for the shell (single quotes; a quote inside is closed, escaped, reopened).
+std::string shell_quote(const std::string& s);
+
+/// Directory of the running executable ("" if unknown).
+std::string executable_dir();
+
+/// A script shipped with draglab: installed next to the executable (bin/../share/draglab), else
+/// the source tree's scripts/. Throws std::runtime_error naming both places if neither exists.
+std::string find_script(const std::string& name);
+
+/// $DRAGLAB_PYTHON (tests, unusual installs), else Debian's /usr/bin/python3.
+std::string python_interpreter();
+
+/// Whether python_interpreter() can import matplotlib.
+bool python_has_matplotlib();
+
+/// Runs `python script args...` with the script's messages on stderr (stdout stays the caller's
+/// for results and JSON). Throws std::runtime_error (a runtime failure, exit 1) when matplotlib
+/// is missing or the script fails or does not write `expected_file`; the message says how to
+/// draw the figure later from `bundle`, which is kept.
+void run_figure_script(const std::string& script_name, const std::vector<std::string>& args,
+                       const std::string& bundle, const std::string& expected_file);
+
+}  // namespace workflows
+}  // namespace draglab
