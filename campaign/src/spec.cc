@@ -10,7 +10,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
-#include "draglab_toml.h"  // toml++, with a fix for its 3.3.0 release
+#include "draglab/core/toml_schema.h"
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
@@ -37,8 +37,8 @@ bool fail(std::string* error, const std::string& message) {
 }
 
 // The keys each section accepts, in documentation order (error messages list them).
-const std::vector<std::pair<std::string, std::vector<std::string>>>& sections() {
-  static const std::vector<std::pair<std::string, std::vector<std::string>>> s = {
+const core::toml_schema::Schema& sections() {
+  static const core::toml_schema::Schema s = {
       {"campaign", {"name", "description"}},
       {"grid", {"phi", "re", "realizations", "seed"}},
       {"packing",
@@ -47,12 +47,6 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& sections() 
       {"dataset", {"extrapolation"}},
   };
   return s;
-}
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& i : items) out += (out.empty() ? "" : ", ") + i;
-  return out;
 }
 
 bool check_list(const std::vector<double>& values, const std::string& field, double lo, double hi,
@@ -72,51 +66,9 @@ bool check_list(const std::vector<double>& values, const std::string& field, dou
   return true;
 }
 
-/// Where a TOML node was defined, for messages ("quick.toml:12").
-std::string where(const std::string& origin, const toml::node& node) {
-  const auto& src = node.source();
-  if (src.begin.line == 0) return origin;
-  return origin + ":" + std::to_string(src.begin.line);
-}
-
 [[noreturn]] void bad(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, message);
 }
-
-/// Reads TOML values into the spec with type checks; the ranges are IsValid's job.
-class Reader {
- public:
-  explicit Reader(std::string origin) : origin_(std::move(origin)) {}
-
-  double number(const toml::node& n, const std::string& field) const {
-    if (auto v = n.value_exact<double>()) return *v;
-    if (auto i = n.value_exact<std::int64_t>()) return static_cast<double>(*i);
-    bad(where(origin_, n) + ": " + field + " must be a number");
-  }
-  std::int64_t integer(const toml::node& n, const std::string& field) const {
-    if (auto i = n.value_exact<std::int64_t>()) return *i;
-    bad(where(origin_, n) + ": " + field + " must be an integer");
-  }
-  std::string text(const toml::node& n, const std::string& field) const {
-    if (auto s = n.value_exact<std::string>()) return *s;
-    bad(where(origin_, n) + ": " + field + " must be a string");
-  }
-  /// A list of numbers; a single number is accepted as a list of one.
-  std::vector<double> numbers(const toml::node& n, const std::string& field) const {
-    std::vector<double> out;
-    if (const toml::array* a = n.as_array()) {
-      for (std::size_t i = 0; i < a->size(); ++i) {
-        out.push_back(number(*a->get(i), field + "[" + std::to_string(i) + "]"));
-      }
-      return out;
-    }
-    out.push_back(number(n, field));
-    return out;
-  }
-
- private:
-  std::string origin_;
-};
 
 }  // namespace
 
@@ -279,80 +231,57 @@ CampaignSpec internal::spec_from_json(const std::string& text) {
 }
 
 CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::string& origin) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, origin);
-  } catch (const toml::parse_error& e) {
-    bad(origin + ":" + std::to_string(e.source().begin.line) +
-        ": not valid TOML: " + std::string(e.description()));
-  }
-  const Reader r(origin);
+  namespace ts = core::toml_schema;
+  const toml::table root = ts::parse(toml_text, origin);
   CampaignSpec s;
   std::set<std::string> given;  // "section.key" present in the file
-  for (const auto& [section_key, section_node] : root) {
-    const std::string section(section_key.str());
-    const std::vector<std::string>* keys = nullptr;
-    std::vector<std::string> section_names;
-    for (const auto& [name, k] : sections()) {
-      section_names.push_back("[" + name + "]");
-      if (name == section) keys = &k;
+  ts::visit(root, origin, sections(), nullptr, [&](const ts::Entry& e) {
+    const toml::node& node = e.node;
+    const std::string& field = e.field;
+    given.insert(e.section + "." + e.key);
+    const std::string id = e.section + "." + e.key;
+    const auto number = [&] { return ts::number(node, field, e.at); };
+    const auto integer = [&] { return ts::integer(node, field, e.at); };
+    const auto text = [&] { return ts::text(node, field, e.at); };
+    const auto numbers = [&] { return ts::numbers(node, field, e.at); };
+    if (id == "campaign.name") s.name = text();
+    if (id == "campaign.description") s.description = text();
+    if (id == "grid.phi") s.phi = numbers();
+    if (id == "grid.re") s.re = numbers();
+    if (id == "grid.realizations") {
+      const std::int64_t v = integer();
+      if (v < 1 || v > 100) bad(field + " = " + std::to_string(v) + " is outside [1, 100]");
+      s.realizations = static_cast<int>(v);
     }
-    if (!keys) {
-      bad(where(origin, section_node) + ": unknown section or key '" + section +
-          "' at the top level; valid sections: " + join(section_names));
+    if (id == "grid.seed") {
+      const std::int64_t v = integer();
+      if (v < 0) bad(field + " = " + std::to_string(v) + " is outside [0, 2^63 - 1]");
+      s.seed = static_cast<std::uint64_t>(v);
     }
-    const toml::table* table = section_node.as_table();
-    if (!table) bad(where(origin, section_node) + ": '" + section + "' must be a [section]");
-    for (const auto& [key_name, node] : *table) {
-      const std::string key(key_name.str());
-      bool known = false;
-      for (const auto& k : *keys) known = known || k == key;
-      if (!known) {
-        bad(where(origin, node) + ": unknown key '" + key + "' in [" + section +
-            "]; valid keys: " + join(*keys));
-      }
-      given.insert(section + "." + key);
-      const std::string field = "[" + section + "] " + key;
-      const std::string id = section + "." + key;
-      if (id == "campaign.name") s.name = r.text(node, field);
-      if (id == "campaign.description") s.description = r.text(node, field);
-      if (id == "grid.phi") s.phi = r.numbers(node, field);
-      if (id == "grid.re") s.re = r.numbers(node, field);
-      if (id == "grid.realizations") {
-        const std::int64_t v = r.integer(node, field);
-        if (v < 1 || v > 100) bad(field + " = " + std::to_string(v) + " is outside [1, 100]");
-        s.realizations = static_cast<int>(v);
-      }
-      if (id == "grid.seed") {
-        const std::int64_t v = r.integer(node, field);
-        if (v < 0) bad(field + " = " + std::to_string(v) + " is outside [0, 2^63 - 1]");
-        s.seed = static_cast<std::uint64_t>(v);
-      }
-      if (id == "packing.spheres") {
-        const std::int64_t v = r.integer(node, field);
-        if (v < 1 || v > 100000) bad(field + " = " + std::to_string(v) + " is outside [1, 100000]");
-        s.spheres = static_cast<int>(v);
-      }
-      if (id == "packing.box_size") s.box_size = r.number(node, field);
-      if (id == "packing.distribution") s.distribution = r.text(node, field);
-      if (id == "packing.size_ratio") s.size_ratio = r.number(node, field);
-      if (id == "packing.large_fraction") s.large_fraction = r.number(node, field);
-      if (id == "packing.sigma") s.sigma = r.number(node, field);
-      if (id == "packing.min_gap") s.min_gap = r.number(node, field);
-      if (id == "lbm.resolutions") s.resolutions = r.numbers(node, field);
-      if (id == "lbm.collision") s.collision = r.text(node, field);
-      if (id == "lbm.boundary") s.boundary = r.text(node, field);
-      if (id == "lbm.tolerance") s.tolerance = r.number(node, field);
-      if (id == "lbm.max_steps") {
-        const std::int64_t v = r.integer(node, field);
-        if (v < 1 || v > 100000000) {
-          bad(field + " = " + std::to_string(v) + " is outside [1, 100000000]");
-        }
-        s.max_steps = v;
-      }
-      if (id == "dataset.extrapolation") s.extrapolation = r.text(node, field);
+    if (id == "packing.spheres") {
+      const std::int64_t v = integer();
+      if (v < 1 || v > 100000) bad(field + " = " + std::to_string(v) + " is outside [1, 100000]");
+      s.spheres = static_cast<int>(v);
     }
-  }
+    if (id == "packing.box_size") s.box_size = number();
+    if (id == "packing.distribution") s.distribution = text();
+    if (id == "packing.size_ratio") s.size_ratio = number();
+    if (id == "packing.large_fraction") s.large_fraction = number();
+    if (id == "packing.sigma") s.sigma = number();
+    if (id == "packing.min_gap") s.min_gap = number();
+    if (id == "lbm.resolutions") s.resolutions = numbers();
+    if (id == "lbm.collision") s.collision = text();
+    if (id == "lbm.boundary") s.boundary = text();
+    if (id == "lbm.tolerance") s.tolerance = number();
+    if (id == "lbm.max_steps") {
+      const std::int64_t v = integer();
+      if (v < 1 || v > 100000000) {
+        bad(field + " = " + std::to_string(v) + " is outside [1, 100000000]");
+      }
+      s.max_steps = v;
+    }
+    if (id == "dataset.extrapolation") s.extrapolation = text();
+  });
   // Required keys, then contradictions a default would hide.
   for (const char* required : {"campaign.name", "grid.phi", "grid.re", "lbm.resolutions"}) {
     if (!given.count(required)) {

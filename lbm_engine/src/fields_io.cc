@@ -15,6 +15,7 @@
 #include "drag_db_version.h"
 #include "draglab/core/files.h"
 #include "draglab/core/hdf5_file.h"
+#include "draglab/core/xdmf.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -64,77 +65,24 @@ std::string base_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-/// XML-escapes a file name for the DataItem text.
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string xdmf_text(const std::string& h5_name, const Fields& f, double dx) {
+  namespace xdmf = core::xdmf;
   const std::int64_t nx = f.dims[0], ny = f.dims[1], nz = f.dims[2];
-  const std::string cells =
-      std::to_string(nz) + " " + std::to_string(ny) + " " + std::to_string(nx);
-  const std::string points =
-      std::to_string(nz + 1) + " " + std::to_string(ny + 1) + " " + std::to_string(nx + 1);
-  const std::string file = xml_escape(h5_name);
-  char spacing[128];
-  std::snprintf(spacing, sizeof spacing, "%.17g %.17g %.17g", dx, dx, dx);
-  std::ostringstream x;
-  // XDMF 2 conventions (checked with ParaView 5.11's XDMFReader): Topology Dimensions are point
-  // counts in z y x order; Origin and spacing are z y x too; cell attributes are "nz ny nx".
-  x << "<?xml version=\"1.0\" ?>\n"
-    << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-    << "<Xdmf Version=\"2.0\">\n"
-    << " <Domain>\n"
-    << "  <Grid Name=\"lbm\" GridType=\"Uniform\">\n"
-    << "   <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << points << "\"/>\n"
-    << "   <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
-    << "    <DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
-       "Format=\"XML\">0 0 0</DataItem>\n"
-    << "    <DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
-       "Format=\"XML\">"
-    << spacing << "</DataItem>\n"
-    << "   </Geometry>\n"
-    << "   <Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Cell\">\n"
-    << "    <DataItem Dimensions=\"" << cells
-    << " 3\" NumberType=\"Float\" Precision=\"4\" "
-       "Format=\"HDF\">"
-    << file << ":/fields/velocity</DataItem>\n"
-    << "   </Attribute>\n"
-    << "   <Attribute Name=\"density\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-    << "    <DataItem Dimensions=\"" << cells
-    << "\" NumberType=\"Float\" Precision=\"4\" "
-       "Format=\"HDF\">"
-    << file << ":/fields/density</DataItem>\n"
-    << "   </Attribute>\n"
-    << "   <Attribute Name=\"solid\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-    << "    <DataItem Dimensions=\"" << cells
-    << "\" NumberType=\"UChar\" Precision=\"1\" "
-       "Format=\"HDF\">"
-    << file << ":/fields/solid</DataItem>\n"
-    << "   </Attribute>\n"
-    << "  </Grid>\n"
-    << " </Domain>\n"
-    << "</Xdmf>\n";
-  return x.str();
+  const std::string cells = xdmf::cell_dims(nx, ny, nz);
+  const std::string in = "    ";
+  return xdmf::begin_document() + "  <Grid Name=\"lbm\" GridType=\"Uniform\">\n" +
+         xdmf::corect_mesh(nx, ny, nz, dx, dx, dx, "   ") +
+         "   <Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Cell\">\n" +
+         xdmf::hdf_item(cells + " 3", "Float", 4, h5_name, "/fields/velocity", in) +
+         "   </Attribute>\n"
+         "   <Attribute Name=\"density\" AttributeType=\"Scalar\" Center=\"Cell\">\n" +
+         xdmf::hdf_item(cells, "Float", 4, h5_name, "/fields/density", in) +
+         "   </Attribute>\n"
+         "   <Attribute Name=\"solid\" AttributeType=\"Scalar\" Center=\"Cell\">\n" +
+         xdmf::hdf_item(cells, "UChar", 1, h5_name, "/fields/solid", in) +
+         "   </Attribute>\n"
+         "  </Grid>\n" +
+         xdmf::end_document();
 }
 
 void check_fields(const Fields& f, const std::string& path) {

@@ -47,10 +47,10 @@ std::string error_of(const std::string& text) {
 // toml++ 3.3.0 reached __builtin_unreachable() when it asked whether a character of U+00A1 ..
 // U+049A (Latin-1 letters, Greek, Cyrillic) was whitespace: for a stray letter outside strings
 // (the fuzzer's input was the two bytes of "Î" alone), a quoted key, or the first character of a
-// line continued by a line-ending backslash (third_party/toml/draglab_toml.h).
+// line continued by a line-ending backslash (core/include/draglab/core/tomlpp.h).
 TEST(SpecFuzzRegression, NonAsciiLetterOutsideStringsIsInvalidToml) {
-  for (const std::string text : {std::string("\xC3\x8E"), std::string("\xCF\xBC"),
-                                 std::string("[campaign]\nname = \"x\" \xC3\xA9\n")}) {
+  for (const std::string& text : {std::string("\xC3\x8E"), std::string("\xCF\xBC"),
+                                  std::string("[campaign]\nname = \"x\" \xC3\xA9\n")}) {
     const std::string message = error_of(text);
     EXPECT_NE(message.find("not valid TOML"), std::string::npos) << message;
   }

@@ -32,10 +32,10 @@ std::string error_of(const std::string& text) {
 }
 
 // toml++ 3.3.0 reached __builtin_unreachable() when it asked whether a character of U+00A1 ..
-// U+049A (Latin-1 letters, Greek, Cyrillic) was whitespace (third_party/toml/draglab_toml.h).
+// U+049A (Latin-1 letters, Greek, Cyrillic) was whitespace (core/include/draglab/core/tomlpp.h).
 TEST(SceneFuzzRegression, NonAsciiLetterOutsideStringsIsInvalidToml) {
-  for (const std::string text : {std::string("\xC3\x8E"), std::string("[scene]\n\xC2\xB5 = 1\n"),
-                                 std::string("[scene]\nname = \"x\" \xC3\xA9\n")}) {
+  for (const std::string& text : {std::string("\xC3\x8E"), std::string("[scene]\n\xC2\xB5 = 1\n"),
+                                  std::string("[scene]\nname = \"x\" \xC3\xA9\n")}) {
     const std::string message = error_of(text);
     EXPECT_NE(message.find("not valid TOML"), std::string::npos) << message;
   }

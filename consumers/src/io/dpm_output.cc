@@ -18,7 +18,9 @@
 #include <vector>
 
 #include "drag_db_version.h"
+#include "draglab/core/files.h"
 #include "draglab/core/hdf5_file.h"
+#include "draglab/core/xdmf.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -26,43 +28,10 @@ namespace consumers {
 namespace {
 
 using Handle = core::Hdf5Handle;
+namespace xdmf = core::xdmf;
 
 [[noreturn]] void Fail(const std::string& path, const std::string& what) {
   throw Error(ErrorCode::kInvalidArgument, "DPM output '" + path + "': " + what);
-}
-
-/// Shortest of %.15g .. %.17g that reads back as the same double (0.025, not
-/// 0.025000000000000001, in the index a user reads).
-std::string Number(double value) {
-  char text[40];
-  for (int digits = 15; digits <= 17; ++digits) {
-    std::snprintf(text, sizeof text, "%.*g", digits, value);
-    if (std::strtod(text, nullptr) == value) break;
-  }
-  return text;
-}
-
-std::string XmlEscape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
 }
 
 /// "name@version" -> "name_version"; anything outside [A-Za-z0-9_.-] becomes '_' too, so the
@@ -124,37 +93,17 @@ struct OutputTime {
   std::size_t particle_count = 0;
 };
 
-/// One HDF DataItem; `dims` is the XDMF Dimensions string.
-std::string HdfItem(const std::string& dims, const char* number_type, int precision,
-                    const std::string& h5_name, const std::string& dataset, const char* indent) {
-  std::ostringstream x;
-  x << indent << "<DataItem Dimensions=\"" << dims << "\" NumberType=\"" << number_type
-    << "\" Precision=\"" << precision << "\" Format=\"HDF\">" << h5_name << ":" << dataset
-    << "</DataItem>\n";
-  return x.str();
-}
-
 std::string GasGrid(const OutputTime& o, const std::string& h5_name) {
-  // VTK x = width (nx cells), VTK y = height (nz gas cells), VTK z = depth (one cell). XDMF 2
-  // lists every triple slowest axis first (z y x): point counts for the topology, origin and
-  // spacing likewise, and cell attributes "nz ny nx" = HDF5 shape (1, nz, nx), x fastest.
-  const std::string cells = "1 " + std::to_string(o.nz) + " " + std::to_string(o.nx);
-  const std::string points = "2 " + std::to_string(o.nz + 1) + " " + std::to_string(o.nx + 1);
+  // VTK x = width (nx cells), VTK y = height (nz gas cells), VTK z = depth (one cell).
+  const std::string cells = xdmf::cell_dims(o.nx, o.nz, 1);
   const char* in = "      ";
   std::ostringstream x;
   x << "    <Grid Name=\"gas\" GridType=\"Uniform\">\n"
-    << "     <Time Value=\"" << Number(o.t_s) << "\"/>\n"
-    << "     <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << points << "\"/>\n"
-    << "     <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
-    << in << "<DataItem Name=\"Origin\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
-    << "Format=\"XML\">0 0 0</DataItem>\n"
-    << in << "<DataItem Name=\"Spacing\" Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
-    << "Format=\"XML\">" << Number(o.depth) << " " << Number(o.dz) << " " << Number(o.dx)
-    << "</DataItem>\n"
-    << "     </Geometry>\n";
+    << "     <Time Value=\"" << xdmf::number(o.t_s) << "\"/>\n"
+    << xdmf::corect_mesh(o.nx, o.nz, 1, o.dx, o.dz, o.depth, "     ");
   for (const std::string& name : o.field_names) {
     x << "     <Attribute Name=\"" << name << "\" AttributeType=\"Scalar\" Center=\"Cell\">\n"
-      << HdfItem(cells, "Float", 8, h5_name, "/" + o.group + "/" + name, in)
+      << xdmf::hdf_item(cells, "Float", 8, h5_name, "/" + o.group + "/" + name, in)
       << "     </Attribute>\n";
   }
   x << "    </Grid>\n";
@@ -169,33 +118,29 @@ std::string ParticleGrid(const OutputTime& o, const std::string& h5_name) {
   const char* in = "      ";
   std::ostringstream x;
   x << "    <Grid Name=\"particles\" GridType=\"Uniform\">\n"
-    << "     <Time Value=\"" << Number(o.t_s) << "\"/>\n"
+    << "     <Time Value=\"" << xdmf::number(o.t_s) << "\"/>\n"
     << "     <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
     << "\" NodesPerElement=\"1\"/>\n"
     << "     <Geometry GeometryType=\"XYZ\">\n"
-    << HdfItem(n3, "Float", 8, h5_name, at + "position", in) << "     </Geometry>\n"
+    << xdmf::hdf_item(n3, "Float", 8, h5_name, at + "position", in) << "     </Geometry>\n"
     << "     <Attribute Name=\"velocity\" AttributeType=\"Vector\" Center=\"Node\">\n"
-    << HdfItem(n3, "Float", 8, h5_name, at + "velocity", in) << "     </Attribute>\n"
+    << xdmf::hdf_item(n3, "Float", 8, h5_name, at + "velocity", in) << "     </Attribute>\n"
     << "     <Attribute Name=\"diameter\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-    << HdfItem(n, "Float", 8, h5_name, at + "diameter", in) << "     </Attribute>\n"
+    << xdmf::hdf_item(n, "Float", 8, h5_name, at + "diameter", in) << "     </Attribute>\n"
     << "     <Attribute Name=\"id\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-    << HdfItem(n, "Int", 8, h5_name, at + "id", in) << "     </Attribute>\n"
+    << xdmf::hdf_item(n, "Int", 8, h5_name, at + "id", in) << "     </Attribute>\n"
     << "     <Attribute Name=\"layer\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-    << HdfItem(n, "Int", 4, h5_name, at + "layer", in) << "     </Attribute>\n"
+    << xdmf::hdf_item(n, "Int", 4, h5_name, at + "layer", in) << "     </Attribute>\n"
     << "    </Grid>\n";
   return x.str();
 }
 
 std::string XdmfText(const std::vector<OutputTime>& outputs, const std::string& h5_name,
                      const std::string& scene, const std::string& law) {
-  const std::string file = XmlEscape(h5_name);
   std::ostringstream x;
-  x << "<?xml version=\"1.0\" ?>\n"
-    << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-    << "<Xdmf Version=\"2.0\">\n"
-    << " <Domain>\n"
-    << "  <Information Name=\"scene\" Value=\"" << XmlEscape(scene) << "\"/>\n"
-    << "  <Information Name=\"law\" Value=\"" << XmlEscape(law) << "\"/>\n";
+  x << xdmf::begin_document() << "  <Information Name=\"scene\" Value=\"" << xdmf::escape(scene)
+    << "\"/>\n"
+    << "  <Information Name=\"law\" Value=\"" << xdmf::escape(law) << "\"/>\n";
   // One temporal collection per kind, so ParaView's reader lists "gas" and "particles" as
   // separate grids (blocks) that can be switched on and off.
   bool any_fields = false, any_particles = false;
@@ -207,19 +152,18 @@ std::string XdmfText(const std::vector<OutputTime>& outputs, const std::string& 
   if (any_fields) {
     x << "  <Grid Name=\"gas\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
     for (const OutputTime& o : outputs) {
-      if (o.fields) x << GasGrid(o, file);
+      if (o.fields) x << GasGrid(o, h5_name);
     }
     x << "  </Grid>\n";
   }
   if (any_particles) {
     x << "  <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
     for (const OutputTime& o : outputs) {
-      if (o.particles && o.particle_count > 0) x << ParticleGrid(o, file);
+      if (o.particles && o.particle_count > 0) x << ParticleGrid(o, h5_name);
     }
     x << "  </Grid>\n";
   }
-  x << " </Domain>\n"
-    << "</Xdmf>\n";
+  x << xdmf::end_document();
   return x.str();
 }
 
@@ -369,8 +313,9 @@ void DpmOutputWriter::Impl::Append(double t_s, const CellFields* cells,
   Impl& m = *this;
   if (!std::isfinite(t_s)) Fail(m.h5_path, "output time t_s must be finite");
   if (!m.outputs.empty() && !(t_s > m.outputs.back().t_s)) {
-    Fail(m.h5_path, "output time t_s = " + Number(t_s) + " s must be after the previous one (" +
-                        Number(m.outputs.back().t_s) + " s)");
+    Fail(m.h5_path, "output time t_s = " + xdmf::number(t_s) +
+                        " s must be after the previous one (" + xdmf::number(m.outputs.back().t_s) +
+                        " s)");
   }
   OutputTime o;
   char group[32];
@@ -458,21 +403,9 @@ void DpmOutputWriter::Impl::Append(double t_s, const CellFields* cells,
 void DpmOutputWriter::Finish() {
   Impl& m = *impl_;
   if (m.index_current || m.outputs.empty()) return;
-  // Written next to the data and renamed into place: ParaView never sees half an index.
-  const std::string partial = m.xmf_path + ".partial";
-  {
-    std::ofstream out(partial, std::ios::trunc);
-    out << XdmfText(m.outputs, m.h5_name, m.scene_name, m.law);
-    out.close();
-    if (!out) {
-      std::remove(partial.c_str());
-      Fail(m.xmf_path, "cannot write the XDMF index (is the directory writable?)");
-    }
-  }
-  if (std::rename(partial.c_str(), m.xmf_path.c_str()) != 0) {
-    std::remove(partial.c_str());
-    Fail(m.xmf_path, "cannot move the finished XDMF index into place");
-  }
+  // Written whole and renamed into place: ParaView never sees half an index.
+  core::write_file_atomically(m.xmf_path, XdmfText(m.outputs, m.h5_name, m.scene_name, m.law),
+                              "XDMF index");
   m.xmf_written = true;
   m.index_current = true;
 }

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "draglab_toml.h"  // toml++, with a fix for its 3.3.0 release
+#include "draglab/core/toml_schema.h"
 
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/ktgf.h"
@@ -43,18 +43,6 @@ bool in_range(double x, double lo, double hi, bool open_lo, bool open_hi, const 
                          ", " + fmt(hi) + (open_hi ? ")" : "]") + (unit.empty() ? "" : " " + unit));
 }
 
-std::string where(const std::string& origin, const toml::node& node) {
-  const auto& src = node.source();
-  if (src.begin.line == 0) return origin;
-  return origin + ":" + std::to_string(src.begin.line);
-}
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& i : items) out += (out.empty() ? "" : ", ") + i;
-  return out;
-}
-
 /// One key of a section and how to store it into the Scene.
 struct Key {
   std::string name;
@@ -63,21 +51,16 @@ struct Key {
 };
 
 double as_number(const toml::node& n, const std::string& field, const std::string& at) {
-  if (auto v = n.value_exact<double>()) return *v;
-  if (auto i = n.value_exact<std::int64_t>()) return static_cast<double>(*i);
-  bad(at + ": " + field + " must be a number");
+  return core::toml_schema::number(n, field, at);
 }
 std::int64_t as_integer(const toml::node& n, const std::string& field, const std::string& at) {
-  if (auto i = n.value_exact<std::int64_t>()) return *i;
-  bad(at + ": " + field + " must be an integer");
+  return core::toml_schema::integer(n, field, at);
 }
 std::string as_text(const toml::node& n, const std::string& field, const std::string& at) {
-  if (auto s = n.value_exact<std::string>()) return *s;
-  bad(at + ": " + field + " must be a string");
+  return core::toml_schema::text(n, field, at);
 }
 bool as_bool(const toml::node& n, const std::string& field, const std::string& at) {
-  if (auto b = n.value_exact<bool>()) return *b;
-  bad(at + ": " + field + " must be true or false");
+  return core::toml_schema::boolean(n, field, at);
 }
 
 void read_contact_steps(Scene& s, const toml::node& n, const std::string& f,
@@ -521,30 +504,21 @@ const char* to_string(BackgroundMode mode) {
 }
 
 Scene parse_scene(const std::string& toml_text, const std::string& origin) {
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, origin);
-  } catch (const toml::parse_error& e) {
-    bad(origin + ":" + std::to_string(e.source().begin.line) +
-        ": not valid TOML: " + std::string(e.description()));
-  }
+  namespace ts = core::toml_schema;
+  const toml::table root = ts::parse(toml_text, origin);
+  static const ts::Schema names = [] {
+    ts::Schema out;
+    for (const auto& [section, keys] : sections()) {
+      out.push_back({section, {}});
+      for (const Key& k : keys) out.back().second.push_back(k.name);
+    }
+    return out;
+  }();
   Scene s;
   s.origin = origin;
   s.source_text = toml_text;
-  std::vector<std::string> section_names;
-  for (const auto& [name, keys] : sections()) section_names.push_back("[" + name + "]");
-  for (const auto& [section_key, section_node] : root) {
-    const std::string section(section_key.str());
-    const std::vector<Key>* keys = nullptr;
-    for (const auto& [name, k] : sections()) {
-      if (name == section) keys = &k;
-    }
-    if (!keys) {
-      bad(where(origin, section_node) + ": unknown section or key '" + section +
-          "' at the top level; valid sections: " + join(section_names));
-    }
-    const toml::table* table = section_node.as_table();
-    if (!table) bad(where(origin, section_node) + ": '" + section + "' must be a [section]");
+  const auto on_section = [&](const std::string& section, const toml::table& table,
+                              const std::string& at) {
     if (section == "tfm") s.tfm.present = true;
     if (section == "dbm") s.dbm.present = true;
     s.tables.push_back(section);
@@ -552,27 +526,21 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
       s.dem_table = true;
       for (const auto& key : kDemKeys) {
         const toml::table* old = root[key[1]].as_table();
-        if (table->contains(key[0]) && old && old->contains(key[0])) {
-          bad(where(origin, section_node) + ": " + key[0] + " is given in [dem] and in [" + key[1] +
+        if (table.contains(key[0]) && old && old->contains(key[0])) {
+          bad(at + ": " + key[0] + " is given in [dem] and in [" + key[1] +
               "]: keep it in [dem] only");
         }
       }
     }
-    for (const auto& [key_name, node] : *table) {
-      const std::string key(key_name.str());
-      const Key* found = nullptr;
-      std::vector<std::string> names;
-      for (const auto& k : *keys) {
-        names.push_back(k.name);
-        if (k.name == key) found = &k;
+  };
+  ts::visit(root, origin, names, on_section, [&](const ts::Entry& e) {
+    for (const auto& [section, keys] : sections()) {
+      if (section != e.section) continue;
+      for (const Key& k : keys) {
+        if (k.name == e.key) k.read(s, e.node, e.field, e.at);
       }
-      if (!found) {
-        bad(where(origin, node) + ": unknown key '" + key + "' in [" + section +
-            "]; valid keys: " + join(names));
-      }
-      found->read(s, node, "[" + section + "] " + key, where(origin, node));
     }
-  }
+  });
   std::string error;
   if (!s.IsValid(&error)) bad(origin + ": " + error);
   return s;
