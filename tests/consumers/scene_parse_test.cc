@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/error.h"
@@ -71,6 +72,32 @@ TEST(SceneParse, SeedSceneDeclaresTheSeedBed) {
   const Scene q = load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_bubble_quick.toml");
   EXPECT_LT(q.particle_count(), 5000);
   EXPECT_NE(q.hash(), s.hash());
+}
+
+// data/scenes/dpm_tiny.toml, the shared scene of the fast tests: the bed the tests' comments
+// describe (tests derive their variants from it key by key, so a change here shows up there).
+TEST(SceneParse, TinySceneDeclaresTheTestBed) {
+  const Scene s = load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_tiny.toml");
+  EXPECT_EQ(s.name, "dpm_tiny");
+  EXPECT_EQ(s.solver, "dpm");
+  EXPECT_EQ(s.seed, 3u);
+  EXPECT_DOUBLE_EQ(s.geometry.width_m, 0.03);
+  EXPECT_DOUBLE_EQ(s.geometry.height_m, 0.09);
+  EXPECT_DOUBLE_EQ(s.geometry.depth_m, 0.0075);
+  EXPECT_DOUBLE_EQ(s.particles.diameter_m, 2.5e-3);
+  EXPECT_DOUBLE_EQ(s.particles.spring_stiffness_n_m, 7000.0);
+  EXPECT_DOUBLE_EQ(s.bed_height_mf_m(), 0.02);
+  // N = 0.58 * 0.03 * 0.0075 * 0.02 / 8.181e-9 = 319.
+  EXPECT_NEAR(static_cast<double>(s.particle_count()), 319.0, 1.0);
+  EXPECT_TRUE(s.dem_table);
+  EXPECT_EQ(s.time.contact_steps, 20);
+  EXPECT_DOUBLE_EQ(s.time.duration_s, 0.06);
+  EXPECT_DOUBLE_EQ(s.time.t_ref_s, 0.03);
+  EXPECT_EQ(s.grid.cells_x, 4);
+  EXPECT_EQ(s.grid.cells_y, 12);
+  EXPECT_EQ(s.laws, std::vector<std::string>{"ergun@1"});
+  std::string why;
+  EXPECT_TRUE(s.IsValid(&why)) << why;
 }
 
 TEST(SceneParse, CountAndHeightAreInterchangeable) {
