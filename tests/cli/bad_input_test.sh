@@ -10,12 +10,13 @@
 #   csv_with ROW COL=VALUE...        the fixture dataset CSV with fields of data row ROW changed
 #   csv_lines TEXT                   a CSV file with exactly TEXT (printf escapes)
 #   toml_with SRC TABLE.KEY=VALUE... a copy of TOML file SRC with keys replaced (VALUE '-' drops
-#                                    the key, TABLE.+KEY=VALUE adds one)
+#                                    the key, TABLE.+KEY=VALUE adds one; tests/support/toml_edit.sh)
 # Usage: bad_input_test.sh DRAGLAB MATRIX DATA_DIR
 set -u
 draglab="$(realpath "$1")"
 matrix="$(realpath "$2")"
 data="$(realpath "$3")"
+. "$(dirname "$0")/../support/toml_edit.sh"
 work="$(mktemp -d)"
 trap 'chmod -R u+w "$work" 2>/dev/null; rm -rf "$work"' EXIT
 cd "$work" || exit 1
@@ -70,33 +71,17 @@ csv_lines() {
   printf "$1" >"$out"
   echo "$out"
 }
-toml_with() {  # toml_with SRC TABLE.KEY=VALUE...
-  local src="$1"
-  shift
+toml_with() {  # toml_with SRC TABLE.KEY=VALUE...: the edits of tests/support/toml_edit.sh
   local out
   out="$(mktemp "$in/case_XXXXXX.toml")"
-  cp "$src" "$out"
-  local edit table key value
-  for edit in "$@"; do
-    table="${edit%%.*}"
-    key="${edit#*.}"
-    value="${key#*=}"
-    key="${key%%=*}"
-    awk -v table="$table" -v key="$key" -v value="$value" '
-      function flush_add() { if (adding && current == table) { print substr(key, 2) " = " value; adding = 0 } }
-      BEGIN { adding = (substr(key, 1, 1) == "+") }
-      /^\[/ { flush_add(); current = substr($0, 2, index($0, "]") - 2) }
-      current == table && index($0, key) == 1 && substr($0, length(key) + 1) ~ /^[ \t]*=/ {
-        if (value != "-") print key " = " value
-        next }
-      { print }
-      END { flush_add() }' "$out" >"$out.new" && mv "$out.new" "$out"
-  done
+  # An edit that finds nothing names a file that is not there: the case then fails on its
+  # pattern instead of passing on the unedited fixture.
+  toml_edit "$@" >"$out" || out="$in/toml_edit_failed.toml"
   echo "$out"
 }
 
 export D DL DB in o dataset_id big_dataset_id
-export -f csv_with csv_lines toml_with
+export -f csv_with csv_lines toml_edit toml_with
 
 # The state a failed command must not change: the fixture database's content and the files
 # outside the inputs (SQLite's own side files excepted).
