@@ -7,9 +7,7 @@
 // own (the studies reuse one packing across laws and grids), a packing of another seed is
 // refused, and the time-resolution hook sets the value that sets each model's step.
 #include <algorithm>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -22,23 +20,18 @@
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law_form.h"
+#include "support/toml_edit.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
 
-/// The tiny DPM bed of the command-line regress tests (tests/cli/data/regress_tiny.toml), with
-/// its solver replaced.
+/// The tiny DPM bed (data/scenes/dpm_tiny.toml), with its solver replaced (and for another
+/// model without the DPM's own [dem] table, which scenes of other models may not have).
 std::string scene_text(const std::string& solver) {
-  std::ifstream file(std::string(DRAGLAB_TEST_SCENES_DIR) + "/regress_tiny.toml");
-  std::stringstream text;
-  text << file.rdbuf();
-  std::string out = text.str();
-  const std::string dpm = "solver = \"dpm\"";
-  const std::size_t at = out.find(dpm);
-  EXPECT_NE(at, std::string::npos) << "regress_tiny.toml not found or changed";
-  if (at != std::string::npos) out.replace(at, dpm.size(), "solver = \"" + solver + "\"");
-  return out;
+  std::string text = test::read_text(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_tiny.toml");
+  if (solver != "dpm") text = test::toml_without_table(text, "dem");
+  return test::toml_edit(text, "scene.solver=\"" + solver + "\"");
 }
 
 std::shared_ptr<const Law> ergun() {
@@ -118,7 +111,7 @@ TEST(BedModel, ScenesNameRegisteredModelsAndRunsDispatchToThem) {
   options.duration_s = 0.25;
   const BedResult r = run_bed_model(scene, ergun(), options);
   EXPECT_EQ(r.model, "echo_test");
-  EXPECT_EQ(r.scene, "dpm_tiny_test");
+  EXPECT_EQ(r.scene, "dpm_tiny");
   EXPECT_EQ(r.law, "ergun@1");
   EXPECT_EQ(r.wall_s, 0.25);
   options.duration_s = -1.0;

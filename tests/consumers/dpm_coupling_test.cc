@@ -1,7 +1,8 @@
 // Coupled DPM validation (consumers/dpm.h): fixed-bed pressure drop, the fluidization plateau,
 // the bed at rest at U_mf, gas mass conservation and drag action-reaction, on a tiny bed.
 //
-// Set-up: a 3 x 9 x 0.75 cm box (4 x 12 gas cells of 7.5 mm = 3 d), 2.5 mm glass beads
+// Set-up: data/scenes/dpm_tiny.toml with a 3 cm bed and a longer run (TinySceneText): a
+// 3 x 9 x 0.75 cm box (4 x 12 gas cells of 7.5 mm = 3 d), 2.5 mm glass beads
 // (rho_p = 2526 kg/m^3, e = 0.97, mu_f = 0.1, k_n = 7000 N/m), air (rho = 1.2 kg/m^3,
 // mu = 1.8e-5 Pa s), a 3 cm bed at eps_mf = 0.42 (~480 particles) settled under gravity; the law
 // is ergun@1 from a fresh database (seeded with the literature laws).
@@ -61,55 +62,19 @@
 #include "draglab/consumers/dpm.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
+#include "support/toml_edit.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
 
-const char* kTinyScene = R"(
-[scene]
-name = "dpm_tiny_test"
-solver = "dpm"
-seed = 3
-[geometry]
-width_m = 0.03
-height_m = 0.09
-depth_m = 0.0075
-[particles]
-diameter_m = 2.5e-3
-density_kg_m3 = 2526.0
-restitution = 0.97
-friction = 0.1
-spring_stiffness_n_m = 7000.0
-bed_height_mf_m = 0.03
-[gas]
-density_kg_m3 = 1.2
-viscosity_pa_s = 1.8e-5
-gravity_m_s2 = 9.81
-[distributor]
-background = "umf"
-umf_factor = 1.0
-[jet]
-slot_width_m = 0.0075
-velocity_m_s = 10.0
-start_s = 0.01
-duration_s = 0.03
-[time]
-settle_s = 0.3
-duration_s = 0.08
-t_ref_s = 0.05
-contact_steps = 20
-[grid]
-cells_x = 4
-cells_y = 12
-[bubble]
-eps_threshold = 0.8
-sample_interval_s = 0.01
-[drag]
-laws = ["ergun@1"]
-eps_mf = 0.42
-range_policy = "clamp"
-)";
+/// data/scenes/dpm_tiny.toml with the bed and run of the set-up: a 3 cm bed (the shared scene's
+/// is 2 cm), a 0.03 s jet and 0.08 s simulated, D at 0.05 s.
+std::string TinySceneText() {
+  return test::toml_edit(test::read_text(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_tiny.toml"),
+                         {"particles.bed_height_mf_m=0.03", "jet.duration_s=0.03",
+                          "time.duration_s=0.08", "time.t_ref_s=0.05"});
+}
 
 class DpmCouplingTest : public ::testing::Test {
  protected:
@@ -131,7 +96,7 @@ class DpmCouplingTest : public ::testing::Test {
     std::remove(path_.c_str());
   }
   static std::shared_ptr<const Law> ergun() { return db_->load("ergun@1", RangePolicy::kClamp); }
-  static Scene tiny() { return parse_scene(kTinyScene, "dpm_tiny_test"); }
+  static Scene tiny() { return parse_scene(TinySceneText(), "dpm_tiny.toml (3 cm bed)"); }
   static double WidthMeanEps(const DpmSimulation& sim, int j) {
     const GridField2D f = sim.VoidFractionField();
     double s = 0.0;

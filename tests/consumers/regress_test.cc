@@ -1,8 +1,8 @@
 // Regression-check logic (consumers/regress.h) without consumer runs.
 //
-// Set-up: a fresh database per test (literature laws seeded: ergun@1), the tiny DPM scene text of
-// dpm_coupling_test.cc registered, and hand-written stored results (the DPM itself is exercised by
-// tests/cli/regress_test.sh). New versions of ergun are made from ergun@1's record.
+// Set-up: a fresh database per test (literature laws seeded: ergun@1), the tiny DPM scene
+// data/scenes/dpm_tiny.toml registered, and hand-written stored results (the DPM itself is
+// exercised by tests/cli/regress_test.sh). New versions of ergun are made from ergun@1's record.
 // What is checked, and the reference:
 //  - compare_metrics against hand-computed limits: |delta| equal to the tolerance is ok, just
 //    above it moved (U_mf relative, diameter absolute + relative to the baseline), a bubble that
@@ -44,38 +44,7 @@ namespace draglab {
 namespace consumers {
 namespace {
 
-const char* kTinyScene = R"(
-[scene]
-name = "dpm_tiny_test"
-solver = "dpm"
-seed = 3
-[geometry]
-width_m = 0.03
-height_m = 0.09
-depth_m = 0.0075
-[particles]
-diameter_m = 2.5e-3
-density_kg_m3 = 2526.0
-bed_height_mf_m = 0.03
-[gas]
-density_kg_m3 = 1.2
-viscosity_pa_s = 1.8e-5
-[jet]
-slot_width_m = 0.0075
-velocity_m_s = 10.0
-start_s = 0.01
-duration_s = 0.03
-[time]
-settle_s = 0.3
-duration_s = 0.08
-t_ref_s = 0.05
-[grid]
-cells_x = 4
-cells_y = 12
-[drag]
-laws = ["ergun@1"]
-eps_mf = 0.42
-)";
+Scene TinyScene() { return load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_tiny.toml"); }
 
 ConsumerMetrics metrics(double umf, bool bubble, double diameter) {
   ConsumerMetrics m;
@@ -138,7 +107,7 @@ TEST(RegressCompare, TolerancesAreInclusiveAndBubblePresenceCounts) {
 }
 
 TEST(RegressCompare, DefaultTolerancesOfTheTinyScene) {
-  const Scene scene = parse_scene(kTinyScene, "tiny");
+  const Scene scene = TinyScene();
   const RegressionTolerances t = default_regression_tolerances(scene);
   EXPECT_NEAR(t.diameter_abs_m, 2 * 0.0075, 1e-15);  // cells of 3 cm / 4 = 9 cm / 12 = 7.5 mm
   EXPECT_EQ(t.diameter_rel, 0.1);
@@ -161,7 +130,7 @@ class RegressPlan : public ::testing::Test {
             ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".db";
     std::remove(path_.c_str());
     db_ = std::make_unique<Database>(path_);
-    scene_ = parse_scene(kTinyScene, "tiny");
+    scene_ = TinyScene();
     tolerances_ = default_regression_tolerances(scene_);
     // Baseline: a hand-written ergun@1 result (U_mf 1.2 m/s, D 2 cm).
     baseline_ =

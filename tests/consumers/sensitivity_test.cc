@@ -214,38 +214,6 @@ TEST(SensitivityArithmetic, BothUsesTheFineMeanItsStandardErrorAndTheGridChangeO
   EXPECT_THROW(headline_uncertainty("holdup", {0.01}, 0.1, {0.01}, 0.1), Error);  // h_f = h_c
 }
 
-// A 3 x 9 x 0.75 cm bed on 4 x 12 cells of 7.5 mm (3 d): the finer grid at 4 x refinement has
-// 1.9 mm cells, smaller than a 2.5 mm particle, which the scene refuses.
-const char* kTinyScene = R"(
-[scene]
-name = "sensitivity_unit_test"
-seed = 3
-[geometry]
-width_m = 0.03
-height_m = 0.09
-depth_m = 0.0075
-[particles]
-diameter_m = 2.5e-3
-density_kg_m3 = 2526.0
-bed_height_mf_m = 0.03
-[gas]
-density_kg_m3 = 1.2
-viscosity_pa_s = 1.8e-5
-[jet]
-slot_width_m = 0.0075
-velocity_m_s = 10.0
-start_s = 0.01
-duration_s = 0.03
-[time]
-duration_s = 0.06
-t_ref_s = 0.05
-[grid]
-cells_x = 4
-cells_y = 12
-[drag]
-laws = ["gidaspow@1", "vdh2004@1"]
-)";
-
 TEST(SensitivityRunner, RefusesBadLawsAndGridsBeforeAnySettling) {
   const std::string path =
       ::testing::TempDir() + "/sensitivity_test_" + std::to_string(::getpid()) + ".db";
@@ -255,7 +223,9 @@ TEST(SensitivityRunner, RefusesBadLawsAndGridsBeforeAnySettling) {
     const LawLoader loader = [&](const std::string& ref) {
       return std::shared_ptr<const Law>(db.load(ref, RangePolicy::kClamp));
     };
-    const Scene scene = parse_scene(kTinyScene, "sensitivity_unit_test");
+    // data/scenes/dpm_tiny.toml: a 3 x 9 x 0.75 cm bed on 4 x 12 cells of 7.5 mm (3 d); the finer
+    // grid at 4 x refinement has 1.9 mm cells, smaller than a 2.5 mm particle, which it refuses.
+    const Scene scene = load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_tiny.toml");
     int reports = 0;
     const SensitivityProgress count = [&](double, const std::string&) { ++reports; };
 
