@@ -7,7 +7,7 @@
 # dataset id) and reuses the identical law version instead of adding one; a bad spec exits 2
 # and writes nothing.
 # The pipeline ends with the regression check of the law it published (--regress-scene): the
-# tiny DPM scene of tests/cli/data/regress_tiny.toml with a gas 100 times as viscous as air and
+# tiny DPM scene of data/scenes/dpm_tiny.toml with a gas 100 times as viscous as air and
 # eps_mf = 0.7, so that the bed at minimum fluidization (phi = 0.3, Re_mf ~ 1) lies inside the
 # validity box of a law fitted to this campaign (phi 0.15-0.35, Re 0-10); one DPM run of ~2 s.
 # The first run registers eq6_tiny@1 as the scene's baseline (exit 0), the re-run compares the
@@ -19,7 +19,9 @@ draglab="$1"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 db="$work/p.db"
+src="$(cd "$(dirname "$0")/../.." && pwd)"
 . "$(dirname "$0")/harness.sh"
+. "$src/tests/support/toml_edit.sh"
 cat > "$work/tiny.toml" <<'TOML'
 [campaign]
 name = "tiny"
@@ -37,9 +39,8 @@ resolutions = [8]
 extrapolation = "finest"
 TOML
 
-sed -e 's/^viscosity_pa_s = 1.8e-5/viscosity_pa_s = 1.8e-3/' -e 's/^eps_mf = 0.42/eps_mf = 0.7/' \
-  -e 's/^name = "dpm_tiny_test"/name = "dpm_tiny_viscous"/' \
-  "$(dirname "$0")/data/regress_tiny.toml" >"$work/viscous.toml"
+toml_edit "$src/data/scenes/dpm_tiny.toml" gas.viscosity_pa_s=1.8e-3 drag.eps_mf=0.7 \
+  'scene.name="dpm_tiny_viscous"' >"$work/viscous.toml"
 
 check "pipeline" 0 "$draglab" --db "$db" pipeline --spec "$work/tiny.toml" --out "$work/report" \
   --regress-scene "$work/viscous.toml" --json

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # End-to-end test of `draglab regress` (consumer results, baselines, regression checks).
-# Set-up: a fresh database; the tiny DPM scene tests/cli/data/regress_tiny.toml (~320 particles,
+# Set-up: a fresh database; the tiny DPM scene data/scenes/dpm_tiny.toml (~320 particles,
 # one run ~5 s of CPU); new versions of ergun made by `draglab fit --form ergun` on synthetic
 # Ergun data F = s (150 phi + 1.75 Re)/(18 eps^2) over ergun@1's validity box (phi 0.2-0.65,
 # Re 0-1000; the fit recovers a = 150 s, b = 1.75 s), published with `draglab law publish`:
@@ -21,8 +21,9 @@ src="$(cd "$(dirname "$0")/../.." && pwd)"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 db="$work/regress.db"
-scene="$src/tests/cli/data/regress_tiny.toml"
+scene="$src/data/scenes/dpm_tiny.toml"
 . "$(dirname "$0")/harness.sh"
+. "$src/tests/support/toml_edit.sh"
 
 counts() {
   "$py" -c '
@@ -165,7 +166,7 @@ e = r["entries"][0]
 assert e["outcome"] == "outside_validity" and e["result_id"] is None and "validity" in e["error"], e
 '
 same_counts "a failed run stored nothing" "$after_fit"
-sed 's/^seed = 3/seed = 4/' "$scene" >"$work/other.toml"
+toml_edit "$scene" scene.seed=4 >"$work/other.toml"
 check "register a failing version" 2 "$draglab" --db "$db" regress register "$work/other.toml" --law ergun@4
 same_counts "a failed registration stored nothing (not even the scene)" "$after_fit"
 

@@ -2,14 +2,15 @@
 # End-to-end test of `draglab sensitivity` and `draglab sensitivity --work-precision`
 # (docs/scenes.md, "Sensitivity and work-precision").
 #
-# Set-up: a tiny DPM scene written here (the bed of tests/consumers/dpm_coupling_test.cc):
-# 3 x 9 x 0.75 cm box, 4 x 12 gas cells of 7.5 mm, 2.5 mm glass beads (479 particles, a 3 cm bed
-# at eps_mf = 0.42), a 10 m/s jet through a 7.5 mm slot from 0.01 s for 0.03 s, D read 0.05 s
-# after injection (at 0.06 s), 0.065 s simulated (the run's duration is rounded to whole gas
-# steps: on the 6 x 18 grid a 0.06 s run ends 4.5e-5 s short of t_ref, without its sample). The
-# springs are softer than the shipped scenes' (k_n = 1000 N/m: contact time 3.2e-4 s, 2.6 x
-# fewer DEM steps; the deepest overlap under the bed's weight is ~1e-3 d and ~0.06 d at 1 m/s
-# impacts) to keep the whole test near 40 s. Laws gidaspow@1 and vdh2004@1, packing seeds 5, 6.
+# Set-up: the tiny DPM scene data/scenes/dpm_tiny.toml with the keys write_scene replaces (a
+# deeper bed, a longer jet and run, softer springs, two laws): 3 x 9 x 0.75 cm box, 4 x 12 gas
+# cells of 7.5 mm, 2.5 mm glass beads (479 particles, a 3 cm bed at eps_mf = 0.42), a 10 m/s jet
+# through a 7.5 mm slot from 0.01 s for 0.03 s, D read 0.05 s after injection (at 0.06 s),
+# 0.065 s simulated (the run's duration is rounded to whole gas steps: on the 6 x 18 grid a
+# 0.06 s run ends 4.5e-5 s short of t_ref, without its sample). The springs are softer than the
+# shipped scenes' (k_n = 1000 N/m: contact time 3.2e-4 s, 2.6 x fewer DEM steps; the deepest
+# overlap under the bed's weight is ~1e-3 d and ~0.06 d at 1 m/s impacts) to keep the whole test
+# near 40 s. Laws gidaspow@1 and vdh2004@1, packing seeds 5, 6.
 # References:
 #  a. The JSON is consistent with itself: per law the mean is the mean of the per-run D and the
 #     uncertainty is sqrt((s/sqrt(n))^2 + h^2), s the sample standard deviation of the runs and h
@@ -39,53 +40,14 @@ draglab="$1"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 db="$work/sens.db"
+src="$(cd "$(dirname "$0")/../.." && pwd)"
 . "$(dirname "$0")/harness.sh"
+. "$src/tests/support/toml_edit.sh"
 
-write_scene() {  # write_scene FILE SEED
-  cat >"$1" <<EOF
-[scene]
-name = "sens_tiny"
-solver = "dpm"
-seed = $2
-[geometry]
-width_m = 0.03
-height_m = 0.09
-depth_m = 0.0075
-[particles]
-diameter_m = 2.5e-3
-density_kg_m3 = 2526.0
-restitution = 0.97
-friction = 0.1
-spring_stiffness_n_m = 1000.0
-bed_height_mf_m = 0.03
-[gas]
-density_kg_m3 = 1.2
-viscosity_pa_s = 1.8e-5
-gravity_m_s2 = 9.81
-[distributor]
-background = "umf"
-umf_factor = 1.0
-[jet]
-slot_width_m = 0.0075
-velocity_m_s = 10.0
-start_s = 0.01
-duration_s = 0.03
-[time]
-settle_s = 0.3
-duration_s = 0.065
-t_ref_s = 0.05
-contact_steps = 20
-[grid]
-cells_x = 4
-cells_y = 12
-[bubble]
-eps_threshold = 0.8
-sample_interval_s = 0.01
-[drag]
-laws = ["gidaspow@1", "vdh2004@1"]
-eps_mf = 0.42
-range_policy = "clamp"
-EOF
+write_scene() {  # write_scene FILE SEED: data/scenes/dpm_tiny.toml with the keys of the set-up
+  toml_edit "$src/data/scenes/dpm_tiny.toml" 'scene.name="sens_tiny"' scene.seed="$2" \
+    particles.bed_height_mf_m=0.03 jet.duration_s=0.03 time.duration_s=0.065 time.t_ref_s=0.05 \
+    dem.spring_stiffness_n_m=1000.0 'drag.laws=["gidaspow@1", "vdh2004@1"]' >"$1"
 }
 write_scene "$work/tiny.toml" 5
 write_scene "$work/tiny_seed6.toml" 6
@@ -271,7 +233,6 @@ if [ "$have_matplotlib" -eq 1 ]; then
   ok "work_precision.png is a plausible PNG" "$py" -c "$png_check" "$work" wp/work_precision.png
 fi
 # A model with headline numbers: the DBM (reference f).
-src="$(cd "$(dirname "$0")/../.." && pwd)"
 dbm=("$draglab" -q --db "$db" sensitivity "$src/data/scenes/dbm_tiny.toml" --duration 5)
 check "dbm: --cfl on a dbm scene" 2 "${dbm[@]}" --work-precision --law gidaspow@1 --cfl 0.3 --out "$work/badd1"
 ok "the message points to --dt" grep -q -- "use --dt" "$work/err"
