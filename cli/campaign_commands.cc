@@ -1,6 +1,5 @@
 // `draglab campaign run|status|export` and `draglab dataset build|list|show|export|import`:
 // LBM drag campaigns (docs/campaigns.md) and the datasets built from them.
-#include <sqlite3.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -271,77 +270,23 @@ void run_status(const CliContext& ctx, const std::string& id) {
   }
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char ch : s) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-  return out + "\"";
-}
-
 /// Every column of every unit, straight from the table.
 void run_export(const CliContext& ctx, const ExportCommand& c) {
   if (!c.out.empty()) core::check_output_file(c.out, "--out");
   std::unique_ptr<Database> db = ctx.open_database(true);
   const campaign::CampaignStatus st = campaign::campaign_status(*db, c.id);
-  sqlite3_stmt* stmt = nullptr;
-  if (sqlite3_prepare_v2(db->handle(),
-                         "SELECT * FROM campaign_units WHERE campaign_id = ? ORDER BY phi_index, "
-                         "re_index, realization, resolution_index",
-                         -1, &stmt, nullptr) != SQLITE_OK) {
-    throw Error(ErrorCode::kDatabase,
-                std::string("campaign export: ") + sqlite3_errmsg(db->handle()));
-  }
-  std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> guard(stmt, sqlite3_finalize);
-  sqlite3_bind_int64(stmt, 1, st.id);
-  const int columns = sqlite3_column_count(stmt);
-  std::ostringstream out;
-  nlohmann::json units = nlohmann::json::array();
-  if (c.csv) {
-    for (int i = 0; i < columns; ++i) out << (i ? "," : "") << sqlite3_column_name(stmt, i);
-    out << "\n";
-  }
-  int rc;
-  while ((rc = sqlite3_step(stmt)) == SQLITE_ROW) {
-    nlohmann::json u = nlohmann::json::object();
-    for (int i = 0; i < columns; ++i) {
-      const std::string name = sqlite3_column_name(stmt, i);
-      const int type = sqlite3_column_type(stmt, i);
-      std::string text;
-      if (type == SQLITE_INTEGER) {
-        u[name] = sqlite3_column_int64(stmt, i);
-        text = std::to_string(sqlite3_column_int64(stmt, i));
-      } else if (type == SQLITE_FLOAT) {
-        u[name] = sqlite3_column_double(stmt, i);
-        text = fmt::format("{:.17g}", sqlite3_column_double(stmt, i));
-      } else if (type == SQLITE_TEXT) {
-        text = reinterpret_cast<const char*>(sqlite3_column_text(stmt, i));
-        if (name == "result_json") {
-          const auto parsed = nlohmann::json::parse(text, nullptr, false);
-          u[name] = parsed.is_discarded() ? nlohmann::json(text) : parsed;
-        } else {
-          u[name] = text;
-        }
-      } else {
-        u[name] = nullptr;
-      }
-      if (c.csv) out << (i ? "," : "") << csv_field(text);
-    }
-    if (c.csv) out << "\n";
-    units.push_back(u);
-  }
-  if (rc != SQLITE_DONE) {
-    throw Error(ErrorCode::kDatabase,
-                std::string("campaign export: ") + sqlite3_errmsg(db->handle()));
-  }
-  std::string text =
-      c.csv ? out.str()
-            : nlohmann::json({{"campaign", status_json(st)}, {"units", units}}).dump(2) + "\n";
+  const campaign::UnitsExport units = campaign::export_units(*db, st.id);
+  const std::string text = c.csv ? units.csv
+                                 : nlohmann::json({{"campaign", status_json(st)},
+                                                   {"units", nlohmann::json::parse(units.json)}})
+                                           .dump(2) +
+                                       "\n";
   if (c.out.empty()) {
     std::cout << text;
     return;
   }
   core::write_file_atomically(c.out, text, "--out");
-  ctx.info(fmt::format("wrote {} units of campaign {} to {}", units.size(), st.name, c.out));
+  ctx.info(fmt::format("wrote {} units of campaign {} to {}", units.count, st.name, c.out));
 }
 
 void run_dataset_build(const CliContext& ctx, const std::string& id) {

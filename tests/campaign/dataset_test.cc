@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "campaign_internal.h"
 #include "campaign_test_util.h"
@@ -186,6 +191,48 @@ TEST_F(SyntheticCampaign, NoConvergedUnitIsAnError) {
     EXPECT_NE(std::string(e.what()).find("no (phi, Re) point with a converged unit"),
               std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace campaign
+}  // namespace draglab
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+/// export_units: every column of every unit, ordered by (phi, Re, realization, resolution);
+/// CSV numbers read back to the same double; a failed unit's F is null.
+TEST_F(SyntheticCampaign, ExportHoldsEveryUnitInOrderAtFullPrecision) {
+  const double F = 1.0 / 3.0;
+  unit(1, 0, 0, F);
+  unit(0, 1, 2, std::nan(""));  // failed
+  unit(0, 0, 1, 2.0 * F);
+  const UnitsExport e = export_units(*db_, campaign_id_);
+  EXPECT_EQ(e.count, 3u);
+  const nlohmann::json units = nlohmann::json::parse(e.json);
+  ASSERT_EQ(units.size(), 3u);
+  EXPECT_EQ(units[0]["phi_index"], 0);
+  EXPECT_EQ(units[0]["realization"], 0);
+  EXPECT_EQ(units[1]["realization"], 1);
+  EXPECT_EQ(units[2]["phi_index"], 1);
+  EXPECT_EQ(units[0]["F"].get<double>(), 2.0 * F);
+  EXPECT_TRUE(units[1]["F"].is_null());
+  EXPECT_DOUBLE_EQ(units[0]["result_json"]["F_standard_error"].get<double>(), 0.05);
+  std::istringstream csv(e.csv);
+  std::string header, first;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  EXPECT_NE(header.find("phi_index"), std::string::npos);
+  EXPECT_NE(header.find(",F,"), std::string::npos);
+  int lines = 0;
+  for (std::string l; std::getline(csv, l);) ++lines;
+  EXPECT_EQ(lines, 2);
+  char full[32];
+  std::snprintf(full, sizeof full, "%.17g", 2.0 * F);
+  EXPECT_NE(first.find(full), std::string::npos) << first;
+  EXPECT_EQ(std::strtod(full, nullptr), 2.0 * F);
+  EXPECT_EQ(export_units(*db_, campaign_id_ + 1).count, 0u);  // another campaign: nothing
 }
 
 }  // namespace

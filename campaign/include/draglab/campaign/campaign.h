@@ -14,6 +14,7 @@
 // database connection; the LBM runs of a worker use threads = max(1, cores / jobs)).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -148,6 +149,16 @@ CampaignStatus campaign_status(const Database& db, const std::string& id_or_name
 std::vector<CampaignStatus> list_campaigns(const Database& db);
 std::vector<UnitRecord> list_units(const Database& db, std::int64_t campaign_id);
 CampaignSpec stored_spec(const Database& db, std::int64_t campaign_id);
+
+/// Every column of every unit of a campaign, straight from the table, ordered by phi, Re,
+/// realization and resolution (for archives and other tools; the columns are those of the
+/// schema, docs/campaigns.md).
+struct UnitsExport {
+  std::size_t count = 0;
+  std::string csv;   ///< A header of column names, then one row per unit (numbers as %.17g).
+  std::string json;  ///< A JSON array of objects, one per unit (result_json parsed).
+};
+UnitsExport export_units(const Database& db, std::int64_t campaign_id);
 
 /// Builds the dataset of a campaign from its finished units (per (phi, Re): realization mean and
 /// standard error at each resolution, then the spec's resolution extrapolation), stores it
