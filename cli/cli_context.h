@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/workflows/messages.h"
 
@@ -76,8 +77,7 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx);
 /// `draglab regress`: consumer predictions of changed law versions against stored baselines.
 void add_regress_commands(CLI::App& app, CliContext& ctx);
 
-/// Formats a double with `digits` significant digits.
-std::string format_number(double x, int digits = 6);
+using core::format_number;
 
 }  // namespace cli
 }  // namespace draglab

@@ -59,8 +59,6 @@ void CliContext::warn(const std::string& message) const {
 
 void CliContext::print_json(const nlohmann::json& j) const { std::cout << j.dump(2) << '\n'; }
 
-std::string format_number(double x, int digits) { return fmt::format("{:.{}g}", x, digits); }
-
 }  // namespace cli
 }  // namespace draglab
 

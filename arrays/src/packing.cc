@@ -5,6 +5,7 @@
 #include <string>
 
 #include "draglab/arrays/packing.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -13,11 +14,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
+using core::format_number;
 
 // Sets *error (if given) and returns false: the IsValid idiom.
 bool fail(std::string* error, const std::string& message) {
@@ -109,7 +106,8 @@ Vec3 Packing::separation(std::size_t i, std::size_t j) const {
 
 bool RandomPackingOptions::IsValid(std::string* error) const {
   if (!(phi > 0.0 && phi <= kMaxRandomPhi)) {
-    return fail(error, "phi = " + fmt(phi) + " is outside (0, " + fmt(kMaxRandomPhi) +
+    return fail(error, "phi = " + format_number(phi) + " is outside (0, " +
+                           format_number(kMaxRandomPhi) +
                            "] (random close packing limit of random packings)");
   }
   if (n < 1 || n > 10000000) {
@@ -117,20 +115,21 @@ bool RandomPackingOptions::IsValid(std::string* error) const {
   }
   if (distribution == SizeDistribution::kBidisperse) {
     if (!(size_ratio > 1.0 && size_ratio <= 4.0)) {
-      return fail(error, "size_ratio = " + fmt(size_ratio) +
+      return fail(error, "size_ratio = " + format_number(size_ratio) +
                              " is outside (1, 4] (bidisperse d_large/d_small)");
     }
     if (!in_closed(large_volume_fraction, 0.0, 1.0)) {
-      return fail(error,
-                  "large_volume_fraction = " + fmt(large_volume_fraction) + " is outside [0, 1]");
+      return fail(error, "large_volume_fraction = " + format_number(large_volume_fraction) +
+                             " is outside [0, 1]");
     }
   }
   if (distribution == SizeDistribution::kLognormal &&
       !(lognormal_sigma > 0.0 && lognormal_sigma <= 0.5)) {
-    return fail(error, "lognormal_sigma = " + fmt(lognormal_sigma) + " is outside (0, 0.5]");
+    return fail(error,
+                "lognormal_sigma = " + format_number(lognormal_sigma) + " is outside (0, 0.5]");
   }
   if (!in_closed(min_gap, 0.0, 0.5)) {
-    return fail(error, "min_gap = " + fmt(min_gap) + " is outside [0, 0.5] (in d_ref)");
+    return fail(error, "min_gap = " + format_number(min_gap) + " is outside [0, 0.5] (in d_ref)");
   }
   // Spheres padded by min_gap / 2 must themselves be packable at random: their solids fraction
   // may not exceed the random close packing limit. Exact for monodisperse packings; for the
@@ -138,16 +137,16 @@ bool RandomPackingOptions::IsValid(std::string* error) const {
   if (distribution == SizeDistribution::kMonodisperse) {
     const double padded_phi = phi * std::pow(1.0 + min_gap, 3);
     if (padded_phi > kMaxRandomPhi) {
-      return fail(error, "min_gap = " + fmt(min_gap) + " at phi = " + fmt(phi) +
-                             " pads the spheres to a solids fraction " + fmt(padded_phi) +
-                             " above " + fmt(kMaxRandomPhi) +
-                             "; need min_gap <= " + fmt(std::cbrt(kMaxRandomPhi / phi) - 1.0));
+      return fail(error, "min_gap = " + format_number(min_gap) + " at phi = " + format_number(phi) +
+                             " pads the spheres to a solids fraction " + format_number(padded_phi) +
+                             " above " + format_number(kMaxRandomPhi) + "; need min_gap <= " +
+                             format_number(std::cbrt(kMaxRandomPhi / phi) - 1.0));
     }
   }
   for (int a = 0; a < 3; ++a) {
     if (!in_closed(aspect[a], 0.25, 4.0)) {
-      return fail(
-          error, "aspect[" + std::to_string(a) + "] = " + fmt(aspect[a]) + " is outside [0.25, 4]");
+      return fail(error, "aspect[" + std::to_string(a) + "] = " + format_number(aspect[a]) +
+                             " is outside [0.25, 4]");
     }
   }
   if (equilibration_sweeps < 0 || equilibration_sweeps > 10000000) {
@@ -155,7 +154,7 @@ bool RandomPackingOptions::IsValid(std::string* error) const {
                            " is outside [0, 10000000]");
   }
   if (!in_closed(max_crystalline_fraction, 0.0, 1.0)) {
-    return fail(error, "max_crystalline_fraction = " + fmt(max_crystalline_fraction) +
+    return fail(error, "max_crystalline_fraction = " + format_number(max_crystalline_fraction) +
                            " is outside [0, 1]");
   }
   if (max_attempts < 1 || max_attempts > 100) {
@@ -168,7 +167,7 @@ bool OrderedPackingOptions::IsValid(std::string* error) const {
   const double limit = close_packing_phi(lattice);
   // The close-packing value itself is allowed (touching spheres); allow its last-bit rounding.
   if (!(phi > 0.0 && phi <= limit * (1.0 + 1e-15))) {
-    return fail(error, "phi = " + fmt(phi) + " is outside (0, " + fmt(limit) +
+    return fail(error, "phi = " + format_number(phi) + " is outside (0, " + format_number(limit) +
                            "] (close packing of " + to_string(lattice) + ")");
   }
   if (cells < 1 || cells > 64) {

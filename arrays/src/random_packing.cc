@@ -36,6 +36,7 @@
 
 #include "cell_list.h"
 #include "draglab/arrays/packing.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -58,11 +59,7 @@ constexpr std::size_t kMinParallelSpheres = 8192;
 /// Minimum interval between two progress calls.
 constexpr double kProgressInterval = 0.25;
 
-std::string fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
+using core::format_number;
 
 /// Uniform and normal deviates from std::mt19937_64, identical on every platform.
 class Random {
@@ -414,10 +411,10 @@ Packing generate_random_packing(const RandomPackingOptions& options, GenerationS
     const double padded_r_max = r_max * (1.0 + kRelaxPadding) + 0.5 * options.min_gap;
     if (min_edge < 2.0 * padded_r_max) {
       throw Error(ErrorCode::kInvalidArgument,
-                  "n = " + std::to_string(options.n) + " at phi = " + fmt(options.phi) +
-                      " gives a box edge " + fmt(min_edge) +
+                  "n = " + std::to_string(options.n) + " at phi = " + format_number(options.phi) +
+                      " gives a box edge " + format_number(min_edge) +
                       " smaller than the largest sphere diameter plus min_gap (" +
-                      fmt(2.0 * padded_r_max) +
+                      format_number(2.0 * padded_r_max) +
                       "): a sphere would touch its own image; "
                       "increase n or lower phi");
     }
@@ -431,9 +428,10 @@ Packing generate_random_packing(const RandomPackingOptions& options, GenerationS
         box_volume;
     if (padded_phi > kMaxRandomPhi) {
       throw Error(ErrorCode::kInvalidArgument,
-                  "min_gap = " + fmt(options.min_gap) + " at phi = " + fmt(options.phi) +
-                      " pads the spheres to a solids fraction " + fmt(padded_phi) + " above " +
-                      fmt(kMaxRandomPhi) + "; lower min_gap or phi");
+                  "min_gap = " + format_number(options.min_gap) +
+                      " at phi = " + format_number(options.phi) +
+                      " pads the spheres to a solids fraction " + format_number(padded_phi) +
+                      " above " + format_number(kMaxRandomPhi) + "; lower min_gap or phi");
     }
 
     std::vector<Vec3> centers(radii.size());
@@ -451,17 +449,18 @@ Packing generate_random_packing(const RandomPackingOptions& options, GenerationS
       attempts_log += "\n  attempt " + std::to_string(attempt + 1) + " (seed " +
                       std::to_string(sub_seed) + "): jammed after " +
                       std::to_string(relaxed.iterations) + " FIRE iterations, overlaps up to " +
-                      fmt(relaxed.max_overlap) + " d_ref";
+                      format_number(relaxed.max_overlap) + " d_ref";
       if (jammed_attempts < 2 && attempt + 1 < options.max_attempts) continue;
       sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      throw Error(ErrorCode::kInternal,
-                  "random packing: overlaps could not be removed at phi = " + fmt(options.phi) +
-                      (options.min_gap > 0.0 ? " with min_gap = " + fmt(options.min_gap) : "") +
-                      " (" + to_string(options.distribution) + ", n = " +
-                      std::to_string(options.n) + "): the FIRE relaxation jammed:" + attempts_log +
-                      "\nphi is too close to random close packing for this size distribution; "
-                      "lower phi or min_gap (monodisperse spheres jam near 0.64; up to 0.62 is "
-                      "safe)");
+      throw Error(
+          ErrorCode::kInternal,
+          "random packing: overlaps could not be removed at phi = " + format_number(options.phi) +
+              (options.min_gap > 0.0 ? " with min_gap = " + format_number(options.min_gap) : "") +
+              " (" + to_string(options.distribution) + ", n = " + std::to_string(options.n) +
+              "): the FIRE relaxation jammed:" + attempts_log +
+              "\nphi is too close to random close packing for this size distribution; "
+              "lower phi or min_gap (monodisperse spheres jam near 0.64; up to 0.62 is "
+              "safe)");
     }
     progress.Report(1.0, "relax", true);
 
@@ -485,13 +484,14 @@ Packing generate_random_packing(const RandomPackingOptions& options, GenerationS
     sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (stats.min_gap < options.min_gap) {
       throw Error(ErrorCode::kInternal, "random packing: internal check failed, smallest gap " +
-                                            fmt(stats.min_gap) + " < min_gap " +
-                                            fmt(options.min_gap) + " (please report: seed " +
+                                            format_number(stats.min_gap) + " < min_gap " +
+                                            format_number(options.min_gap) +
+                                            " (please report: seed " +
                                             std::to_string(options.seed) + ")");
     }
     attempts_log += "\n  attempt " + std::to_string(attempt + 1) + " (seed " +
                     std::to_string(sub_seed) + "): crystalline fraction " +
-                    fmt(stats.crystalline_fraction) + ", Q6 " + fmt(stats.q6);
+                    format_number(stats.crystalline_fraction) + ", Q6 " + format_number(stats.q6);
     if (stats.crystalline_fraction <= options.max_crystalline_fraction) {
       settings["relaxation"] = {
           {"method", "FIRE"}, {"padding", kRelaxPadding}, {"iterations", relaxed.iterations}};
@@ -510,9 +510,9 @@ Packing generate_random_packing(const RandomPackingOptions& options, GenerationS
   throw Error(ErrorCode::kInternal,
               "random packing: no attempt gave a disordered packing (crystalline fraction at "
               "most max_crystalline_fraction = " +
-                  fmt(options.max_crystalline_fraction) + ") at phi = " + fmt(options.phi) +
-                  " after " + std::to_string(options.equilibration_sweeps) +
-                  " MC sweeps:" + attempts_log +
+                  format_number(options.max_crystalline_fraction) +
+                  ") at phi = " + format_number(options.phi) + " after " +
+                  std::to_string(options.equilibration_sweeps) + " MC sweeps:" + attempts_log +
                   "\nThe hard-sphere fluid freezes above phi = 0.494; use fewer "
                   "equilibration_sweeps, a polydisperse size distribution, or more attempts");
 }

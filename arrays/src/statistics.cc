@@ -28,6 +28,7 @@
 
 #include "cell_list.h"
 #include "draglab/arrays/packing.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -50,11 +51,7 @@ constexpr std::size_t kMinParallelSpheres = 8192;
 
 using Q6Vector = std::array<std::complex<double>, 7>;  // m = 0..6; m < 0 follow by symmetry.
 
-std::string fmt(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
+using core::format_number;
 
 /// Spherical harmonics Y_6^m of the direction of v (|v| > 0), m = 0..6, orthonormal on the unit
 /// sphere. Y_6^{-m} = (-1)^m conj(Y_6^m), so m >= 0 suffices for |q|^2 and q(i).q(j)*.
@@ -105,17 +102,18 @@ double q6_dot(const Q6Vector& a, const Q6Vector& b) {
 void check_options(const StatisticsOptions& o) {
   if (!(o.g_r_bin > 0.0 && o.g_r_bin <= 0.5)) {
     throw Error(ErrorCode::kInvalidArgument,
-                "g_r_bin = " + fmt(o.g_r_bin) + " is outside (0, 0.5]");
+                "g_r_bin = " + format_number(o.g_r_bin) + " is outside (0, 0.5]");
   }
   if (!(o.contact_fit_width >= 2.0 * o.g_r_bin && o.contact_fit_width <= 1.0)) {
-    throw Error(ErrorCode::kInvalidArgument, "contact_fit_width = " + fmt(o.contact_fit_width) +
-                                                 " is outside [2 g_r_bin, 1] = [" +
-                                                 fmt(2.0 * o.g_r_bin) + ", 1]");
+    throw Error(ErrorCode::kInvalidArgument,
+                "contact_fit_width = " + format_number(o.contact_fit_width) +
+                    " is outside [2 g_r_bin, 1] = [" + format_number(2.0 * o.g_r_bin) + ", 1]");
   }
   if (!(o.g_r_max >= 1.0 + o.contact_fit_width && o.g_r_max <= 20.0)) {
-    throw Error(ErrorCode::kInvalidArgument, "g_r_max = " + fmt(o.g_r_max) +
+    throw Error(ErrorCode::kInvalidArgument, "g_r_max = " + format_number(o.g_r_max) +
                                                  " is outside [1 + contact_fit_width, 20] = [" +
-                                                 fmt(1.0 + o.contact_fit_width) + ", 20]");
+                                                 format_number(1.0 + o.contact_fit_width) +
+                                                 ", 20]");
   }
 }
 
@@ -129,14 +127,14 @@ void check_packing(const Packing& p) {
   for (int a = 0; a < 3; ++a) {
     if (!(p.box_length[a] > 0.0 && std::isfinite(p.box_length[a]))) {
       throw Error(ErrorCode::kInvalidArgument, "box_length[" + std::to_string(a) +
-                                                   "] = " + fmt(p.box_length[a]) +
+                                                   "] = " + format_number(p.box_length[a]) +
                                                    " must be positive and finite");
     }
   }
   for (std::size_t i = 0; i < p.radii.size(); ++i) {
     if (!(p.radii[i] > 0.0 && std::isfinite(p.radii[i]))) {
       throw Error(ErrorCode::kInvalidArgument, "radius of sphere " + std::to_string(i) + " = " +
-                                                   fmt(p.radii[i]) +
+                                                   format_number(p.radii[i]) +
                                                    " must be positive and finite");
     }
     for (int a = 0; a < 3; ++a) {
@@ -153,7 +151,7 @@ void check_packing(const Packing& p) {
 double carnahan_starling_contact(double phi) {
   if (!(phi >= 0.0 && phi < 1.0)) {
     throw Error(ErrorCode::kInvalidArgument,
-                "carnahan_starling_contact: phi = " + fmt(phi) + " is outside [0, 1)");
+                "carnahan_starling_contact: phi = " + format_number(phi) + " is outside [0, 1)");
   }
   const double e = 1.0 - phi;
   return (1.0 - 0.5 * phi) / (e * e * e);

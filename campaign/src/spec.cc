@@ -14,6 +14,7 @@
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -24,12 +25,7 @@ constexpr double kMinPhi = 0.05, kMaxPhi = 0.6;
 constexpr double kMaxRe = 1000.0;
 constexpr double kMinResolution = 4.0, kMaxResolution = 512.0;
 
-std::string fmt(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+using core::format_number;
 
 bool fail(std::string* error, const std::string& message) {
   if (error) *error = message;
@@ -56,11 +52,12 @@ bool check_list(const std::vector<double>& values, const std::string& field, dou
   for (std::size_t i = 0; i < values.size(); ++i) {
     const double v = values[i];
     if (!std::isfinite(v) || v < lo || v > hi) {
-      return fail(error, field + "[" + std::to_string(i) + "] = " + fmt(v) + " is outside [" +
-                             fmt(lo) + ", " + fmt(hi) + "] (" + what + ")");
+      return fail(error, field + "[" + std::to_string(i) + "] = " + format_number(v) +
+                             " is outside [" + format_number(lo) + ", " + format_number(hi) +
+                             "] (" + what + ")");
     }
     if (!seen.insert(v).second) {
-      return fail(error, field + " lists " + fmt(v) + " twice (each value once)");
+      return fail(error, field + " lists " + format_number(v) + " twice (each value once)");
     }
   }
   return true;
@@ -96,11 +93,12 @@ bool CampaignSpec::IsValid(std::string* error) const {
   }
   if (box_size > 0.0) {
     if (!std::isfinite(box_size) || box_size < 1.5 || box_size > 100.0) {
-      return fail(error, "[packing] box_size = " + fmt(box_size) +
+      return fail(error, "[packing] box_size = " + format_number(box_size) +
                              " is outside [1.5, 100] sphere diameters");
     }
   } else if (box_size != 0.0) {
-    return fail(error, "[packing] box_size = " + fmt(box_size) + " must be > 0 (or left out)");
+    return fail(error,
+                "[packing] box_size = " + format_number(box_size) + " must be > 0 (or left out)");
   } else if (spheres < 1 || spheres > 100000) {
     return fail(error,
                 "[packing] spheres = " + std::to_string(spheres) + " is outside [1, 100000]");
@@ -110,16 +108,18 @@ bool CampaignSpec::IsValid(std::string* error) const {
         error, "[packing] distribution = '" + distribution + "' is not one of mono, bi, lognormal");
   }
   if (!(size_ratio > 1.0 && size_ratio <= 4.0)) {
-    return fail(error, "[packing] size_ratio = " + fmt(size_ratio) + " is outside (1, 4]");
+    return fail(error,
+                "[packing] size_ratio = " + format_number(size_ratio) + " is outside (1, 4]");
   }
   if (!(large_fraction >= 0.0 && large_fraction <= 1.0)) {
-    return fail(error, "[packing] large_fraction = " + fmt(large_fraction) + " is outside [0, 1]");
+    return fail(error, "[packing] large_fraction = " + format_number(large_fraction) +
+                           " is outside [0, 1]");
   }
   if (!(sigma > 0.0 && sigma <= 0.5)) {
-    return fail(error, "[packing] sigma = " + fmt(sigma) + " is outside (0, 0.5]");
+    return fail(error, "[packing] sigma = " + format_number(sigma) + " is outside (0, 0.5]");
   }
   if (!(min_gap >= 0.0 && min_gap <= 0.5)) {
-    return fail(error, "[packing] min_gap = " + fmt(min_gap) +
+    return fail(error, "[packing] min_gap = " + format_number(min_gap) +
                            " is outside [0, 0.5] diameters (0 = no forced gap)");
   }
   if (!check_list(resolutions, "[lbm] resolutions", kMinResolution, kMaxResolution,
@@ -133,7 +133,8 @@ bool CampaignSpec::IsValid(std::string* error) const {
     return fail(error, "[lbm] boundary = '" + boundary + "' is not one of ibb, bb");
   }
   if (!(tolerance >= 1e-9 && tolerance <= 1e-2)) {
-    return fail(error, "[lbm] tolerance = " + fmt(tolerance) + " is outside [1e-9, 1e-2]");
+    return fail(error,
+                "[lbm] tolerance = " + format_number(tolerance) + " is outside [1e-9, 1e-2]");
   }
   if (max_steps < 1 || max_steps > 100000000) {
     return fail(error,
@@ -156,24 +157,25 @@ bool CampaignSpec::IsValid(std::string* error) const {
       if (padded > internal::kMaxPaddedPhi) {
         const double max_gap = std::cbrt(internal::kMaxPaddedPhi / p) - 1.0;
         return fail(error,
-                    "[grid] phi = " + fmt(p) + " with a minimum gap of " + fmt(gap) +
-                        " diameters pads the spheres to a solids fraction " + fmt(padded) +
-                        " above " + fmt(internal::kMaxPaddedPhi) +
+                    "[grid] phi = " + format_number(p) + " with a minimum gap of " +
+                        format_number(gap) + " diameters pads the spheres to a solids fraction " +
+                        format_number(padded) + " above " + format_number(internal::kMaxPaddedPhi) +
                         " (random packings of padded spheres jam); [packing] min_gap must be <= " +
-                        fmt(max_gap) + " diameters (0, the default, packs without a forced gap)");
+                        format_number(max_gap) +
+                        " diameters (0, the default, packs without a forced gap)");
       }
       if (box_size == 0.0) {
         const double edge = std::cbrt(spheres * M_PI / (6.0 * p));
         if (edge < 1.0 + gap) {
-          return fail(error, "[packing] spheres = " + std::to_string(spheres) +
-                                 " at phi = " + fmt(p) + " gives a box of " + fmt(edge) +
+          return fail(error, "[packing] spheres = " + std::to_string(spheres) + " at phi = " +
+                                 format_number(p) + " gives a box of " + format_number(edge) +
                                  " diameters, below one diameter plus the gap; use more spheres");
         }
       }
     }
     arrays::RandomPackingOptions o = internal::packing_options(*this, p, 1);
     std::string e;
-    if (!o.IsValid(&e)) return fail(error, "[packing] at phi = " + fmt(p) + ": " + e);
+    if (!o.IsValid(&e)) return fail(error, "[packing] at phi = " + format_number(p) + ": " + e);
   }
   return true;
 }

@@ -1,6 +1,7 @@
 // core/src/text.cc: see draglab/core/text.h.
 #include "draglab/core/text.h"
 
+#include <cstdio>
 #include <cstdlib>
 
 #include "draglab/drag_db/error.h"
@@ -40,6 +41,12 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
     values.push_back(v);
   }
   return values;
+}
+
+std::string format_number(double x, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*g", digits, x);
+  return text;
 }
 
 }  // namespace core

@@ -7,18 +7,14 @@
 #include <vector>
 
 #include "draglab/consumers/scene.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
 
-std::string fmt(double x, int digits = 6) {
-  std::ostringstream s;
-  s.precision(digits);
-  s << x;
-  return s.str();
-}
+using core::format_number;
 
 /// Brent's root finder (inverse quadratic interpolation with bisection safeguard) on [a, b]
 /// with f(a) f(b) <= 0. Returns the root; *iterations counts function evaluations after the
@@ -90,10 +86,11 @@ bool MinFluidizationOptions::IsValid(std::string* error) const {
     return false;
   };
   if (!(eps_mf > 0.2 && eps_mf < 0.9)) {
-    return fail("eps_mf = " + fmt(eps_mf) + " is outside (0.2, 0.9)");
+    return fail("eps_mf = " + format_number(eps_mf) + " is outside (0.2, 0.9)");
   }
   if (!(relative_tolerance > 0.0 && relative_tolerance <= 1e-3)) {
-    return fail("relative_tolerance = " + fmt(relative_tolerance) + " is outside (0, 1e-3]");
+    return fail("relative_tolerance = " + format_number(relative_tolerance) +
+                " is outside (0, 1e-3]");
   }
   if (max_iterations < 10 || max_iterations > 10000) {
     return fail("max_iterations = " + std::to_string(max_iterations) + " is outside [10, 10000]");
@@ -103,9 +100,11 @@ bool MinFluidizationOptions::IsValid(std::string* error) const {
 
 std::string MinFluidizationResult::BriefReport() const {
   std::ostringstream s;
-  s << law << ": U_mf = " << fmt(umf_m_s, 4) << " m/s (Re_mf = " << fmt(re_mf, 4)
-    << ", eps_mf = " << eps_mf << ", Ar = " << fmt(archimedes, 4) << ", F = " << fmt(F_mf, 4)
-    << ", beta = " << fmt(beta_mf, 4) << " kg/m^3/s, " << iterations << " Brent iterations)";
+  s << law << ": U_mf = " << format_number(umf_m_s, 4)
+    << " m/s (Re_mf = " << format_number(re_mf, 4) << ", eps_mf = " << eps_mf
+    << ", Ar = " << format_number(archimedes, 4) << ", F = " << format_number(F_mf, 4)
+    << ", beta = " << format_number(beta_mf, 4) << " kg/m^3/s, " << iterations
+    << " Brent iterations)";
   return s.str();
 }
 
@@ -119,7 +118,7 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   auto positive = [](double x, const std::string& field, const std::string& unit) {
     if (!(std::isfinite(x) && x > 0.0)) {
       throw Error(ErrorCode::kInvalidArgument,
-                  field + " = " + fmt(x) + " is outside (0, inf) " + unit);
+                  field + " = " + format_number(x) + " is outside (0, inf) " + unit);
     }
   };
   positive(d, "particles.diameter_m", "m");
@@ -128,18 +127,20 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   positive(mu, "gas.viscosity_pa_s", "Pa s");
   positive(g, "gas.gravity_m_s2", "m/s^2");
   if (!(rho_p > rho)) {
-    throw Error(ErrorCode::kInvalidArgument, "particles.density_kg_m3 = " + fmt(rho_p) +
-                                                 " must exceed gas.density_kg_m3 = " + fmt(rho));
+    throw Error(ErrorCode::kInvalidArgument,
+                "particles.density_kg_m3 = " + format_number(rho_p) +
+                    " must exceed gas.density_kg_m3 = " + format_number(rho));
   }
 
   const double eps = options.eps_mf, phi = 1.0 - eps;
   const ValidityBox& box = law.record().validity;
   const std::string ref = law.reference();
   if (!box.phi.contains(phi)) {
-    throw Error(ErrorCode::kOutOfValidity,
-                ref + ": the bed at eps_mf = " + fmt(eps) + " (phi = " + fmt(phi) +
-                    ") is outside the law's validity range phi in [" + fmt(box.phi.min) + ", " +
-                    fmt(box.phi.max) + "]; use an eps_mf inside it or another law");
+    throw Error(
+        ErrorCode::kOutOfValidity,
+        ref + ": the bed at eps_mf = " + format_number(eps) + " (phi = " + format_number(phi) +
+            ") is outside the law's validity range phi in [" + format_number(box.phi.min) + ", " +
+            format_number(box.phi.max) + "]; use an eps_mf inside it or another law");
   }
   // Monodisperse particles: every polydispersity input y_i = d_i/<d> is 1.
   std::vector<double> extra(static_cast<std::size_t>(law.num_extra_inputs()), 1.0);
@@ -158,8 +159,8 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   double a = re_lo, fa = residual(re_lo);
   if (fa > 0.0) {
     throw Error(ErrorCode::kOutOfValidity,
-                ref + ": U_mf lies below the law's validity range Re >= " + fmt(re_lo) +
-                    " (Ar = " + fmt(ar, 4) + "); use a law valid at lower Re");
+                ref + ": U_mf lies below the law's validity range Re >= " + format_number(re_lo) +
+                    " (Ar = " + format_number(ar, 4) + "); use a law valid at lower Re");
   }
   const double start = std::max(re_lo, 1e-6 * std::max(re_hi, 1.0));
   const int kScan = 80;
@@ -180,9 +181,10 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   if (!bracketed) {
     const double u_hi = re_hi * mu / (rho * d);
     throw Error(ErrorCode::kOutOfValidity,
-                ref + ": the law's drag at its highest valid Re = " + fmt(re_hi) + " (U = " +
-                    fmt(u_hi, 4) + " m/s) does not yet carry the bed's weight (Ar = " + fmt(ar, 4) +
-                    ", eps_mf = " + fmt(eps) +
+                ref + ": the law's drag at its highest valid Re = " + format_number(re_hi) +
+                    " (U = " + format_number(u_hi, 4) +
+                    " m/s) does not yet carry the bed's weight (Ar = " + format_number(ar, 4) +
+                    ", eps_mf = " + format_number(eps) +
                     "): U_mf lies outside its validity box; use a law valid at higher Re or "
                     "smaller/lighter particles");
   }
@@ -193,7 +195,7 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   if (!converged) {
     throw Error(ErrorCode::kInternal,
                 ref + ": Brent's method did not reach relative_tolerance = " +
-                    fmt(options.relative_tolerance) + " in " +
+                    format_number(options.relative_tolerance) + " in " +
                     std::to_string(options.max_iterations) +
                     " iterations (raise max_iterations or relative_tolerance)");
   }

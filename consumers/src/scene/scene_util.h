@@ -1,8 +1,9 @@
 // Small helpers shared by the scene sources (private to consumers/src/scene).
 #pragma once
 
-#include <sstream>
 #include <string>
+
+#include "draglab/core/text.h"
 
 namespace draglab {
 namespace consumers {
@@ -11,12 +12,7 @@ namespace scene_util {
 constexpr double kPi = 3.14159265358979323846;
 
 /// A value for a message, with `digits` significant digits.
-inline std::string fmt(double x, int digits = 6) {
-  std::ostringstream s;
-  s.precision(digits);
-  s << x;
-  return s.str();
-}
+inline std::string fmt(double x, int digits = 6) { return core::format_number(x, digits); }
 
 /// IsValid() helper: stores `message` in *error (if given) and returns false.
 inline bool fail(std::string* error, const std::string& message) {

@@ -1,6 +1,7 @@
-// draglab/core/text.h: the comma-separated lists of the command line and the scene and campaign
-// files (laws a@1,b@1, parameters a,b,c0, numbers 0.1,0.2), parsed one way everywhere.
-// Errors: draglab::Error(kInvalidArgument) naming `field`, the offending item and an example.
+// draglab/core/text.h: numbers in messages, and the comma-separated lists of the command line and
+// the scene and campaign files (laws a@1,b@1, parameters a,b,c0, numbers 0.1,0.2), parsed one way
+// everywhere. Errors: draglab::Error(kInvalidArgument) naming `field`, the offending item and an
+// example.
 #pragma once
 
 #include <string>
@@ -17,6 +18,9 @@ std::vector<std::string> split_list(const std::string& text, const std::string& 
 /// nan and inf are numbers here, ranges are the caller's to check.
 std::vector<double> parse_number_list(const std::string& text, const std::string& field,
                                       const std::string& example = "0.1,0.2,0.3");
+
+/// x with `digits` significant digits (printf %g): the numbers of messages and tables.
+std::string format_number(double x, int digits = 6);
 
 }  // namespace core
 }  // namespace draglab
