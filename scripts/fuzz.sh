@@ -40,29 +40,10 @@ jobs="${DRAGLAB_FUZZ_JOBS:-$(nproc 2>/dev/null || echo 2)}"
 if [ -z "${DRAGLAB_FUZZ_JOBS:-}" ] && ((jobs > 2)); then jobs=2; fi
 
 # ---- packages: the project's (scripts/setup.sh) and clang's fuzzing toolchain --------------------
-"$here/scripts/setup.sh" --no-build
 # clang-14 and libFuzzer; the sanitizer and fuzzer runtimes (libclang-rt-14-dev) and clang's
 # OpenMP (libomp-14-dev; consumers/ needs OpenMP) are only recommended/suggested by clang-14.
-packages=(clang-14 libfuzzer-14-dev libclang-rt-14-dev libomp-14-dev)
-missing=()
-for p in "${packages[@]}"; do
-  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
-    missing+=("$p")
-  fi
-done
-if ((${#missing[@]})); then
-  echo "fuzz: installing missing Debian packages: ${missing[*]}" >&2
-  if [ "$(id -u)" -eq 0 ]; then
-    sudo=(env DEBIAN_FRONTEND=noninteractive)
-  elif command -v sudo >/dev/null; then
-    sudo=(sudo env DEBIAN_FRONTEND=noninteractive)
-  else
-    echo "fuzz: missing packages (${missing[*]}) and neither root nor sudo" >&2
-    exit 1
-  fi
-  "${sudo[@]}" apt-get update -qq
-  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+DRAGLAB_EXTRA_PACKAGES="clang-14 libfuzzer-14-dev libclang-rt-14-dev libomp-14-dev" \
+  "$here/scripts/setup.sh" --no-build
 
 # ---- build: only the fuzz targets and what they link ---------------------------------------------
 if [ ! -f "$build/CMakeCache.txt" ]; then

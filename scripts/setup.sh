@@ -8,6 +8,7 @@
 # DRAGLAB_BUILD_DIR: another build directory. DRAGLAB_SANITIZE=1: build with ASan + UBSan
 # (-DDRAGLAB_SANITIZE=ON, RelWithDebInfo) into build-sanitize/ unless DRAGLAB_BUILD_DIR says.
 # DRAGLAB_BUILD_TARGET: build only this target (e.g. input_tests) instead of everything.
+# DRAGLAB_EXTRA_PACKAGES: more Debian packages to install the same way (scripts/fuzz.sh: clang).
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -38,6 +39,9 @@ packages=(
   gnuplot-nox                       # draglab lbm convergence --plot (PNG, no X11)
   python3                           # Python bindings test (Debian's /usr/bin/python3)
 )
+
+# shellcheck disable=SC2206  # a space-separated list of package names
+packages+=(${DRAGLAB_EXTRA_PACKAGES:-})
 
 missing=()
 for p in "${packages[@]}"; do
