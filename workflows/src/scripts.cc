@@ -37,6 +37,15 @@ std::string find_script(const std::string& name) {
       fmt::format("the script {} was found neither at {} nor at {}", name, installed, source));
 }
 
+std::string find_shipped_file(const std::string& relative) {
+  const std::string source = std::string(DRAGLAB_SOURCE_DATA_DIR) + "/" + relative;
+  if (core::file_exists(source)) return source;
+  const std::string installed =
+      executable_dir() + "/../" + DRAGLAB_INSTALL_SHARE_DIR + "/" + relative;
+  if (core::file_exists(installed)) return installed;
+  return "";
+}
+
 std::string python_interpreter() {
   const char* p = std::getenv("DRAGLAB_PYTHON");
   return p && *p ? p : "/usr/bin/python3";

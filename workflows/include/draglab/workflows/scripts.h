@@ -1,5 +1,6 @@
-// draglab/workflows/scripts.h: the Python figure scripts shipped with draglab (report, Fig. 4/5,
-// Fig. 6) and the interpreter that runs them.
+// draglab/workflows/scripts.h: the files shipped with draglab (the Python figure scripts of the
+// report, Fig. 4/5 and Fig. 6; campaign presets and scenes) and the interpreter that runs the
+// scripts.
 //
 // The C++ side computes every number and writes a JSON bundle; a script only draws from it, so a
 // figure can be redrawn without rerunning. Scripts need matplotlib, which Debian's
@@ -21,6 +22,11 @@ std::string executable_dir();
 /// A script shipped with draglab: installed next to the executable (bin/../share/draglab), else
 /// the source tree's scripts/. Throws std::runtime_error naming both places if neither exists.
 std::string find_script(const std::string& name);
+
+/// A data file shipped with draglab (e.g. "campaigns/quick.toml", "scenes/dpm_tiny.toml"): in
+/// the source tree's data/, else under the installed share/draglab (relative to the executable,
+/// so installs are relocatable); "" if neither exists.
+std::string find_shipped_file(const std::string& relative);
 
 /// $DRAGLAB_PYTHON (tests, unusual installs), else Debian's /usr/bin/python3.
 std::string python_interpreter();

@@ -1,0 +1,104 @@
+// workflows::run_pipeline: campaign -> dataset -> fit of Eq. 6 -> published law, in process.
+//
+// Set-up: a tiny campaign, 3 phi (0.15, 0.25, 0.35) x 3 Re (0, 4, 10), one 8-sphere packing per
+// phi at d = 8 (a few seconds of LBM); no report (no Python) and no regression check (the
+// command line's test, tests/cli/pipeline_test.sh, runs both).
+// References: the comparison table's "RMS vs data" of the fit is the fitter's own RMS relative
+// error on the same points (two computations of one number, to round-off); a re-run resumes
+// the campaign (no new unit) and reuses the identical published version (content hash and
+// dataset equal); bad input is refused before any LBM (no campaign stored).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "draglab/campaign/campaign.h"
+#include "draglab/core/files.h"
+#include "draglab/drag_db/database.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/workflows/pipeline.h"
+#include "support/temp_dir.h"
+
+namespace draglab {
+namespace {
+
+const char* const kTinySpec = R"([campaign]
+name = "tiny"
+[grid]
+phi = [0.15, 0.25, 0.35]
+re = [0, 4, 10]
+realizations = 1
+seed = 7
+[packing]
+spheres = 8
+[lbm]
+resolutions = [8]
+[dataset]
+extrapolation = "finest"
+)";
+
+workflows::PipelineOptions tiny_options(const test::TempDir& dir) {
+  { std::ofstream(dir.file("tiny.toml")) << kTinySpec; }
+  workflows::PipelineOptions o;
+  o.db_path = dir.file("p.db");
+  o.spec_path = dir.file("tiny.toml");
+  o.jobs = 1;
+  o.report = false;
+  o.regress = false;
+  return o;
+}
+
+TEST(Pipeline, PublishesTheFitAndReusesItOnARerun) {
+  test::TempDir dir;
+  const workflows::PipelineOptions o = tiny_options(dir);
+  const workflows::PipelineSummary first = workflows::run_pipeline(o);
+  EXPECT_EQ(first.campaign.units_total, 9);
+  EXPECT_EQ(first.campaign.units_done, 9);
+  EXPECT_EQ(first.dataset.points.size(), 9u);
+  EXPECT_EQ(first.law.reference(), "eq6_tiny@1");
+  EXPECT_EQ(first.law.status, LawStatus::kPublished);
+  EXPECT_EQ(first.law.provenance.dataset_id, first.dataset.id);
+  ASSERT_FALSE(first.comparison.empty());
+  EXPECT_EQ(first.comparison.front().law, "eq6_tiny@1 (fit)");
+  EXPECT_NEAR(first.comparison.front().rms_vs_data, first.fit.rms_rel_err,
+              1e-12 + 1e-9 * first.fit.rms_rel_err);
+  EXPECT_FALSE(first.checked);
+  EXPECT_NE(first.FullReport().find("Regression check skipped"), std::string::npos);
+  const nlohmann::json j = first.ToJson();
+  EXPECT_EQ(j["law"], "eq6_tiny");
+  EXPECT_EQ(j["version"], 1);
+  EXPECT_TRUE(j["regress"].is_null());
+
+  const workflows::PipelineSummary again = workflows::run_pipeline(o);
+  EXPECT_EQ(again.campaign.id, first.campaign.id);
+  EXPECT_EQ(again.campaign.units_total, 9);  // resumed: no new unit
+  EXPECT_EQ(again.dataset.id, first.dataset.id);
+  EXPECT_EQ(again.law.reference(), "eq6_tiny@1");  // the identical version, not @2
+  Database db(o.db_path);
+  EXPECT_EQ(db.list("eq6_tiny").size(), 1u);
+}
+
+TEST(Pipeline, BadInputIsRefusedBeforeAnyLbm) {
+  test::TempDir dir;
+  workflows::PipelineOptions o = tiny_options(dir);
+  o.law_name = "_x";
+  try {
+    workflows::run_pipeline(o);
+    FAIL() << "an invalid law name must be refused";
+  } catch (const Error& e) {
+    EXPECT_TRUE(e.is_bad_input());
+    EXPECT_NE(std::string(e.what()).find("--law-name"), std::string::npos) << e.what();
+  }
+  o.law_name.clear();
+  o.regress_scene = dir.file("tiny.toml");  // with regress = false
+  EXPECT_THROW(workflows::run_pipeline(o), Error);
+  o.regress = true;
+  o.regress_scene = dir.file("missing.toml");
+  EXPECT_THROW(workflows::run_pipeline(o), Error);
+  EXPECT_FALSE(core::file_exists(o.db_path));  // nothing was stored
+  EXPECT_THROW(workflows::preset_spec_path("nosuch"), Error);
+  EXPECT_TRUE(core::file_exists(workflows::preset_spec_path("quick")));
+}
+
+}  // namespace
+}  // namespace draglab
