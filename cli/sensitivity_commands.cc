@@ -47,15 +47,13 @@
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/workflows/bed_results.h"
-#include "draglab/workflows/scripts.h"
+#include "draglab/workflows/studies.h"
 
 namespace draglab {
 namespace cli {
 namespace {
 
 using consumers::Scene;
-
-const char* const kFigureScript = "draglab_fig4.py";
 
 struct SensitivityArgs {
   std::string scene_path;
@@ -85,21 +83,6 @@ std::string time_resolution_flag(const std::string& name) {
   for (const auto& [key, flag] : kTimeResolutionFlags)
     if (key == name) return flag;
   return "--" + name;
-}
-
-/// Writes JSON to `path` through a temporary file and a rename, so a reader never sees half.
-void write_json_file(const std::string& path, const nlohmann::json& j) {
-  core::write_file_atomically(path, j.dump(1) + "\n", "sensitivity data");
-}
-
-/// Runs the figure script on `bundle`; it writes `figure` into out_dir.
-void render(const CliContext& ctx, const std::string& bundle, const std::string& out_dir,
-            const std::string& figure, const std::string& beside = "") {
-  std::remove(figure.c_str());  // so a stale figure is never taken for a new one
-  std::vector<std::string> args = {bundle, out_dir};
-  if (!beside.empty()) args.insert(args.end(), {"--beside", beside});
-  if (ctx.quiet) args.push_back("--quiet");
-  workflows::run_figure_script(kFigureScript, args, bundle, figure);
 }
 
 std::string cm(double metres) { return fmt::format("{:.2f}", 100.0 * metres); }
@@ -226,14 +209,6 @@ void print_work_precision_table(const consumers::WorkPrecisionResult& w) {
 }
 
 void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args) {
-  if (!args.beside.empty()) {
-    if (args.work_precision)
-      throw UsageError("--beside is for the law study, not --work-precision");
-    if (args.no_figure) throw UsageError("--beside draws a figure: drop --no-figure");
-    if (!core::file_exists(args.beside))
-      throw UsageError("--beside: '" + args.beside +
-                       "' does not exist (give another study's sensitivity.json)");
-  }
   // Flags of the other mode are a usage error, not silently ignored.
   if (args.work_precision) {
     if (!args.laws.empty())
@@ -321,31 +296,18 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (!sens.IsValid(&why)) throw UsageError(why);
   }
 
-  const std::string out_dir =
-      args.out_dir.empty() ? "out/" + scene.name + "_sensitivity" : args.out_dir;
-
+  workflows::StudyOutput output;
+  output.out_dir = args.out_dir.empty() ? "out/" + scene.name + "_sensitivity" : args.out_dir;
+  output.figure = !args.no_figure;
+  output.beside = args.beside;
+  output.quiet = ctx.quiet;
+  // Read-write: a missing database is created and seeded with the literature library.
   auto db = ctx.open_database(/*read_only=*/false);
-  const RangePolicy policy = range_policy_from_string(scene.range_policy);
-  std::set<std::string> warned;
-  const consumers::LawLoader loader = [&](const std::string& reference) {
-    std::string warning;
-    std::shared_ptr<const Law> law = db->load(reference, policy, &warning);
-    if (!warning.empty() && warned.insert(reference).second) ctx.warn(warning);
-    return law;
-  };
   // One progress line for the whole study (its ETA is the study's); each settling or run is
   // announced on its own line as it starts.
-  // The output folder is made at the first progress report: after the runner has checked every
-  // law and grid (bad input leaves nothing behind), before the first settling (a bad --out fails
-  // at once, not after the runs).
   ProgressLine progress(!ctx.quiet);
   std::string current;
-  bool out_dir_made = false;
   const auto on_progress = [&](double f, const std::string& stage) {
-    if (!out_dir_made) {
-      core::make_directories(out_dir, "--out");
-      out_dir_made = true;
-    }
     if (stage != current) {
       current = stage;
       progress.finish();
@@ -355,90 +317,29 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   };
 
   if (args.work_precision) {
-    const consumers::WorkPrecisionResult w =
-        consumers::run_work_precision(scene, loader, wp, on_progress);
+    const workflows::WorkPrecisionStudy study =
+        workflows::run_work_precision_study(*db, scene, wp, output, ctx.messages(), on_progress);
     progress.finish();
-    // A model with headline numbers has no bubble at t_ref and no figure of this study.
-    const bool headline = w.has_headline();
-    const bool no_figure = args.no_figure || headline;
-    for (const auto& r : w.rows) {
-      if (!r.bubble_found && !headline)
-        ctx.warn(fmt::format("grid {}x{}, {} {}: no bubble at t_ref (D = 0){}", r.cells_x,
-                             r.cells_y, w.time_resolution_name, format_number(r.time_resolution, 4),
-                             r.reached_t_ref ? ""
-                                             : ": the run ended before t_ref (duration rounded "
-                                               "to whole gas steps; raise [time] duration_s)"));
-    }
-    core::make_directories(out_dir, "--out");
-    const std::string bundle = out_dir + "/work_precision.json";
-    const std::string figure = out_dir + "/work_precision.png";
-    nlohmann::json j = workflows::work_precision_bundle_json(w);
-    write_json_file(bundle, j);
-    if (!no_figure) render(ctx, bundle, out_dir, figure);
     if (ctx.json) {
-      j["out_dir"] = out_dir;
-      j["data"] = bundle;
-      j["figure"] = no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
-      ctx.print_json(j);
+      ctx.print_json(study.ToJson(output.out_dir));
       return;
     }
-    print_work_precision_table(w);
-    std::cout << "  data: " << bundle << (no_figure ? "" : "\n  figure: " + figure) << "\n";
+    print_work_precision_table(study.result);
+    std::cout << "  data: " << study.bundle_path
+              << (study.figure_path.empty() ? "" : "\n  figure: " + study.figure_path) << "\n";
     return;
   }
-
-  const consumers::SensitivitySummary s =
-      consumers::run_sensitivity(scene, loader, sens, on_progress);
+  const workflows::SensitivityStudy study =
+      workflows::run_sensitivity_study(*db, scene, sens, output, ctx.messages(), on_progress);
   progress.finish();
-  // A model with headline numbers has no bubble at t_ref (no snapshot, nothing for the figure
-  // script to draw): its numbers are the result.
-  const bool headline = s.has_headline();
-  if (headline && !args.beside.empty())
-    throw UsageError(fmt::format(
-        "--beside: the {} model reports headline numbers, not a bubble at t_ref, so there is no "
-        "Fig. 5 to draw; rerun without --beside",
-        scene.solver));
-  const bool no_figure = args.no_figure || headline;
-  for (const auto& lr : s.laws) {
-    if (headline) break;
-    int not_reached = 0;
-    for (const auto& r : lr.runs) not_reached += r.reached_t_ref ? 0 : 1;
-    if (not_reached > 0)
-      ctx.warn(
-          fmt::format("{}: {} of {} runs ended before t_ref (the duration is rounded to whole "
-                      "gas steps): raise [time] duration_s a little past jet.start_s + "
-                      "t_ref_s",
-                      lr.law, not_reached, lr.runs.size()));
-    if (lr.bubbles_found < static_cast<int>(lr.runs.size()))
-      ctx.warn(
-          fmt::format("{}: no bubble at t_ref in {} of {} runs; D = 0 is taken for them, so "
-                      "its mean and uncertainty mix bubble and no bubble",
-                      lr.law, lr.runs.size() - lr.bubbles_found, lr.runs.size()));
-  }
-  core::make_directories(out_dir, "--out");
-  const std::string bundle = out_dir + "/sensitivity.json";
-  const std::string figure = out_dir + "/fig4.png";
-  write_json_file(bundle, workflows::sensitivity_bundle_json(scene, s, /*with_snapshots=*/true));
-  const std::string fig5 = out_dir + "/fig5.png";
-  if (!no_figure) {
-    render(ctx, bundle, out_dir, figure, args.beside);
-    if (!args.beside.empty() && !core::file_exists(fig5))
-      throw std::runtime_error("the figure script wrote no " + fig5 + " (--beside " + args.beside +
-                               ")");
-  }
-  const bool with_fig5 = !no_figure && !args.beside.empty();
   if (ctx.json) {
-    nlohmann::json j = workflows::sensitivity_bundle_json(scene, s, /*with_snapshots=*/false);
-    j["out_dir"] = out_dir;
-    j["data"] = bundle;
-    j["figure"] = no_figure ? nlohmann::json(nullptr) : nlohmann::json(figure);
-    j["figure_beside"] = with_fig5 ? nlohmann::json(fig5) : nlohmann::json(nullptr);
-    ctx.print_json(j);
+    ctx.print_json(study.ToJson(scene, output.out_dir));
     return;
   }
-  print_sensitivity_table(s);
-  std::cout << "  data: " << bundle << (no_figure ? "" : "\n  figure: " + figure)
-            << (with_fig5 ? "\n  figure: " + fig5 : "") << "\n";
+  print_sensitivity_table(study.summary);
+  std::cout << "  data: " << study.bundle_path
+            << (study.figure_path.empty() ? "" : "\n  figure: " + study.figure_path)
+            << (study.beside_path.empty() ? "" : "\n  figure: " + study.beside_path) << "\n";
 }
 
 }  // namespace
