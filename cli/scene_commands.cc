@@ -192,22 +192,12 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
   // version and metrics, stored (immutable) unless asked not to.
   std::int64_t result_id = 0;
   if (!args.no_store) {
-    const ConsumerScene stored_scene = register_consumer_scene(*db, scene.name, scene.source_text);
-    ConsumerResult stored;
-    stored.scene_name = scene.name;
-    stored.scene_hash = stored_scene.hash;
-    stored.law_name = law->record().name;
-    stored.law_version = law->record().version;
-    stored.law_content_hash = law->record().content_hash;
-    stored.metrics = r.metrics;
-    stored.result_json = r.result_json;
-    result_id = store_consumer_result(*db, stored).id;
+    register_consumer_scene(*db, scene.name, scene.source_text);
+    result_id = store_consumer_result(*db, consumers::consumer_result(scene, *law, r)).id;
   }
-  const nlohmann::json full = nlohmann::json::parse(r.result_json);
-  const std::int64_t clamps = full.value("void_fraction_clamps", std::int64_t{0});
-  if (clamps > 0)
-    ctx.warn(
-        fmt::format("{} cell void fractions were raised to the minimum (dense packing)", clamps));
+  if (r.void_fraction_clamps > 0)
+    ctx.warn(fmt::format("{} cell void fractions were raised to the minimum (dense packing)",
+                         r.void_fraction_clamps));
   if (ctx.json) {
     ctx.print_json(workflows::scene_run_json(scene, r, result_id));
     return;

@@ -87,6 +87,18 @@ std::shared_ptr<const BedRealization> BedModel::Realize(const Scene&, std::share
               "bed model '" + key() + "' is deterministic: it has no realizations to prepare");
 }
 
+ConsumerResult consumer_result(const Scene& scene, const Law& law, const BedResult& result) {
+  ConsumerResult stored;
+  stored.scene_name = scene.name;
+  stored.scene_hash = scene.hash();
+  stored.law_name = law.record().name;
+  stored.law_version = law.record().version;
+  stored.law_content_hash = law.record().content_hash;
+  stored.metrics = result.metrics;
+  stored.result_json = result.result_json;
+  return stored;
+}
+
 BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
                         const BedRunOptions& options, const BedProgress& progress,
                         const BedRealization* start) {

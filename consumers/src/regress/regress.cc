@@ -52,16 +52,7 @@ ConsumerResult run_scene(const Database& db, const Scene& scene, const LawRecord
   std::shared_ptr<const Law> law =
       db.load(record.reference(), range_policy_from_string(scene.range_policy), &warning);
   if (!warning.empty() && warnings) warnings->push_back(warning);
-  const BedResult r = run_bed_model(scene, law, options, progress);
-  ConsumerResult result;
-  result.scene_name = scene.name;
-  result.scene_hash = scene.hash();
-  result.law_name = law->record().name;
-  result.law_version = law->record().version;
-  result.law_content_hash = law->record().content_hash;
-  result.metrics = r.metrics;
-  result.result_json = r.result_json;
-  return result;
+  return consumer_result(scene, *law, run_bed_model(scene, law, options, progress));
 }
 
 bool version_is_checked(const LawRecord& record, bool include_drafts) {

@@ -155,5 +155,10 @@ BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
                         const BedProgress& progress = nullptr,
                         const BedRealization* start = nullptr);
 
+/// The stored form of a run (provenance like laws and datasets: the scene's hash, the law's
+/// name, version and content hash, the metrics and the model's full result JSON), as
+/// `draglab scene run` and the regression checks store it.
+ConsumerResult consumer_result(const Scene& scene, const Law& law, const BedResult& result);
+
 }  // namespace consumers
 }  // namespace draglab
