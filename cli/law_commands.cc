@@ -68,6 +68,22 @@ nlohmann::json evaluation_json(const Law& law, const Evaluation& e) {
   return j;
 }
 
+/// One point of a grid of evaluations: the evaluation, or where it lies outside the law's
+/// validity box (range policy "error") the law, the point and why.
+nlohmann::json grid_point_json(const Law& law, double phi, double re,
+                               const std::vector<double>& extra) {
+  try {
+    return evaluation_json(law, evaluate(law, phi, re, extra));
+  } catch (const Error& e) {
+    if (e.code() != ErrorCode::kOutOfValidity) throw;
+    return {{"law", law.record().name},
+            {"version", law.record().version},
+            {"phi", phi},
+            {"re", re},
+            {"error", e.what()}};
+  }
+}
+
 /// Physical range of the inputs, checked before anything is opened or printed.
 void check_physical_inputs(const std::vector<double>& phis, const std::vector<double>& res,
                            const std::string& phi_field, const std::string& re_field) {
@@ -244,16 +260,7 @@ void run_eval(const CliContext& ctx, const EvalOptions& o) {
     nlohmann::json out = nlohmann::json::array();
     for (double phi : phis) {
       for (double re : res) {
-        try {
-          out.push_back(evaluation_json(*law, evaluate(*law, phi, re, o.extra)));
-        } catch (const Error& e) {
-          if (e.code() != ErrorCode::kOutOfValidity) throw;
-          out.push_back({{"law", law->record().name},
-                         {"version", law->record().version},
-                         {"phi", phi},
-                         {"re", re},
-                         {"error", e.what()}});
-        }
+        out.push_back(grid_point_json(*law, phi, re, o.extra));
       }
     }
     ctx.print_json(out);
@@ -410,16 +417,7 @@ void run_compare(const CliContext& ctx, const std::string& phi_list, const std::
     for (const auto& law : laws) {
       for (double re : res) {
         for (double phi : phis) {
-          try {
-            out.push_back(evaluation_json(*law, evaluate(*law, phi, re, {})));
-          } catch (const Error& e) {
-            if (e.code() != ErrorCode::kOutOfValidity) throw;
-            out.push_back({{"law", law->record().name},
-                           {"version", law->record().version},
-                           {"phi", phi},
-                           {"re", re},
-                           {"error", e.what()}});
-          }
+          out.push_back(grid_point_json(*law, phi, re, {}));
         }
       }
     }

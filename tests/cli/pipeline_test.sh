@@ -22,22 +22,7 @@ db="$work/p.db"
 src="$(cd "$(dirname "$0")/../.." && pwd)"
 . "$(dirname "$0")/harness.sh"
 . "$src/tests/support/toml_edit.sh"
-cat > "$work/tiny.toml" <<'TOML'
-[campaign]
-name = "tiny"
-description = "pipeline test"
-[grid]
-phi = [0.15, 0.25, 0.35]
-re = [0, 4, 10]
-realizations = 1
-seed = 7
-[packing]
-spheres = 8
-[lbm]
-resolutions = [8]
-[dataset]
-extrapolation = "finest"
-TOML
+cp "$src/tests/support/data/tiny_campaign.toml" "$work/tiny.toml"
 
 toml_edit "$src/data/scenes/dpm_tiny.toml" gas.viscosity_pa_s=1.8e-3 drag.eps_mf=0.7 \
   'scene.name="dpm_tiny_viscous"' >"$work/viscous.toml"

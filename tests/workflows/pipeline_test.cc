@@ -1,12 +1,12 @@
 // workflows::run_pipeline: campaign -> dataset -> fit of Eq. 6 -> published law, in process.
 //
-// Set-up: a tiny campaign, 3 phi (0.15, 0.25, 0.35) x 3 Re (0, 4, 10), one 8-sphere packing per
-// phi at d = 8 (a few seconds of LBM); no report (no Python) and no regression check (the
-// command line's test, tests/cli/pipeline_test.sh, runs both).
-// References: the comparison table's "RMS vs data" of the fit is the fitter's own RMS relative
-// error on the same points (two computations of one number, to round-off); a re-run resumes
-// the campaign (no new unit) and reuses the identical published version (content hash and
-// dataset equal); bad input is refused before any LBM (no campaign stored).
+// Set-up: tests/support/data/tiny_campaign.toml, 3 phi (0.15, 0.25, 0.35) x 3 Re (0, 4, 10), one
+// 8-sphere packing per phi at d = 8 (a few seconds of LBM); no report (no Python) and no regression
+// check (the command line's test, tests/cli/pipeline_test.sh, runs both). References: the
+// comparison table's "RMS vs data" of the fit is the fitter's own RMS relative error on the same
+// points (two computations of one number, to round-off); a re-run resumes the campaign (no new
+// unit) and reuses the identical published version (content hash and dataset equal); bad input is
+// refused before any LBM (no campaign stored).
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -22,26 +22,12 @@
 namespace draglab {
 namespace {
 
-const char* const kTinySpec = R"([campaign]
-name = "tiny"
-[grid]
-phi = [0.15, 0.25, 0.35]
-re = [0, 4, 10]
-realizations = 1
-seed = 7
-[packing]
-spheres = 8
-[lbm]
-resolutions = [8]
-[dataset]
-extrapolation = "finest"
-)";
+const std::string kTinySpec = std::string(DRAGLAB_TEST_SUPPORT_DIR) + "/data/tiny_campaign.toml";
 
 workflows::PipelineOptions tiny_options(const test::TempDir& dir) {
-  { std::ofstream(dir.file("tiny.toml")) << kTinySpec; }
   workflows::PipelineOptions o;
   o.db_path = dir.file("p.db");
-  o.spec_path = dir.file("tiny.toml");
+  o.spec_path = kTinySpec;
   o.jobs = 1;
   o.report = false;
   o.regress = false;
@@ -90,7 +76,7 @@ TEST(Pipeline, BadInputIsRefusedBeforeAnyLbm) {
     EXPECT_NE(std::string(e.what()).find("--law-name"), std::string::npos) << e.what();
   }
   o.law_name.clear();
-  o.regress_scene = dir.file("tiny.toml");  // with regress = false
+  o.regress_scene = kTinySpec;  // with regress = false
   EXPECT_THROW(workflows::run_pipeline(o), Error);
   o.regress = true;
   o.regress_scene = dir.file("missing.toml");
