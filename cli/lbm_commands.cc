@@ -34,7 +34,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMaxRe = 1000.0;  // the range; beyond it the Mach budget needs d > 80
-constexpr double kMinResolution = 4.0, kMaxResolution = 512.0;
 
 /// Which geometry: a packing file or an ordered array.
 struct CaseOptions {
@@ -131,46 +130,6 @@ Case load_case(const CaseOptions& o) {
   return c;
 }
 
-/// Lattice nodes of the box at resolution d (the voxelizer's rounding).
-double node_count(const arrays::Packing& p, double d) {
-  const double nx = std::max(1.0, std::round(d * p.box_length[0]));
-  const double dx = p.box_length[0] / nx;
-  return nx * std::round(p.box_length[1] / dx) * std::round(p.box_length[2] / dx);
-}
-
-/// Resolution range, gaps resolved, memory available: all before any work.
-void check_resolution(const arrays::Packing& p, double d, const std::string& field,
-                      const lbm::RunOptions& run, const std::string& precision) {
-  if (!std::isfinite(d) || d < kMinResolution || d > kMaxResolution) {
-    throw UsageError(fmt::format("{} = {} is outside [{}, {}] lattice units per diameter", field, d,
-                                 kMinResolution, kMaxResolution));
-  }
-  if (run.min_gap_nodes > 0.0) {
-    const double gap = arrays::min_gap_lattice_units(p, d);
-    if (gap < run.min_gap_nodes) {
-      throw UsageError(fmt::format(
-          "{} = {}: the smallest gap between spheres spans {:.3g} lattice units, below "
-          "--min-gap-nodes = {}{}; drop --min-gap-nodes to run the under-resolved gaps (they are "
-          "reported, and a d sweep estimates their error)",
-          field, d, gap, run.min_gap_nodes,
-          gap > 0.0 ? fmt::format(" (use {} >= {:.2f})", field,
-                                  std::ceil(d * run.min_gap_nodes / gap * 100.0) / 100.0)
-                    : std::string(" (the spheres touch or overlap)")));
-    }
-  }
-  // Populations (19 per node) plus flags, links and fields: generous per-node budget.
-  const double bytes_per_node = precision == "float" ? 110.0 : 200.0;
-  const double nodes = node_count(p, d);
-  const double memory =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
-  if (memory > 0 && nodes * bytes_per_node > 0.8 * memory) {
-    throw UsageError(fmt::format(
-        "{} = {} needs about {:.1f} GiB for {:.3g} lattice nodes, more than 80 % of this "
-        "machine's {:.1f} GiB; lower {} (or use --precision float)",
-        field, d, nodes * bytes_per_node / 1073741824.0, nodes, memory / 1073741824.0, field));
-  }
-}
-
 lbm::RunOptions run_options(const SolverOptions& s) {
   lbm::RunOptions r;
   if (std::isnan(s.re)) throw UsageError("--re is required (0 = Stokes flow)");
@@ -249,7 +208,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
   lbm::RunOptions options = run_options(c.solver);
   if (std::isnan(c.d)) throw UsageError("--d is required (lattice units per sphere diameter)");
   const Case the_case = load_case(c.case_options);
-  check_resolution(the_case.packing, c.d, "--d", options, c.solver.precision);
+  lbm::check_run_size(the_case.packing, c.d, options, "--d");
   if (!c.fields.empty()) core::check_output_file(c.fields, "--fields");
   if (c.d_hydro != 0.0 && c.calibrate) throw UsageError("give --d-hydro or --calibrate, not both");
   if (c.d_hydro != 0.0) {
@@ -473,8 +432,7 @@ void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c)
     }
     co.reference_F = c.reference;
   }
-  for (double d : co.resolutions)
-    check_resolution(the_case.packing, d, "--d", options, c.solver.precision);
+  for (double d : co.resolutions) lbm::check_run_size(the_case.packing, d, options, "--d");
   std::string error;
   if (!co.IsValid(&error)) throw UsageError(error);
   std::string tool;

@@ -21,7 +21,6 @@ namespace draglab {
 namespace campaign {
 namespace {
 
-constexpr double kBytesPerNode = 200.0;  // populations, flags, links: generous (as check_memory)
 constexpr double kMemoryShare = 0.8;
 
 std::string format(const char* fmt, double x) {
@@ -59,11 +58,6 @@ double measure_node_update_seconds() {
   return 1e-6 / r.mflups;
 }
 
-double machine_memory() {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
-}
-
 }  // namespace
 
 CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_update_seconds) {
@@ -97,7 +91,7 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
         p.fluid_nodes = nodes * (1.0 - phi);
         p.steps = lbm::predicted_steps(phi, re, d, collision);
         p.unit_seconds = p.fluid_nodes * p.steps * plan.node_update_seconds;
-        p.memory_bytes = nodes * kBytesPerNode;
+        p.memory_bytes = lbm::estimated_run_bytes(nodes, lbm::Precision::kDouble);
         plan.units += p.units;
         plan.core_seconds += p.units * p.unit_seconds;
         plan.largest_unit_memory_bytes = std::max(plan.largest_unit_memory_bytes, p.memory_bytes);
@@ -119,7 +113,7 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
     plan.wall_seconds = std::max(plan.wall_seconds, load.top());
     load.pop();
   }
-  plan.machine_memory_bytes = machine_memory();
+  plan.machine_memory_bytes = lbm::physical_memory_bytes();
   plan.fits_in_memory =
       plan.machine_memory_bytes <= 0.0 ||
       plan.largest_unit_memory_bytes * jobs <= kMemoryShare * plan.machine_memory_bytes;

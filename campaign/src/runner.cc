@@ -327,9 +327,8 @@ void check_memory(const CampaignSpec& spec, int workers) {
     const int n = internal::packing_options(spec, phi, 1).n;
     nodes = std::max(nodes, std::pow(std::cbrt(n * M_PI / (6.0 * phi)) * d, 3));
   }
-  const double bytes = nodes * 200.0 * workers;  // populations, flags, links: generous
-  const double memory =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  const double bytes = lbm::estimated_run_bytes(nodes, lbm::Precision::kDouble) * workers;
+  const double memory = lbm::physical_memory_bytes();
   if (memory > 0 && bytes > 0.8 * memory) {
     char buf[320];
     std::snprintf(buf, sizeof buf,

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 #include "draglab/core/toml_schema.h"
+#include "draglab/lbm/lbm.h"
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
@@ -23,7 +24,8 @@ namespace {
 
 constexpr double kMinPhi = 0.05, kMaxPhi = 0.6;
 constexpr double kMaxRe = 1000.0;
-constexpr double kMinResolution = 4.0, kMaxResolution = 512.0;
+using lbm::kMaxResolution;
+using lbm::kMinResolution;
 
 using core::format_number;
 

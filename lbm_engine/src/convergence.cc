@@ -251,17 +251,8 @@ ConvergenceResult run_convergence(const ConvergenceOptions& options,
   std::vector<double> resolutions = options.resolutions;
   std::sort(resolutions.begin(), resolutions.end());
   resolutions.erase(std::unique(resolutions.begin(), resolutions.end()), resolutions.end());
-  // Refuse resolutions that do not resolve the gaps before spending any time.
-  for (double d : resolutions) {
-    if (!(options.run.min_gap_nodes > 0.0)) break;  // opt-in check
-    const double gap = arrays::min_gap_lattice_units(options.packing, d);
-    if (gap < options.run.min_gap_nodes) {
-      throw Error(ErrorCode::kInvalidArgument,
-                  format("convergence: resolution d = %g is too low for the gaps: the smallest gap "
-                         "between spheres spans %.3g lattice units (at least %g needed)",
-                         d, gap, options.run.min_gap_nodes));
-    }
-  }
+  // Refuse what cannot run (gaps not resolved, too little memory) before spending any time.
+  for (double d : resolutions) check_run_size(options.packing, d, options.run, "convergence: d");
 
   const auto start = std::chrono::steady_clock::now();
   ConvergenceResult result;

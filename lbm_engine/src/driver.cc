@@ -91,7 +91,7 @@ int resolve_threads(int requested) {
 #endif
 }
 
-double physical_memory_bytes() {
+double machine_memory_bytes() {
 #if defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
   return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
@@ -204,7 +204,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
                               static_cast<double>(lattice.stride()) +
                           static_cast<double>(lattice.memory_bytes()) +
                           48.0 * static_cast<double>(grid.num_links());
-    const double available = physical_memory_bytes();
+    const double available = machine_memory_bytes();
     if (available > 0.0 && needed > 0.9 * available) {
       throw Error(ErrorCode::kInvalidArgument,
                   "lbm run: the lattice needs about " + fmt("%.3g", needed / 1073741824.0) +
@@ -556,14 +556,20 @@ RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
   return run_checked(grid, phi_exact, options, fields, progress);
 }
 
-RunResult run(const arrays::Packing& packing, double resolution, const RunOptions& options,
-              const ProgressCallback& progress) {
-  std::string error;
-  if (!options.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, "lbm run: " + error);
-  if (!(std::isfinite(resolution) && resolution > 0.0)) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "lbm run: resolution (lattice units per diameter) must be > 0, got " +
-                    fmt("%g", resolution));
+double physical_memory_bytes() { return machine_memory_bytes(); }
+
+double estimated_run_bytes(double nodes, Precision precision) {
+  // Populations (19 per node) plus flags, links and fields: a generous per-node budget.
+  return nodes * (precision == Precision::kFloat ? 110.0 : 200.0);
+}
+
+void check_run_size(const arrays::Packing& packing, double resolution, const RunOptions& options,
+                    const std::string& field) {
+  if (!std::isfinite(resolution) || resolution < kMinResolution || resolution > kMaxResolution) {
+    throw Error(ErrorCode::kInvalidArgument, field + " = " + fmt("%g", resolution) +
+                                                 " is outside [" + fmt("%g", kMinResolution) +
+                                                 ", " + fmt("%g", kMaxResolution) +
+                                                 "] lattice units per diameter");
   }
   const double gap = options.min_gap_nodes > 0.0
                          ? arrays::min_gap_lattice_units(packing, resolution)
@@ -572,20 +578,44 @@ RunResult run(const arrays::Packing& packing, double resolution, const RunOption
     const double needed = gap > 0.0 ? resolution * options.min_gap_nodes / gap : 0.0;
     throw Error(
         ErrorCode::kInvalidArgument,
-        "lbm run: resolution " + fmt("%g", resolution) +
-            " too low for the gaps: the smallest gap between spheres spans " + fmt("%.3g", gap) +
+        field + " = " + fmt("%g", resolution) +
+            " is too low for the gaps: the smallest gap between spheres spans " + fmt("%.3g", gap) +
             " lattice units, below min_gap_nodes = " + fmt("%g", options.min_gap_nodes) +
-            (gap > 0.0 && needed <= 512.0
+            (gap > 0.0 && needed <= kMaxResolution
                  ? "; raise the resolution to at least " + fmt("%.4g", needed) + ", or"
-                 : std::string(gap > 0.0 ? " (the resolution it would need, " +
-                                               fmt("%.4g", needed) + ", is beyond the limit 512);"
-                                         : "; the spheres touch or overlap;")) +
+                 : std::string(gap > 0.0
+                                   ? " (the resolution it would need, " + fmt("%.4g", needed) +
+                                         ", is beyond the limit " + fmt("%g", kMaxResolution) + ");"
+                                   : "; the spheres touch or overlap;")) +
             " generate the packing with a minimum surface gap of at least " +
             fmt("%.3g", options.min_gap_nodes / resolution) +
             " diameters (draglab pack --min-gap " +
             fmt("%.3g", 1.5 * options.min_gap_nodes / resolution) +
-            "), or lower min_gap_nodes if under-resolved gaps are acceptable");
+            "), or set min_gap_nodes to 0 to run the under-resolved gaps (they are reported, "
+            "and a sweep in d estimates their error)");
   }
+  // Lattice nodes of the box at this resolution (the voxelizer's rounding).
+  const double nx = std::max(1.0, std::round(resolution * packing.box_length[0]));
+  const double dx = packing.box_length[0] / nx;
+  const double nodes =
+      nx * std::round(packing.box_length[1] / dx) * std::round(packing.box_length[2] / dx);
+  const double bytes = estimated_run_bytes(nodes, options.precision);
+  const double memory = machine_memory_bytes();
+  if (memory > 0.0 && bytes > 0.8 * memory) {
+    throw Error(ErrorCode::kInvalidArgument,
+                field + " = " + fmt("%g", resolution) + " needs about " +
+                    fmt("%.1f", bytes / 1073741824.0) + " GiB for " + fmt("%.3g", nodes) +
+                    " lattice nodes, more than 80 % of this machine's " +
+                    fmt("%.1f", memory / 1073741824.0) + " GiB; lower " + field +
+                    " (or use --precision float)");
+  }
+}
+
+RunResult run(const arrays::Packing& packing, double resolution, const RunOptions& options,
+              const ProgressCallback& progress) {
+  std::string error;
+  if (!options.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, "lbm run: " + error);
+  check_run_size(packing, resolution, options, "lbm run: resolution");
   arrays::VoxelizationOptions vox;
   vox.resolution = resolution;
   const arrays::VoxelGrid grid = arrays::voxelize(packing, vox);

@@ -192,12 +192,30 @@ struct RunResult {
 /// re >= 0, d > 0.
 double predicted_steps(double phi, double re, double d, Collision collision = Collision::kTrt);
 
+/// The resolutions a run accepts, lattice units per sphere diameter: below 4 a sphere is a few
+/// voxels; above 512 the box of even one sphere outgrows any memory.
+constexpr double kMinResolution = 4.0, kMaxResolution = 512.0;
+
+/// This machine's physical memory in bytes (0 when unknown).
+double physical_memory_bytes();
+/// Memory of a run on `nodes` lattice nodes (19 populations, flags, links and fields), bytes:
+/// a generous estimate, so that a refusal comes before the system kills the process.
+double estimated_run_bytes(double nodes, Precision precision);
+
+/// Checks, before any work, that `packing` can be run at `resolution`: the resolution within
+/// [kMinResolution, kMaxResolution], the gaps between spheres resolved when
+/// options.min_gap_nodes > 0, and the lattice's estimated memory within 80 % of this machine's.
+/// Throws Error(kInvalidArgument) naming `field` (the option that sets the resolution, e.g.
+/// "--d") with the limit and a remedy.
+void check_run_size(const arrays::Packing& packing, double resolution, const RunOptions& options,
+                    const std::string& field);
+
 /// Runs to steady state on a voxelized geometry (flow along +x). `phi_exact` is the exact solids
 /// fraction (Packing::phi()) or <= 0 to use the lattice one.
 RunResult run(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
               const ProgressCallback& progress = nullptr);
 
-/// Convenience: voxelize `packing` at `resolution` (checking the gap resolution) and run.
+/// Convenience: voxelize `packing` at `resolution` (check_run_size first) and run.
 RunResult run(const arrays::Packing& packing, double resolution, const RunOptions& options,
               const ProgressCallback& progress = nullptr);
 
