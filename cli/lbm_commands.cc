@@ -26,6 +26,7 @@
 #include "draglab/lbm/convergence.h"
 #include "draglab/lbm/fields_io.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/workflows/bed_results.h"
 #include "draglab/workflows/convergence_plot.h"
 
 namespace draglab {
@@ -33,6 +34,7 @@ namespace cli {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using workflows::number_or_null;
 constexpr double kMaxRe = 1000.0;  // the range; beyond it the Mach budget needs d > 80
 
 /// Which geometry: a packing file or an ordered array.
@@ -157,52 +159,6 @@ lbm::RunOptions run_options(const SolverOptions& s) {
   return r;
 }
 
-/// Converged value or JSON null.
-nlohmann::json number_or_null(double x) {
-  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
-}
-
-nlohmann::json run_json(const lbm::RunResult& r, const lbm::RunOptions& o, double re_target,
-                        const arrays::VoxelGrid& grid, std::size_t spheres) {
-  nlohmann::json j = {{"F", number_or_null(r.F)},
-                      {"K", number_or_null(r.K)},
-                      {"beta_d2_over_mu", number_or_null(r.beta_d2_over_mu)},
-                      {"F_standard_error", number_or_null(r.F_standard_error)},
-                      {"re", number_or_null(r.re)},
-                      {"re_target", re_target},
-                      {"phi", r.phi},
-                      {"phi_lattice", r.phi_lattice},
-                      {"converged", r.converged},
-                      {"diagnosis", r.diagnosis},
-                      {"steps", r.steps},
-                      {"wall_s", r.wall_s},
-                      {"mflups", r.mflups},
-                      {"momentum_balance_rel", number_or_null(r.momentum_balance_rel)},
-                      {"mach_max", number_or_null(r.mach_max)},
-                      {"error_estimate", number_or_null(r.error_estimate)},
-                      {"d", r.d},
-                      {"resolution", grid.resolution()},
-                      {"dims", grid.dims},
-                      {"spheres", spheres},
-                      {"tau", r.tau},
-                      {"nu", r.nu},
-                      {"body_force", r.body_force},
-                      {"superficial_velocity", r.superficial_velocity},
-                      {"collision", lbm::to_string(o.collision)},
-                      {"boundary", lbm::to_string(o.boundary)},
-                      {"precision", lbm::to_string(o.precision)},
-                      {"narrow_gap_pairs", r.narrow_gap_pairs},
-                      {"smallest_gap_nodes", number_or_null(r.smallest_gap_nodes)},
-                      {"narrow_gap_fluid_fraction", r.narrow_gap_fluid_fraction},
-                      {"fallback_links", r.fallback_links},
-                      {"boundary_links", r.boundary_links},
-                      {"warnings", r.warnings}};
-  if (o.collision == lbm::Collision::kTrt) j["magic"] = o.magic;
-  j["d_hydrodynamic"] = o.use_hydrodynamic_diameter ? nlohmann::json(o.hydrodynamic_diameter)
-                                                    : nlohmann::json(nullptr);
-  return j;
-}
-
 void run_lbm(const CliContext& ctx, const RunCommand& c) {
   // Everything the user typed is checked before the (possibly long) run.
   lbm::RunOptions options = run_options(c.solver);
@@ -268,7 +224,11 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
                        : lbm::run_with_fields(grid, phi_exact, options, &fields, report("lbm run"));
   progress.finish();
 
-  nlohmann::json j = run_json(r, options, c.solver.re, grid, the_case.packing.size());
+  nlohmann::json j = nlohmann::json::parse(r.ToJson(options));
+  j["re_target"] = c.solver.re;
+  j["resolution"] = grid.resolution();
+  j["dims"] = grid.dims;
+  j["spheres"] = the_case.packing.size();
   j["case"] = the_case.description;
   if (!calibration_json.is_null()) j["calibration"] = calibration_json;
   // The exact answer where one is known: the run's true error beside its own estimate. With a

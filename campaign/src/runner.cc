@@ -189,37 +189,14 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
     out.done = out.run.converged && std::isfinite(out.run.F);
     out.diagnosis = out.run.converged ? "" : out.run.diagnosis;
     if (out.run.converged && !std::isfinite(out.run.F)) out.diagnosis = "non-finite drag";
-    out.result = {{"spheres", packing.size()},
-                  {"box_length", packing.box_length},
-                  {"packing_seed", unit.seed},
-                  {"packing_wall_s", summary.wall_s},
-                  {"lbm_wall_s", out.run.wall_s},
-                  {"F_standard_error", out.run.F_standard_error},
-                  {"K", out.run.K},
-                  {"phi_lattice", out.run.phi_lattice},
-                  {"d", out.run.d},
-                  {"tau", out.run.tau},
-                  {"tau_minus", out.run.tau_minus},
-                  {"nu", out.run.nu},
-                  {"body_force", out.run.body_force},
-                  {"superficial_velocity", out.run.superficial_velocity},
-                  {"momentum_balance_rel", out.run.momentum_balance_rel},
-                  {"mach_max", out.run.mach_max},
-                  {"convergence_residual", out.run.convergence_residual},
-                  {"discretisation_error", out.run.discretisation_error},
-                  {"fluid_nodes", out.run.fluid_nodes},
-                  {"narrow_gap_pairs", out.run.narrow_gap_pairs},
-                  {"narrow_gap_fluid_fraction", out.run.narrow_gap_fluid_fraction},
-                  {"fallback_links", out.run.fallback_links},
-                  {"stokes_mode", out.run.stokes_mode},
-                  {"warnings", out.run.warnings},
-                  {"threads", threads},
-                  {"collision", spec.collision},
-                  {"boundary", spec.boundary}};
-    // JSON has no NaN: failed runs leave these null.
-    for (auto& [key, value] : out.result.items()) {
-      if (value.is_number_float() && !std::isfinite(value.get<double>())) value = nullptr;
-    }
+    // The run's own record (every scalar, the scheme), with where the unit's packing came from.
+    out.result = nlohmann::json::parse(out.run.ToJson(ro));
+    out.result["spheres"] = packing.size();
+    out.result["box_length"] = packing.box_length;
+    out.result["packing_seed"] = unit.seed;
+    out.result["packing_wall_s"] = summary.wall_s;
+    out.result["lbm_wall_s"] = out.run.wall_s;
+    out.result["threads"] = threads;
   } catch (const std::exception& e) {
     // Bad geometry for this unit (gap too small, packing not found) or an engine refusal:
     // recorded as a failed unit, the others go on.

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/lbm.h"
 
@@ -162,8 +164,8 @@ std::string RunResult::FullReport() const {
       << "momentum balance     " << format("%.3g", momentum_balance_rel) << " (relative)\n"
       << "mass change          " << format("%.3g", mass_change_rel) << " (relative)\n"
       << "sub-node gaps        " << narrow_gap_pairs << " sphere pairs below one node (smallest "
-      << format("%.3g", smallest_gap_nodes) << "), " << format("%.3g", 100.0 * narrow_gap_fluid_fraction)
-      << " % of fluid nodes in one-node gaps\n"
+      << format("%.3g", smallest_gap_nodes) << "), "
+      << format("%.3g", 100.0 * narrow_gap_fluid_fraction) << " % of fluid nodes in one-node gaps\n"
       << "fluid nodes / links  " << fluid_nodes << " / " << boundary_links << " (" << fallback_links
       << " interpolation fallbacks)\n"
       << "steps                " << steps << " (characteristic time " << characteristic_steps
@@ -181,6 +183,51 @@ std::string RunResult::FullReport() const {
     }
   }
   return out.str();
+}
+
+std::string RunResult::ToJson(const RunOptions& o) const {
+  nlohmann::json j = {{"F", F},
+                      {"K", K},
+                      {"beta_d2_over_mu", beta_d2_over_mu},
+                      {"F_standard_error", F_standard_error},
+                      {"re", re},
+                      {"phi", phi},
+                      {"phi_lattice", phi_lattice},
+                      {"converged", converged},
+                      {"diagnosis", diagnosis},
+                      {"steps", steps},
+                      {"wall_s", wall_s},
+                      {"mflups", mflups},
+                      {"momentum_balance_rel", momentum_balance_rel},
+                      {"mach_max", mach_max},
+                      {"error_estimate", error_estimate},
+                      {"convergence_residual", convergence_residual},
+                      {"discretisation_error", discretisation_error},
+                      {"d", d},
+                      {"tau", tau},
+                      {"tau_minus", tau_minus},
+                      {"nu", nu},
+                      {"body_force", body_force},
+                      {"superficial_velocity", superficial_velocity},
+                      {"stokes_mode", stokes_mode},
+                      {"fluid_nodes", fluid_nodes},
+                      {"collision", to_string(o.collision)},
+                      {"boundary", to_string(o.boundary)},
+                      {"precision", to_string(o.precision)},
+                      {"narrow_gap_pairs", narrow_gap_pairs},
+                      {"smallest_gap_nodes", smallest_gap_nodes},
+                      {"narrow_gap_fluid_fraction", narrow_gap_fluid_fraction},
+                      {"fallback_links", fallback_links},
+                      {"boundary_links", boundary_links},
+                      {"warnings", warnings}};
+  if (o.collision == Collision::kTrt) j["magic"] = o.magic;
+  j["d_hydrodynamic"] =
+      o.use_hydrodynamic_diameter ? nlohmann::json(o.hydrodynamic_diameter) : nlohmann::json();
+  // JSON has no NaN: what a failed run did not measure is null.
+  for (auto& [key, value] : j.items()) {
+    if (value.is_number_float() && !std::isfinite(value.get<double>())) value = nullptr;
+  }
+  return j.dump();
 }
 
 }  // namespace lbm

@@ -181,6 +181,11 @@ struct RunResult {
   std::size_t memory_bytes = 0;           ///< Populations plus lattice tables.
   std::string BriefReport() const;
   std::string FullReport() const;
+  /// Every scalar of the run as a JSON object (text) with the options that shaped it
+  /// (collision, boundary, precision, magic for TRT, d_hydrodynamic): what `draglab lbm run
+  /// --json` prints and what a campaign stores per unit. A value that is not finite (a run that
+  /// did not converge) is null.
+  std::string ToJson(const RunOptions& options) const;
 };
 
 /// A-priori number of time steps a run with the automatic relaxation time (RunOptions::tau == 0)
