@@ -23,9 +23,10 @@ nlohmann::json record_json(const LawRecord& r) {
   return nlohmann::json::parse(export_law(r, ExportFormat::kJson));
 }
 
-/// Values of one evaluation, as printed by `law eval`. Under the clamp policy F is evaluated at
-/// the clamped point (phi_evaluated, re_evaluated); beta d^2/mu and K use the requested phi
-/// (law.h explains why).
+/// Values of one evaluation, as printed by `law eval`: F, beta d^2/mu and K all at one point,
+/// the point the formula saw (phi_evaluated, re_evaluated: the clamped point under the clamp
+/// policy, else the requested one). A solver's Law::beta_d2_over_mu and Law::K convert with its
+/// cell's own phi instead (law.h); `law eval` shows the closure at a single point.
 struct Evaluation {
   double phi, re, F, beta_d2_over_mu, K;
   double phi_evaluated, re_evaluated;
@@ -40,8 +41,8 @@ Evaluation evaluate(const Law& law, double phi, double re, const std::vector<dou
   e.F = v.F;
   e.phi_evaluated = v.phi;
   e.re_evaluated = v.re;
-  e.beta_d2_over_mu = conventions::beta_d2_over_mu(phi, e.F);
-  e.K = conventions::total_force_K(phi, e.F);
+  e.beta_d2_over_mu = conventions::beta_d2_over_mu(v.phi, e.F);
+  e.K = conventions::total_force_K(v.phi, e.F);
   e.outside_validity = v.out_of_validity;
   return e;
 }
@@ -56,15 +57,8 @@ nlohmann::json evaluation_json(const Law& law, const Evaluation& e) {
                       {"beta_d2_over_mu", e.beta_d2_over_mu},
                       {"K", e.K},
                       {"outside_validity", e.outside_validity}};
-  if (e.phi_evaluated != e.phi || e.re_evaluated != e.re) {
-    // One closure evaluation (at the clamped point); beta and K convert that F with the cell's
-    // own phi, as a solver does (law.h): each quantity says where it comes from.
-    j["F_evaluated_at"] = {{"phi", e.phi_evaluated}, {"re", e.re_evaluated}};
-    j["conversions_at"] = {{"phi", e.phi},
-                           {"note",
-                            "beta_d2_over_mu = 18 phi (1 - phi) F and K = F/(1 - phi) "
-                            "with the requested phi and F from F_evaluated_at"}};
-  }
+  // Every value comes from this one point (the clamped point under the clamp policy).
+  j["evaluated_at"] = {{"phi", e.phi_evaluated}, {"re", e.re_evaluated}};
   return j;
 }
 
@@ -245,10 +239,8 @@ void run_eval(const CliContext& ctx, const EvalOptions& o) {
         "phi = {}  Re = {}{}\n", format_number(e.phi), format_number(e.re),
         e.outside_validity ? "  (outside validity box: " + o.policy + ")" : "");
     if (e.phi_evaluated != e.phi || e.re_evaluated != e.re) {
-      std::cout << fmt::format(
-          "  F evaluated at the clamped point phi = {}, Re = {}; beta and K "
-          "use the actual phi\n",
-          format_number(e.phi_evaluated), format_number(e.re_evaluated));
+      std::cout << fmt::format("  every value at the clamped point phi = {}, Re = {}\n",
+                               format_number(e.phi_evaluated), format_number(e.re_evaluated));
     }
     std::cout << fmt::format("  F              = {}\n", format_number(e.F, 10));
     std::cout << fmt::format("  beta d^2/mu    = {}\n", format_number(e.beta_d2_over_mu, 10));

@@ -58,10 +58,10 @@ check "negative Re" 2 "$draglab" law eval bvk2007 --phi 0.3 --re -1
 check "NaN phi" 2 "$draglab" law eval bvk2007 --phi nan --re 1
 check "outside validity" 2 "$draglab" law eval bvk2007 --phi 0.05 --re 1
 check "clamp policy" 0 "$draglab" law eval bvk2007 --phi 0.05 --re 1 --range-policy clamp --json
-# Under clamp every quantity says where it comes from: F at the clamped point, beta and K
-# converting that F with the requested phi.
-json_check "clamp: F's point and the conversions' phi reported" \
-  "j['F_evaluated_at']['phi'] > 0.05 and j['conversions_at']['phi'] == 0.05 and abs(j['K'] - j['F']/0.95) < 1e-12*j['K'] and abs(j['beta_d2_over_mu'] - 18*0.05*0.95*j['F']) < 1e-9*j['beta_d2_over_mu']"
+# Under clamp every quantity comes from one point, reported: F, beta and K at the clamped point
+# (bvk2007's validity starts at phi = 0.1), the requested point kept beside it.
+json_check "clamp: one evaluation point for every value, reported" \
+  "j['phi'] == 0.05 and j['evaluated_at']['phi'] == 0.1 and abs(j['K'] - j['F']/0.9) < 1e-12*j['K'] and abs(j['beta_d2_over_mu'] - 18*0.1*0.9*j['F']) < 1e-9*j['beta_d2_over_mu']"
 json_check "clamped value equals phi=0.1" "abs(j['F'] - 2.49816) < 1e-5"
 check "unknown law" 2 "$draglab" law eval no_such_law --phi 0.3 --re 1
 grep -q "bvk2007" "$work/err" || { echo "FAIL: unknown law does not list known names"; failures=$((failures + 1)); }
