@@ -303,13 +303,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!build_file(in, path)) return 0;
   }
   draglab_fuzz::expect_clean([&] {
-    const draglab::arrays::Packing packing = draglab::arrays::read_packing_hdf5(path);
+    const draglab::arrays::Packing packing = draglab::arrays::read_packing_hdf5_in_process(path);
     check(packing, "accepted packing");
     const std::string again_path = scratch.file("again.h5");
     draglab::arrays::write_packing_hdf5(again_path, packing);
     draglab::arrays::Packing again;
     try {
-      again = draglab::arrays::read_packing_hdf5(again_path);
+      again = draglab::arrays::read_packing_hdf5_in_process(again_path);
     } catch (const draglab::Error& e) {
       draglab_fuzz::finding(std::string("a written packing is refused: ") + e.what());
     }

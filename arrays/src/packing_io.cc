@@ -11,6 +11,7 @@
 
 #include "drag_db_version.h"
 #include "draglab/core/hdf5_file.h"
+#include "draglab/core/isolated.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -190,7 +191,7 @@ void write_packing_hdf5(const std::string& path, const Packing& packing,
   file.save(path);
 }
 
-Packing read_packing_hdf5(const std::string& path) {
+Packing read_packing_hdf5_in_process(const std::string& path) {
   silence_hdf5();
   if (access(path.c_str(), R_OK) != 0) fail(path, "does not exist or is not readable");
   if (H5Fis_hdf5(path.c_str()) <= 0) fail(path, "is not an HDF5 file");
@@ -232,6 +233,17 @@ Packing read_packing_hdf5(const std::string& path) {
   unsigned long long seed = 0;
   if (read_number(group.get(), "seed", H5T_NATIVE_ULLONG, &seed, path)) p.seed = seed;
   return p;
+}
+
+Packing read_packing_hdf5(const std::string& path) {
+  // Damaged files can crash, hang or exhaust memory inside libhdf5 1.10 (fuzz/regressions/):
+  // the read is tried in a child first. A packing of the largest accepted size reads in seconds
+  // within a few hundred MB.
+  constexpr unsigned kSeconds = 120;
+  constexpr unsigned long long kMemoryBytes = 8ULL << 30;
+  core::run_isolated([&path] { read_packing_hdf5_in_process(path); }, "packing file '" + path + "'",
+                     kSeconds, kMemoryBytes);
+  return read_packing_hdf5_in_process(path);
 }
 
 }  // namespace arrays

@@ -159,6 +159,23 @@ TEST(PackingIo, MalformedFilesGiveClearErrors) {
   expect_error(dir.file("shape.h5"), "[N, 3]");
 }
 
+// A packing file damaged where libhdf5 1.10 reads a variable-length string attribute (found by
+// fuzz_packing_hdf5: fuzz/regressions/libhdf5_global_heap_read.h5; under ASan libhdf5 copies
+// about 1 GiB out of a bogus global-heap object). Whatever libhdf5 does with it, the caller
+// survives: a well-formed packing or a bad-input error naming the file, never a crash.
+TEST(PackingIo, DamagedFileThatCrashesLibhdf5IsBadInputNotACrash) {
+  const std::string path =
+      std::string(DRAGLAB_FUZZ_REGRESSIONS_DIR) + "/libhdf5_global_heap_read.h5";
+  try {
+    const Packing p = read_packing_hdf5(path);
+    EXPECT_GT(p.size(), 0u);
+  } catch (const Error& e) {
+    EXPECT_TRUE(e.is_bad_input()) << e.what();
+    EXPECT_NE(std::string(e.what()).find("libhdf5_global_heap_read.h5"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace arrays
 }  // namespace draglab

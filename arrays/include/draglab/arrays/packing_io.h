@@ -21,8 +21,14 @@ void write_packing_hdf5(const std::string& path, const Packing& packing,
 /// Reads a packing written by write_packing_hdf5 (or any file with the same layout). Throws
 /// draglab::Error(kInvalidArgument) naming the path and the missing/malformed item, also for
 /// datasets of more values than 10^7 spheres have (checked before any allocation) and for
-/// attributes (generator, settings, seed) that hold more than one value.
+/// attributes (generator, settings, seed) that hold more than one value. The file is read first
+/// in a child process (core/isolated.h): a damaged file that crashes, hangs or exhausts memory in
+/// libhdf5 is reported as damaged (kInvalidArgument) instead of ending the caller.
 Packing read_packing_hdf5(const std::string& path);
+
+/// The same read in this process only, without that protection: for the fuzzer (which must see
+/// such crashes) and for callers that isolate the read themselves.
+Packing read_packing_hdf5_in_process(const std::string& path);
 
 }  // namespace arrays
 }  // namespace draglab
