@@ -34,6 +34,8 @@ cp "$data/campaigns/quick.toml" "$in/spec.toml"
 cp "$data/scenes/dpm_bubble_quick.toml" "$in/dpm.toml"
 cp "$data/scenes/dbm_tiny.toml" "$in/dbm.toml"
 cp "$data/scenes/tfm_bubble.toml" "$in/tfm.toml"
+# A damaged packing that crashes libhdf5 itself (fuzz/regressions/README.md).
+cp "$data/../fuzz/regressions/libhdf5_global_heap_read.h5" "$in/crashes_libhdf5.h5"
 $D dataset import "$in/good.csv" >/dev/null 2>&1 || { echo "fixture: import failed"; exit 1; }
 $D pack --phi 0.2 --n 8 --seed 3 --out "$in/p.h5" >/dev/null 2>&1 || { echo "fixture: pack"; exit 1; }
 $D fit --data "$in/good.csv" --form wen_yu --cv 0 --no-global --publish draft_law >/dev/null 2>&1 ||
