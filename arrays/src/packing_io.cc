@@ -4,6 +4,8 @@
 #include <hdf5.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -213,13 +215,20 @@ Packing read_packing_hdf5_in_process(const std::string& path) {
   if (dims.size() != 1 || dims[0] != 3) fail(path, "box_length must have shape [3]");
   if (n == 0) fail(path, "contains no spheres");
   for (int a = 0; a < 3; ++a) {
-    if (!(box[a] > 0.0)) fail(path, "box_length must be positive");
+    if (!(box[a] > 0.0 && std::isfinite(box[a])))
+      fail(path, "box_length must be positive and finite");
     p.box_length[a] = box[a];
   }
+  const double min_edge = std::min({box[0], box[1], box[2]});
   p.centers.resize(n);
   p.radii = radii;
   for (std::size_t i = 0; i < n; ++i) {
     if (!(radii[i] > 0.0)) fail(path, "radius " + std::to_string(i) + " is not positive");
+    // A sphere wider than the box overlaps its own periodic image: not a packing (a damaged file
+    // can hold such values where libhdf5 read garbage without failing).
+    if (!(2.0 * radii[i] <= min_edge)) {
+      fail(path, "radius " + std::to_string(i) + " exceeds half the smallest box edge");
+    }
     for (int a = 0; a < 3; ++a) {
       const double x = centers[3 * i + a];
       if (!(x >= 0.0 && x < box[a])) {
@@ -228,6 +237,7 @@ Packing read_packing_hdf5_in_process(const std::string& path) {
       p.centers[i][a] = x;
     }
   }
+  if (!(p.phi() <= 1.0)) fail(path, "the spheres' volume exceeds the box volume (phi > 1)");
   read_string(group.get(), "generator", &p.generator, path);
   read_string(group.get(), "settings", &p.settings_json, path);
   unsigned long long seed = 0;

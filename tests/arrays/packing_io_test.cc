@@ -5,12 +5,15 @@
 #include <hdf5.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
@@ -157,6 +160,51 @@ TEST(PackingIo, MalformedFilesGiveClearErrors) {
     H5Fclose(f);
   }
   expect_error(dir.file("shape.h5"), "[N, 3]");
+  // Well-shaped files with values no packing has (a damaged file can hold them where libhdf5 read
+  // garbage without failing): each is refused, naming the value.
+  auto write_one_sphere = [&dir](const std::string& name, double radius, double box_edge) {
+    const std::string path = dir.file(name);
+    hid_t f = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t g = H5Gcreate2(f, "packing", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    auto put = [g](const char* key, std::vector<hsize_t> dims, const double* values) {
+      hid_t s = H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr);
+      hid_t d = H5Dcreate2(g, key, H5T_IEEE_F64LE, s, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values);
+      H5Dclose(d);
+      H5Sclose(s);
+    };
+    const double center[3] = {0.5, 0.5, 0.5};
+    const double box[3] = {box_edge, box_edge, box_edge};
+    put("centers", {1, 3}, center);
+    put("radii", {1}, &radius);
+    put("box_length", {3}, box);
+    H5Gclose(g);
+    H5Fclose(f);
+    return path;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_NO_THROW(read_packing_hdf5_in_process(write_one_sphere("ok.h5", 0.5, 1.0)));
+  expect_error(write_one_sphere("huge_radius.h5", 1e300, 1.0), "radius 0 exceeds half");
+  expect_error(write_one_sphere("inf_radius.h5", inf, 1.0), "radius 0 exceeds half");
+  expect_error(write_one_sphere("nan_radius.h5", std::nan(""), 1.0), "radius 0");
+  expect_error(write_one_sphere("inf_box.h5", 0.5, inf), "box_length must be positive and finite");
+}
+
+TEST(PackingIo, SpheresFillingMoreThanTheBoxAreRefused) {
+  TempDir dir;
+  Packing p;
+  p.box_length = {1.0, 1.0, 1.0};
+  p.centers = {{0.25, 0.5, 0.5}, {0.75, 0.5, 0.5}};
+  p.radii = {0.5, 0.5};  // each fits the box; together 2 pi / 6 > 1
+  p.generator = "test";
+  write_packing_hdf5(dir.file("p.h5"), p);
+  ASSERT_GT(p.phi(), 1.0);
+  try {
+    read_packing_hdf5_in_process(dir.file("p.h5"));
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("phi > 1"), std::string::npos) << e.what();
+  }
 }
 
 // A packing file damaged where libhdf5 1.10 reads a variable-length string attribute (found by
