@@ -5,9 +5,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
 
 #include "draglab/drag_db/error.h"
 
@@ -22,6 +25,61 @@ std::string parent_directory(const std::string& path) {
   if (slash == std::string::npos) return ".";
   return slash == 0 ? "/" : path.substr(0, slash);
 }
+
+// Temporary files being written, removed when SIGINT, SIGTERM or SIGHUP ends the process in the
+// middle of a write (a SIGKILL can still leave one; never a partial file under the final name).
+// The handler only reads these slots and calls unlink, both async-signal-safe.
+constexpr int kTemporarySlots = 32;
+std::atomic<const char*> g_temporaries[kTemporarySlots];
+
+void remove_temporaries_and_reraise(int sig) {
+  for (auto& slot : g_temporaries) {
+    const char* path = slot.load();
+    if (path) ::unlink(path);
+  }
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+// Installed once, and only for signals whose disposition is still the default: a program that
+// handles or ignores them (Python, nohup) keeps its own behaviour.
+void install_temporary_cleanup() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+      struct sigaction current {};
+      if (::sigaction(sig, nullptr, &current) != 0) continue;
+      if ((current.sa_flags & SA_SIGINFO) != 0 || current.sa_handler != SIG_DFL) continue;
+      struct sigaction cleanup {};
+      cleanup.sa_handler = remove_temporaries_and_reraise;
+      sigemptyset(&cleanup.sa_mask);
+      ::sigaction(sig, &cleanup, nullptr);
+    }
+  });
+}
+
+/// Registers a temporary file for removal on a terminating signal while it lives.
+class TemporaryRegistration {
+ public:
+  explicit TemporaryRegistration(const std::string& path) {
+    install_temporary_cleanup();
+    for (int i = 0; i < kTemporarySlots; ++i) {
+      const char* empty = nullptr;
+      if (g_temporaries[i].compare_exchange_strong(empty, path.c_str())) {
+        slot_ = i;
+        return;
+      }
+    }
+  }
+  ~TemporaryRegistration() {
+    if (slot_ >= 0) g_temporaries[slot_].store(nullptr);
+  }
+  TemporaryRegistration(const TemporaryRegistration&) = delete;
+  TemporaryRegistration& operator=(const TemporaryRegistration&) = delete;
+
+ private:
+  int slot_ = -1;  // -1: more writes at once than slots; that file is not cleaned up
+};
 
 [[noreturn]] void bad_path(const std::string& field, const std::string& path,
                            const std::string& what) {
@@ -122,6 +180,8 @@ void write_file_atomically(const std::string& path, const void* data, std::size_
                            const std::string& field) {
   if (path.empty()) throw Error(ErrorCode::kInvalidArgument, field + ": empty path (give a file)");
   std::string temporary = path + ".tmp_XXXXXX";
+  // Registered before mkstemp fills in the name: the slot points at this string's buffer.
+  const TemporaryRegistration registration(temporary);
   const int fd = ::mkstemp(temporary.data());
   if (fd < 0) {
     const int error = errno;

@@ -9,13 +9,21 @@
 //  - a write that fails part-way (disk full, simulated by a file-size limit RLIMIT_FSIZE: the
 //    kernel answers EFBIG as it answers ENOSPC on a full disk) throws Error(kIo) naming the
 //    system's reason, leaves the old file as it was and no temporary file;
+//  - SIGTERM arriving while a file is being written (a child process writing large files in a
+//    loop, the signal sent once its temporary file is seen) ends the process by that signal and
+//    leaves no temporary file, and the output is absent or whole;
 //  - an HDF5 file built in memory saves to a file HDF5 reads back, and fails the same clean way
 //    (libhdf5 1.10 writing to disk directly crashed at exit after such a failure).
 #include <gtest/gtest.h>
 #include <hdf5.h>
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
+#include <thread>
+#include <vector>
 
 #include <cerrno>
 #include <cstring>
@@ -143,6 +151,46 @@ void write_example(Hdf5MemoryFile& file, std::size_t n) {
   ASSERT_GE(H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0);
   H5Dclose(set);
   H5Sclose(space);
+}
+
+TEST(CoreFiles, TerminatingSignalDuringAWriteLeavesNoTemporaryFile) {
+  TempDir dir;
+  const std::string path = dir.file("out.bin");
+  // Large enough that a write (with its fsync) lasts milliseconds, long enough to be caught.
+  const std::size_t size = std::size_t{32} << 20;
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const std::vector<char> bytes(size, 'x');
+    try {
+      for (;;) write_file_atomically(path, bytes.data(), bytes.size(), "test output");
+    } catch (...) {
+    }
+    ::_exit(3);
+  }
+  auto temporaries = [&dir] {
+    std::vector<std::string> found;
+    for (const auto& entry : fs::directory_iterator(dir.path())) {
+      const std::string name = entry.path().filename().string();
+      if (name.find(".tmp_") != std::string::npos) found.push_back(name);
+    }
+    return found;
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (temporaries().empty() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  const bool seen = !temporaries().empty();
+  ::kill(child, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(seen) << "the child never had a temporary file in 30 s";
+  ASSERT_TRUE(WIFSIGNALED(status)) << "status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  EXPECT_TRUE(temporaries().empty()) << temporaries().front();
+  if (fs::exists(path)) {
+    EXPECT_EQ(fs::file_size(path), size);
+  }
 }
 
 TEST(CoreFiles, InMemoryHdf5FileSavesWholeOrNotAtAll) {

@@ -34,8 +34,9 @@ void check_output_file(const std::string& path, const std::string& field);
 void check_output_directory(const std::string& path, const std::string& field);
 
 /// Writes `size` bytes to `path` through a temporary file in the same directory, fsync and a
-/// rename: readers see the old file or the new one, never part of one; on failure the temporary
-/// file is removed. `field` names the option or the kind of file in the message.
+/// rename: readers see the old file or the new one, never part of one; on failure, and when
+/// SIGINT, SIGTERM or SIGHUP (left at their default action) end the process during the write, the
+/// temporary file is removed. `field` names the option or the kind of file in the message.
 void write_file_atomically(const std::string& path, const void* data, std::size_t size,
                            const std::string& field);
 inline void write_file_atomically(const std::string& path, const std::string& contents,
