@@ -20,6 +20,7 @@
 #include "draglab/core/files.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/mpi/world.h"
 
 namespace draglab {
 namespace cli {
@@ -29,6 +30,8 @@ struct RunCommand {
   std::string spec;
   bool resume = false;
   int jobs = 0;
+  int threads_per_unit = 0;
+  double worker_timeout_s = 30.0;
 };
 
 struct ExportCommand {
@@ -181,9 +184,24 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
   // The whole spec is checked before the database is opened: bad input writes nothing.
   const campaign::CampaignSpec spec = campaign::parse_campaign_spec(resolve_spec_path(c.spec));
   if (c.jobs < 0) throw UsageError("--jobs must be >= 0 (0 = all cores)");
+  if (!(c.worker_timeout_s >= 1.0 && c.worker_timeout_s <= 86400.0)) {
+    throw UsageError("--worker-timeout must be in [1, 86400] seconds");
+  }
   campaign::RunCampaignOptions options;
   options.jobs = c.jobs;
   options.resume = c.resume;
+  options.threads_per_unit = c.threads_per_unit;
+  options.worker_timeout_s = c.worker_timeout_s;
+  const bool distributed = mpi::size() > 1;
+  if (!distributed && mpi::started_by_launcher()) {
+    ctx.info(
+        "note: started by an MPI launcher with one rank: running as the single-process "
+        "runner (--jobs workers); start 2 or more ranks to distribute the units");
+  }
+  if (distributed && mpi::rank() != 0) {
+    campaign::run_campaign(ctx.resolved_db_path(), spec, options);  // a worker: no output
+    return;
+  }
   auto printer = std::make_shared<CampaignProgressPrinter>(!ctx.quiet);
   options.progress = [printer](std::int64_t finished, std::int64_t total, const std::string& line) {
     (*printer)(finished, total, line);
@@ -194,6 +212,10 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
       "(database {})",
       spec.name, spec.phi.size(), spec.re.size(), spec.realizations, spec.resolutions.size(),
       spec.phi.size() * spec.re.size() * spec.realizations * spec.resolutions.size(), db_path));
+  if (distributed) {
+    ctx.info(fmt::format("MPI: {} ranks; rank 0 ({}) holds the database, ranks 1..{} run the units",
+                         mpi::size(), mpi::host_name(), mpi::size() - 1));
+  }
   const auto start = std::chrono::steady_clock::now();
   const campaign::CampaignStatus st = campaign::run_campaign(db_path, spec, options);
   printer->finish();
@@ -202,6 +224,7 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
 
   nlohmann::json j = status_json(st);
   j["run_wall_s"] = wall;
+  j["session"] = nlohmann::json::parse(st.session.ToJson());
   std::unique_ptr<Database> db = ctx.open_database();
   if (st.units_pending + st.units_running == 0 && st.units_done > 0) {
     const Dataset d = build_and_report(ctx, *db, st.id);
@@ -229,6 +252,7 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
   std::cout << st.BriefReport() << "\n";
   std::cout << fmt::format("wall time        {:.1f} s this run, {:.1f} s of LBM units in all\n",
                            wall, st.wall_s);
+  std::cout << st.session.FullReport();
   if (j.contains("dataset_id")) {
     std::cout << fmt::format("dataset          {} ({} points): draglab dataset show {}\n",
                              j["dataset_id"].get<std::string>(),
@@ -400,14 +424,30 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
     cmd->add_flag("--resume", o->resume,
                   "Continue the campaign of the same name (finished units are kept; units in "
                   "flight when it stopped run again)");
-    cmd->add_option("--jobs", o->jobs, "Units run in parallel (0 = all cores)")
+    cmd->add_option("--jobs", o->jobs, "Units run in parallel (0 = all cores; one process)")
+        ->capture_default_str();
+    cmd->add_option("--threads-per-unit", o->threads_per_unit,
+                    "OpenMP threads of each unit's LBM run (0 = the node's cores shared among its "
+                    "workers); runs that must give the same dataset id use the same value")
+        ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    cmd->add_option("--worker-timeout", o->worker_timeout_s,
+                    "MPI: seconds of silence after which a worker rank is presumed dead and its "
+                    "unit handed to another, [1, 86400]")
+        ->check(CLI::Range(1.0, 86400.0))
         ->capture_default_str();
     cmd->footer(
         "Examples:\n  draglab campaign run data/campaigns/quick.toml --db q.db --jobs 2\n"
         "  draglab campaign run data/campaigns/quick.toml --db q.db --resume\n"
+        "  mpirun -np 9 draglab campaign run paper --db paper.db   (rank 0 + 8 workers)\n"
         "One process at a time runs a campaign (a lock file next to the database guards it).\n"
+        "Under MPI (mpirun, srun) rank 0 alone opens the database and ranks 1..N-1 run the\n"
+        "units; `mpirun --enable-recovery` (srun --no-kill) lets the job go on past a dead rank.\n"
         "When every unit has finished, the dataset is built and its id printed.");
-    cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_campaign_command(ctx, *o); }; });
+    cmd->callback([&ctx, o] {
+      ctx.runs_on_ranks = true;
+      ctx.action = [&ctx, o] { run_campaign_command(ctx, *o); };
+    });
   }
   {
     auto* cmd = campaign->add_subcommand(

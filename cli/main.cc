@@ -15,12 +15,14 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
 #include "drag_db_version.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/mpi/world.h"
 
 namespace draglab {
 namespace cli {
@@ -64,6 +66,15 @@ void CliContext::print_json(const nlohmann::json& j) const { std::cout << j.dump
 
 int main(int argc, char** argv) {
   using draglab::cli::CliContext;
+  namespace mpi = draglab::mpi;
+  // MPI starts only when an MPI launcher (mpirun, srun) started this process.
+  std::unique_ptr<mpi::Session> mpi_session;
+  try {
+    mpi_session = std::make_unique<mpi::Session>(&argc, &argv);
+  } catch (const draglab::Error& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  }
   CliContext ctx;
   CLI::App app{
       "draglab: drag closures for dense gas-solid fluidized beds.\n"
@@ -142,17 +153,30 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  // Ranks other than 0 print only their own failures, with their rank.
+  const std::string who =
+      mpi::size() > 1 && mpi::rank() != 0 ? "rank " + std::to_string(mpi::rank()) + ": " : "";
+  if (mpi::size() > 1 && !ctx.runs_on_ranks) {
+    if (mpi::rank() == 0) {
+      std::cerr << "error: started with " << mpi::size()
+                << " MPI ranks, but only `draglab campaign run` runs across ranks: start this "
+                   "command without mpirun/srun (or with one rank)\n";
+    }
+    return 2;
+  }
   try {
     if (ctx.action) ctx.action();
     return 0;
+  } catch (const mpi::EndedByRank0& e) {
+    return e.exit_code();  // rank 0 printed why
   } catch (const draglab::cli::UsageError& e) {
-    std::cerr << "error: " << e.what() << '\n';
+    std::cerr << "error: " << who << e.what() << '\n';
     return 2;
   } catch (const draglab::Error& e) {
-    std::cerr << "error: " << e.what() << '\n';
+    std::cerr << "error: " << who << e.what() << '\n';
     return e.is_bad_input() ? 2 : 1;
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << '\n';
+    std::cerr << "error: " << who << e.what() << '\n';
     return 1;
   }
 }

@@ -38,6 +38,7 @@ packages=(
   python3-h5py                      # tests: packing files open in h5py
   gnuplot-nox                       # draglab lbm convergence --plot (PNG, no X11)
   python3                           # Python bindings test (Debian's /usr/bin/python3)
+  libopenmpi-dev openmpi-bin        # campaigns across ranks and nodes (mpirun, srun): mpi/
 )
 
 # shellcheck disable=SC2206  # a space-separated list of package names

@@ -7,12 +7,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -23,13 +26,16 @@
 #include "db/sqlite_util.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/mpi/world.h"
+#include "runner_internal.h"
 
 namespace draglab {
 namespace campaign {
-namespace {
+namespace runner {
 
 using db::Statement;
 using db::Transaction;
@@ -80,55 +86,45 @@ void require_campaign_tables(const Database& db) {
   }
 }
 
-/// An exclusive flock on "<db>.campaign-<id>.lock", held while a process runs the campaign. The
-/// kernel releases it when the process dies (SIGKILL included), so a stale lock never blocks a
-/// resume; the file itself stays (removing it would race with a process about to lock it).
-class CampaignLock {
- public:
-  CampaignLock(const std::string& db_path, std::int64_t campaign_id, const std::string& name) {
-    path_ = db_path + ".campaign-" + std::to_string(campaign_id) + ".lock";
-    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd_ < 0) {
-      throw Error(ErrorCode::kDatabase, "cannot create the campaign lock file '" + path_ + "'");
-    }
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      char holder[128] = {0};
-      const ssize_t got = ::pread(fd_, holder, sizeof holder - 1, 0);
-      if (got > 0) holder[got] = 0;
-      std::string who(holder);
-      while (!who.empty() && (who.back() == '\n' || who.back() == ' ')) who.pop_back();
+CampaignLock::CampaignLock(const std::string& db_path, std::int64_t campaign_id,
+                           const std::string& name) {
+  path_ = db_path + ".campaign-" + std::to_string(campaign_id) + ".lock";
+  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    throw Error(ErrorCode::kDatabase, "cannot create the campaign lock file '" + path_ + "'");
+  }
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    if (error != EWOULDBLOCK) {
       ::close(fd_);
-      throw Error(ErrorCode::kDatabase,
-                  "campaign '" + name + "' is being run by another process (" +
-                      (who.empty() ? std::string("lock file ") + path_ : who) +
-                      "); one process at a time runs a campaign: wait for it, or stop it and use "
-                      "--resume");
+      throw Error(ErrorCode::kInvalidArgument,
+                  "cannot lock '" + path_ + "': " + std::strerror(error) +
+                      ": the database's filesystem does not support locks (a network "
+                      "filesystem?); put the database on a local disk of the node that runs "
+                      "the campaign (rank 0 under MPI)");
     }
-    char host[256] = {0};
-    ::gethostname(host, sizeof host - 1);
-    const std::string me = "pid " + std::to_string(::getpid()) + " on " + host + "\n";
-    if (::ftruncate(fd_, 0) == 0) {
-      [[maybe_unused]] const ssize_t w = ::pwrite(fd_, me.data(), me.size(), 0);
-    }
+    char holder[128] = {0};
+    const ssize_t got = ::pread(fd_, holder, sizeof holder - 1, 0);
+    if (got > 0) holder[got] = 0;
+    std::string who(holder);
+    while (!who.empty() && (who.back() == '\n' || who.back() == ' ')) who.pop_back();
+    ::close(fd_);
+    throw Error(ErrorCode::kDatabase,
+                "campaign '" + name + "' is being run by another process (" +
+                    (who.empty() ? std::string("lock file ") + path_ : who) +
+                    "); one process at a time runs a campaign: wait for it, or stop it and use "
+                    "--resume");
   }
-  ~CampaignLock() {
-    if (fd_ >= 0) ::close(fd_);  // releases the flock
+  char host[256] = {0};
+  ::gethostname(host, sizeof host - 1);
+  const std::string me = "pid " + std::to_string(::getpid()) + " on " + host + "\n";
+  if (::ftruncate(fd_, 0) == 0) {
+    [[maybe_unused]] const ssize_t w = ::pwrite(fd_, me.data(), me.size(), 0);
   }
-  CampaignLock(const CampaignLock&) = delete;
-  CampaignLock& operator=(const CampaignLock&) = delete;
-
- private:
-  std::string path_;
-  int fd_ = -1;
-};
-
-/// A unit claimed by a worker.
-struct ClaimedUnit {
-  std::int64_t id = 0;
-  double phi = 0, re_target = 0, resolution = 0;
-  std::int64_t seed = 0;
-  int realization = 0;
-};
+}
+CampaignLock::~CampaignLock() {
+  if (fd_ >= 0) ::close(fd_);  // releases the flock
+}
 
 bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token,
                 ClaimedUnit* unit) {
@@ -154,16 +150,6 @@ bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token
   tx.commit();
   return got;
 }
-
-/// What one unit produced.
-struct UnitOutcome {
-  bool done = false;
-  lbm::RunResult run;
-  std::string diagnosis;
-  std::string packing_hash;
-  double wall_s = 0.0;
-  nlohmann::json result;
-};
 
 UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int threads,
                          std::atomic<double>* fraction) {
@@ -318,21 +304,12 @@ void check_memory(const CampaignSpec& spec, int workers) {
   }
 }
 
-}  // namespace
-
-CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
-                            const RunCampaignOptions& options) {
-  std::string error;
-  if (!spec.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, error);
-  if (options.jobs < 0 || options.jobs > 1024) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "jobs = " + std::to_string(options.jobs) + " is outside [0, 1024] (0 = all cores)");
-  }
-  const int cores = std::max(1u, std::thread::hardware_concurrency());
-  const int jobs = options.jobs == 0 ? cores : options.jobs;
-  check_memory(spec, jobs);
-
-  Database db(db_path);
+OpenedCampaign open_campaign(const std::string& db_path, const CampaignSpec& spec,
+                             const RunCampaignOptions& options, int workers_per_node) {
+  check_memory(spec, workers_per_node);
+  OpenedCampaign c;
+  c.db = std::make_unique<Database>(db_path);
+  Database& db = *c.db;
   require_campaign_tables(db);
   const std::string spec_json = spec.to_json();
   const std::string spec_hash = draglab::sha256_hex(spec_json);
@@ -361,7 +338,8 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
                   "campaign '" + spec.name + "' was just created by another process");
     }
   }
-  const CampaignLock lock(db_path, id, spec.name);
+  c.id = id;
+  c.lock = std::make_unique<CampaignLock>(db_path, id, spec.name);
 
   // Units left 'running' by a process that died (the lock proves it is gone) run again.
   {
@@ -374,38 +352,179 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
   }
 
   // The session's work: pending units and their estimated costs (for the ETA).
-  double session_cost = 0.0;
-  std::int64_t pending = 0, finished_before = 0, total = 0;
-  {
-    Statement s(db.handle(),
-                "SELECT status, phi, re_target, resolution FROM campaign_units "
-                "WHERE campaign_id = ?");
-    s.bind(1, id);
-    while (s.step()) {
-      ++total;
-      if (s.text(0) == "pending") {
-        ++pending;
-        session_cost += internal::unit_cost_estimate(spec, s.real(1), s.real(2), s.real(3));
-      } else {
-        ++finished_before;
-      }
+  Statement s(db.handle(),
+              "SELECT status, phi, re_target, resolution FROM campaign_units "
+              "WHERE campaign_id = ?");
+  s.bind(1, id);
+  while (s.step()) {
+    ++c.total;
+    if (s.text(0) == "pending") {
+      ++c.pending;
+      c.session_cost += internal::unit_cost_estimate(spec, s.real(1), s.real(2), s.real(3));
+    } else {
+      ++c.finished_before;
     }
   }
+  return c;
+}
+
+void release_unit(Database& db, std::int64_t unit_id, const std::string& token) {
+  Transaction tx(db.handle(), Transaction::Kind::kWrite);
+  Statement s(db.handle(),
+              "UPDATE campaign_units SET status = 'pending', claimed_by = NULL, started_at = NULL "
+              "WHERE id = ? AND status = 'running' AND claimed_by = ?");
+  s.bind(1, unit_id).bind(2, token).run();
+  tx.commit();
+}
+
+std::string progress_line(const std::string& name, std::int64_t finished, std::int64_t total,
+                          std::int64_t failed, double fraction, double elapsed_s,
+                          const std::string& event) {
+  const double eta = fraction > 0.005 ? elapsed_s * (1.0 - fraction) / fraction : NAN;
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "campaign %s: %lld/%lld units (%lld failed this run), %.1f %% of the work, "
+                "elapsed %s, eta %s%s",
+                name.c_str(), static_cast<long long>(finished), static_cast<long long>(total),
+                static_cast<long long>(failed), 100.0 * fraction,
+                format_duration(elapsed_s).c_str(), format_duration(eta).c_str(),
+                event.empty() ? "" : ("; " + event).c_str());
+  return buf;
+}
+
+std::string unit_event(const ClaimedUnit& unit, const UnitOutcome& o) {
+  char event[512];
+  std::snprintf(event, sizeof event, "phi = %g, Re = %g, d = %g, realization %d: %s", unit.phi,
+                unit.re_target, unit.resolution, unit.realization,
+                o.done ? "done" : ("FAILED: " + o.diagnosis).c_str());
+  return event;
+}
+
+int cores() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+SessionReport session_report(const std::string& mode, double wall_s, int threads_per_unit,
+                             std::vector<WorkerReport> workers) {
+  SessionReport r;
+  r.mode = mode;
+  r.wall_s = wall_s;
+  r.threads_per_unit = threads_per_unit;
+  double busy = 0.0;
+  for (const WorkerReport& w : workers) busy += w.busy_s;
+  r.workers = std::move(workers);
+  if (wall_s > 0 && !r.workers.empty()) {
+    r.parallel_efficiency = std::min(1.0, busy / (wall_s * static_cast<double>(r.workers.size())));
+  }
+  return r;
+}
+
+nlohmann::json unit_to_json(const ClaimedUnit& unit) {
+  return {{"id", unit.id},
+          {"phi", unit.phi},
+          {"re_target", unit.re_target},
+          {"resolution", unit.resolution},
+          {"seed", unit.seed},
+          {"realization", unit.realization}};
+}
+
+ClaimedUnit unit_from_json(const nlohmann::json& j) {
+  ClaimedUnit u;
+  u.id = j.at("id").get<std::int64_t>();
+  u.phi = j.at("phi").get<double>();
+  u.re_target = j.at("re_target").get<double>();
+  u.resolution = j.at("resolution").get<double>();
+  u.seed = j.at("seed").get<std::int64_t>();
+  u.realization = j.at("realization").get<int>();
+  return u;
+}
+
+namespace {
+nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+double number_from(const nlohmann::json& j, const char* key) {
+  const auto it = j.find(key);
+  return (it == j.end() || it->is_null()) ? NAN : it->get<double>();
+}
+}  // namespace
+
+nlohmann::json outcome_to_json(const UnitOutcome& o) {
+  return {{"done", o.done},
+          {"diagnosis", o.diagnosis},
+          {"packing_hash", o.packing_hash},
+          {"wall_s", o.wall_s},
+          {"result", o.result},
+          {"F", number(o.run.F)},
+          {"beta_d2_over_mu", number(o.run.beta_d2_over_mu)},
+          {"re", number(o.run.re)},
+          {"error_estimate", number(o.run.error_estimate)},
+          {"steps", o.run.steps},
+          {"mflups", number(o.run.mflups)}};
+}
+
+UnitOutcome outcome_from_json(const nlohmann::json& j) {
+  UnitOutcome o;
+  o.done = j.at("done").get<bool>();
+  o.diagnosis = j.at("diagnosis").get<std::string>();
+  o.packing_hash = j.at("packing_hash").get<std::string>();
+  o.wall_s = j.at("wall_s").get<double>();
+  o.result = j.at("result");
+  o.run.F = number_from(j, "F");
+  o.run.beta_d2_over_mu = number_from(j, "beta_d2_over_mu");
+  o.run.re = number_from(j, "re");
+  o.run.error_estimate = number_from(j, "error_estimate");
+  o.run.steps = j.at("steps").get<std::int64_t>();
+  o.run.mflups = number_from(j, "mflups");
+  return o;
+}
+
+}  // namespace runner
+
+using db::Statement;
+using runner::format_duration;
+using runner::require_campaign_tables;
+
+CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
+                            const RunCampaignOptions& options) {
+  using namespace runner;
+  std::string error;
+  if (!spec.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, error);
+  if (options.jobs < 0 || options.jobs > 1024) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "jobs = " + std::to_string(options.jobs) + " is outside [0, 1024] (0 = all cores)");
+  }
+  if (options.threads_per_unit < 0 || options.threads_per_unit > 1024) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "threads per unit = " + std::to_string(options.threads_per_unit) +
+                    " is outside [0, 1024] (0 = cores / jobs)");
+  }
+  if (!(options.worker_timeout_s >= 1.0 && options.worker_timeout_s <= 86400.0)) {
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        "worker timeout = " + core::format_number(options.worker_timeout_s) + " s is outside [1, 86400]");
+  }
+  if (mpi::size() > 1) return run_campaign_distributed(db_path, spec, options);
+
+  const int jobs = options.jobs == 0 ? cores() : options.jobs;
+  OpenedCampaign opened = open_campaign(db_path, spec, options, jobs);
+  const std::int64_t id = opened.id;
+  const double session_cost = opened.session_cost;
+  const std::int64_t pending = opened.pending, finished_before = opened.finished_before,
+                     total = opened.total;
   const int workers = static_cast<int>(
       std::max<std::int64_t>(1, std::min<std::int64_t>(jobs, std::max<std::int64_t>(pending, 1))));
-  const int threads = std::max(1, cores / workers);
+  const int threads =
+      options.threads_per_unit > 0 ? options.threads_per_unit : std::max(1, cores() / workers);
 
   std::mutex mutex;  // guards the counters below, the progress callback and first_error
   std::int64_t finished = finished_before, failed_session = 0;
   double cost_done = 0.0;
   std::vector<std::atomic<double>> fractions(workers);
   std::vector<double> in_flight_cost(workers, 0.0);
+  std::vector<double> busy_s(workers, 0.0);
+  std::vector<int> units_run(workers, 0);
   for (auto& f : fractions) f.store(0.0);
   std::exception_ptr first_error;
   std::atomic<bool> stop{false};
   const auto start = Clock::now();
-  char host[256] = {0};
-  ::gethostname(host, sizeof host - 1);
+  const std::string host = mpi::host_name();
 
   auto report = [&](const std::string& event) {
     // Caller holds `mutex`.
@@ -414,23 +533,15 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
     for (int w = 0; w < workers; ++w) partial += in_flight_cost[w] * fractions[w].load();
     const double fraction = session_cost > 0 ? std::min(1.0, partial / session_cost) : 1.0;
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    const double eta = fraction > 0.005 ? elapsed * (1.0 - fraction) / fraction : NAN;
-    char buf[320];
-    std::snprintf(buf, sizeof buf,
-                  "campaign %s: %lld/%lld units (%lld failed this run), %.1f %% of the work, "
-                  "elapsed %s, eta %s%s",
-                  spec.name.c_str(), static_cast<long long>(finished),
-                  static_cast<long long>(total), static_cast<long long>(failed_session),
-                  100.0 * fraction, format_duration(elapsed).c_str(), format_duration(eta).c_str(),
-                  event.empty() ? "" : ("; " + event).c_str());
-    options.progress(finished, total, buf);
+    options.progress(
+        finished, total,
+        progress_line(spec.name, finished, total, failed_session, fraction, elapsed, event));
   };
 
   auto worker = [&](int w) {
     try {
       Database wdb(db_path, worker_db_options());
-      const std::string token =
-          std::string(host) + ":" + std::to_string(::getpid()) + ":" + std::to_string(w);
+      const std::string token = host + ":" + std::to_string(::getpid()) + ":" + std::to_string(w);
       ClaimedUnit unit;
       while (!stop.load() && claim_next(wdb, id, token, &unit)) {
         {
@@ -446,14 +557,12 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
         std::lock_guard<std::mutex> g(mutex);
         cost_done += in_flight_cost[w];
         in_flight_cost[w] = 0.0;
+        busy_s[w] += o.wall_s;
+        ++units_run[w];
         if (!ours) continue;
         ++finished;
         if (!o.done) ++failed_session;
-        char event[512];
-        std::snprintf(event, sizeof event, "phi = %g, Re = %g, d = %g, realization %d: %s",
-                      unit.phi, unit.re_target, unit.resolution, unit.realization,
-                      o.done ? "done" : ("FAILED: " + o.diagnosis).c_str());
-        report(event);
+        report(unit_event(unit, o));
       }
     } catch (...) {
       std::lock_guard<std::mutex> g(mutex);
@@ -481,7 +590,52 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
   all_done.store(true);
   ticker.join();
   if (first_error) std::rethrow_exception(first_error);
-  return campaign_status(db, std::to_string(id));
+  CampaignStatus status = campaign_status(*opened.db, std::to_string(id));
+  status.session = session_report(
+      "threads", std::chrono::duration<double>(Clock::now() - start).count(), threads, [&] {
+        std::vector<WorkerReport> r;
+        for (int w = 0; w < workers; ++w) {
+          r.push_back({"worker " + std::to_string(w), host, units_run[w], busy_s[w]});
+        }
+        return r;
+      }());
+  return status;
+}
+
+std::string SessionReport::FullReport() const {
+  if (mode.empty()) return "";
+  std::ostringstream s;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-10s %-20s %6s %12s %7s\n", "worker", "host", "units", "busy",
+                "busy %");
+  s << line;
+  for (const WorkerReport& w : workers) {
+    std::snprintf(line, sizeof line, "%-10s %-20s %6d %12s %6.1f%%\n", w.name.c_str(),
+                  w.host.c_str(), w.units, runner::format_duration(w.busy_s).c_str(),
+                  wall_s > 0 ? 100.0 * w.busy_s / wall_s : 0.0);
+    s << line;
+  }
+  std::snprintf(
+      line, sizeof line, "parallel efficiency %.1f %% (%zu %s x %s, %d thread%s per unit)\n",
+      100.0 * parallel_efficiency, workers.size(), mode == "mpi" ? "ranks" : "workers",
+      runner::format_duration(wall_s).c_str(), threads_per_unit, threads_per_unit == 1 ? "" : "s");
+  s << line;
+  for (const std::string& n : notes) s << "note: " << n << "\n";
+  return s.str();
+}
+
+std::string SessionReport::ToJson() const {
+  nlohmann::json j = {{"mode", mode},
+                      {"wall_s", wall_s},
+                      {"threads_per_unit", threads_per_unit},
+                      {"parallel_efficiency", parallel_efficiency},
+                      {"notes", notes},
+                      {"workers", nlohmann::json::array()}};
+  for (const WorkerReport& w : workers) {
+    j["workers"].push_back(
+        {{"name", w.name}, {"host", w.host}, {"units", w.units}, {"busy_s", w.busy_s}});
+  }
+  return j.dump();
 }
 
 std::string CampaignStatus::BriefReport() const {

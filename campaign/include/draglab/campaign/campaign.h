@@ -80,6 +80,29 @@ struct UnitRecord {
   std::string finished_at;
 };
 
+/// What one worker of a run did: a thread of the single-process runner, or an MPI rank.
+struct WorkerReport {
+  std::string name;     ///< "worker 0" (a thread) or "rank 3".
+  std::string host;     ///< The node it ran on.
+  int units = 0;        ///< Units it ran (failed ones included).
+  double busy_s = 0.0;  ///< Sum of its units' run times.
+};
+
+/// The run that just ended (left empty by status queries).
+struct SessionReport {
+  std::string mode;          ///< "threads" (one process) or "mpi" (ranks); "" if no run.
+  double wall_s = 0.0;       ///< Wall time of the run, from the first claim to the last commit.
+  int threads_per_unit = 0;  ///< OpenMP threads of each unit's LBM run.
+  std::vector<WorkerReport> workers;
+  /// Busy time over (workers x wall time): the share of the workers' time spent in units. Low
+  /// when a long unit leaves the others idle at the end, or when a rank waited on rank 0.
+  double parallel_efficiency = 0.0;
+  std::vector<std::string> notes;  ///< E.g. ranks presumed dead and the units handed on.
+  /// A table: per worker its units and busy time, then the efficiency and the notes.
+  std::string FullReport() const;
+  std::string ToJson() const;  ///< The same as a JSON object.
+};
+
 struct CampaignStatus {
   std::int64_t id = 0;
   std::string name;
@@ -87,20 +110,33 @@ struct CampaignStatus {
   std::string created_at;
   std::int64_t units_total = 0, units_done = 0, units_failed = 0, units_pending = 0,
                units_running = 0;
-  double wall_s = 0.0;  ///< Sum of the finished units' run times.
+  double wall_s = 0.0;    ///< Sum of the finished units' run times.
+  SessionReport session;  ///< Filled by run_campaign for the run it made.
   std::string BriefReport() const;
   std::string FullReport() const;
 };
 
 struct RunCampaignOptions {
-  int jobs = 0;         ///< Parallel units; 0 = number of cores.
+  int jobs = 0;         ///< Parallel units of one process; 0 = number of cores. Unused under MPI.
   bool resume = false;  ///< Continue the campaign of the same name (same spec hash required).
+  /// OpenMP threads of each unit's LBM run, [0, 1024]; 0 = the cores of the node shared among the
+  /// workers on it. The thread count changes the rounding of the engine's sums: runs that must
+  /// agree bit for bit (the same dataset id) use the same value.
+  int threads_per_unit = 0;
+  /// MPI: a worker rank silent this long (no heartbeat) is presumed dead, and its unit goes back
+  /// to the queue for another rank; [1, 86400] s.
+  double worker_timeout_s = 30.0;
   /// Progress: units finished (done + failed), total, and a status line (ETA included).
   std::function<void(std::int64_t finished, std::int64_t total, const std::string& line)> progress;
 };
 
 /// Creates the campaign (or, with resume, finds it; resume also creates a missing one) and runs
-/// its pending units; units left 'running' by a dead process run again. One process at a time
+/// its pending units; units left 'running' by a dead process run again. Started by an MPI
+/// launcher with several ranks (draglab/mpi/world.h), rank 0 alone opens the database, claims
+/// units, hands them to ranks 1..N-1 (most expensive first) and commits each result in its own
+/// transaction, exactly as one process does; a rank silent for worker_timeout_s is presumed dead
+/// and its unit handed to another. Every rank must call it; ranks other than 0 return an empty
+/// status (their work is in rank 0's session report). One process at a time
 /// runs a campaign: it holds an exclusive flock on "<db_path>.campaign-<id>.lock" (released by
 /// the kernel when the process dies). Returns the final status. Errors: Error(kInvalidArgument)
 /// for a spec that fails IsValid, jobs outside [0, 1024], units too large for the memory, a new

@@ -1,0 +1,381 @@
+// The campaign runner across MPI ranks. Rank 0 is the single-process runner's database side:
+// it alone opens the database (SQLite must never be written by many nodes over a network
+// filesystem), claims units most expensive first with the same UPDATE ... RETURNING, and commits
+// every result in its own transaction with the same guarded UPDATE. Ranks 1..N-1 only compute:
+// they receive a unit, generate its packing, run the LBM engine (OpenMP threads within the rank)
+// and send the outcome back.
+//
+// Kill-safety is the database's, as for one process: a unit is 'running' under its rank's token
+// until its result is committed. A worker sends a heartbeat every second; one silent for
+// worker_timeout_s is presumed dead, its unit is released to the queue and handed to another
+// rank, and a late result from it is refused by the token check. When rank 0 dies, the workers
+// notice its silence and end; `--resume` on any number of ranks finishes the campaign.
+//
+// Messages (tags below) are JSON text.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "campaign_internal.h"
+#include "draglab/campaign/campaign.h"
+#include "draglab/core/text.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/mpi/world.h"
+#include "runner_internal.h"
+
+namespace draglab {
+namespace campaign {
+namespace runner {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+enum Tag : int {
+  kReady = 1,      // worker -> 0: give me a unit (sent once at the start)
+  kUnit = 2,       // 0 -> worker: a unit to run
+  kResult = 3,     // worker -> 0: the outcome of its unit (and ready for the next)
+  kHeartbeat = 4,  // worker -> 0: alive, with the fraction of its unit done
+  kStop = 5,       // 0 -> worker: no more work
+  kPing = 6,       // 0 -> idle worker: rank 0 is alive
+};
+
+// How long a send may take before the peer is taken for gone, and how often rank 0 shows an idle
+// worker it is alive. A worker that hears nothing from rank 0 for kRank0SilenceSeconds while idle
+// ends (rank 0 is gone; the campaign resumes with --resume).
+constexpr double kSendSeconds = 60.0;
+constexpr double kHeartbeatSeconds = 1.0;
+constexpr double kPingSeconds = 5.0;
+constexpr double kRank0SilenceSeconds = 120.0;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+/// Threads of a unit on a worker rank: the node's cores shared among the workers on it.
+int worker_threads(const RunCampaignOptions& options) {
+  if (options.threads_per_unit > 0) return options.threads_per_unit;
+  const int workers_here = std::max(1, mpi::local_size() - (mpi::rank0_is_local() ? 1 : 0));
+  return std::max(1, cores() / workers_here);
+}
+
+// ---- rank 0 -------------------------------------------------------------------------------
+
+struct WorkerState {
+  bool alive = true;      ///< Not presumed dead.
+  bool reachable = true;  ///< No send to it has failed.
+  bool heartbeat = true;  ///< It sends heartbeats (until its ready message says otherwise).
+  bool idle = false;      ///< Waiting for a unit.
+  bool has_unit = false;
+  ClaimedUnit unit;
+  double unit_cost = 0.0;
+  double fraction = 0.0;
+  Clock::time_point last_heard = Clock::now();
+  Clock::time_point last_ping = Clock::now();
+  WorkerReport report;
+  std::string token;
+};
+
+CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
+                         const RunCampaignOptions& options) {
+  const int ranks = mpi::size();
+  std::string go;
+  OpenedCampaign opened;
+  try {
+    // Rank 0's node runs rank 0 plus its workers; other nodes check their own memory.
+    opened = open_campaign(db_path, spec, options, std::max(1, mpi::local_size() - 1));
+    go = nlohmann::json{{"ok", true}, {"spec", spec.to_json()}}.dump();
+  } catch (const Error& e) {
+    go = nlohmann::json{{"ok", false}, {"exit_code", e.is_bad_input() ? 2 : 1}}.dump();
+    mpi::broadcast(&go);
+    throw;
+  } catch (const std::exception&) {
+    go = nlohmann::json{{"ok", false}, {"exit_code", 1}}.dump();
+    mpi::broadcast(&go);
+    throw;
+  }
+  mpi::broadcast(&go);
+
+  Database& db = *opened.db;
+  const std::string base_token = mpi::host_name() + ":" + std::to_string(::getpid()) + ":rank";
+  std::map<int, WorkerState> workers;
+  for (int r = 1; r < ranks; ++r) {
+    workers[r].token = base_token + std::to_string(r);
+    workers[r].report.name = "rank " + std::to_string(r);
+  }
+  std::int64_t finished = opened.finished_before, failed_session = 0;
+  std::int64_t in_flight = 0;
+  double cost_done = 0.0;
+  bool queue_empty = false;  // no pending unit was found at the last claim
+  std::vector<std::string> notes;
+  const auto start = Clock::now();
+  auto last_line = Clock::now() - std::chrono::seconds(10);
+
+  auto report = [&](const std::string& event) {
+    if (!options.progress) return;
+    if (event.empty() && seconds_since(last_line) < 0.5) return;
+    last_line = Clock::now();
+    double partial = cost_done;
+    for (const auto& [r, w] : workers) {
+      if (w.has_unit) partial += w.unit_cost * w.fraction;
+    }
+    const double fraction =
+        opened.session_cost > 0 ? std::min(1.0, partial / opened.session_cost) : 1.0;
+    options.progress(finished, opened.total,
+                     progress_line(spec.name, finished, opened.total, failed_session, fraction,
+                                   seconds_since(start), event));
+  };
+
+  // A rank presumed dead may only be slow: it is told to stop too, with a short wait.
+  auto stop_all = [&] {
+    const bool lost = std::any_of(workers.begin(), workers.end(),
+                                  [](const auto& e) { return !e.second.alive; });
+    if (lost) mpi::mark_peer_lost();
+    const std::string stop = nlohmann::json{{"peer_lost", lost}}.dump();
+    for (auto& [r, w] : workers) {
+      if (w.reachable) mpi::send(r, kStop, stop, w.alive ? kSendSeconds : 2.0);
+      w.alive = false;
+    }
+  };
+
+  // Hands a unit to an idle worker; false when the queue is empty.
+  auto hand_out = [&](int r, WorkerState& w) {
+    ClaimedUnit unit;
+    if (!claim_next(db, opened.id, w.token, &unit)) {
+      queue_empty = true;
+      return false;
+    }
+    if (!mpi::send(r, kUnit, unit_to_json(unit).dump(), kSendSeconds)) {
+      release_unit(db, unit.id, w.token);
+      w.alive = w.reachable = false;
+      notes.push_back(w.report.name + " did not take a unit: presumed dead");
+      return true;
+    }
+    w.idle = false;
+    w.has_unit = true;
+    w.unit = unit;
+    w.unit_cost = internal::unit_cost_estimate(spec, unit.phi, unit.re_target, unit.resolution);
+    w.fraction = 0.0;
+    w.last_heard = Clock::now();
+    ++in_flight;
+    return true;
+  };
+
+  try {
+    report("");
+    for (;;) {
+      const bool any_alive =
+          std::any_of(workers.begin(), workers.end(), [](const auto& e) { return e.second.alive; });
+      if (!any_alive) break;
+      if (queue_empty && in_flight == 0) break;
+
+      mpi::Message m;
+      if (mpi::receive(&m, 0.25)) {
+        auto it = workers.find(m.source);
+        if (it != workers.end() && it->second.alive) {
+          WorkerState& w = it->second;
+          w.last_heard = Clock::now();
+          if (m.tag == kHeartbeat) {
+            const auto j = nlohmann::json::parse(m.text, nullptr, false);
+            if (w.has_unit && j.is_object() && j.value("unit", std::int64_t{-1}) == w.unit.id) {
+              w.fraction = std::clamp(j.value("fraction", 0.0), 0.0, 1.0);
+            }
+            if (w.report.host.empty() && j.is_object()) w.report.host = j.value("host", "");
+          } else if (m.tag == kReady) {
+            const auto j = nlohmann::json::parse(m.text, nullptr, false);
+            w.idle = true;
+            if (j.is_object()) {
+              w.report.host = j.value("host", "");
+              w.heartbeat = j.value("heartbeat", false);
+            }
+            if (!w.heartbeat) {
+              notes.push_back(w.report.name +
+                              " sends no heartbeat (MPI without MPI_THREAD_MULTIPLE): its death "
+                              "is not detected");
+            }
+          } else if (m.tag == kResult && w.has_unit) {
+            const UnitOutcome o = outcome_from_json(nlohmann::json::parse(m.text));
+            const bool ours = commit_unit(db, w.unit, w.token, o);
+            w.has_unit = false;
+            w.idle = true;
+            --in_flight;
+            cost_done += w.unit_cost;
+            ++w.report.units;
+            w.report.busy_s += o.wall_s;
+            if (ours) {
+              ++finished;
+              if (!o.done) ++failed_session;
+              report(unit_event(w.unit, o) + " (" + w.report.name + ")");
+            }
+          }
+        }
+      }
+
+      // Presume silent workers dead; their units go back to the queue.
+      for (auto& [r, w] : workers) {
+        if (!w.alive || !w.heartbeat) continue;
+        if (seconds_since(w.last_heard) <= options.worker_timeout_s) continue;
+        w.alive = false;
+        std::string note = w.report.name + " silent for " +
+                           core::format_number(options.worker_timeout_s) + " s: presumed dead";
+        if (w.has_unit) {
+          release_unit(db, w.unit.id, w.token);
+          w.has_unit = false;
+          --in_flight;
+          queue_empty = false;
+          note += "; its unit (phi = " + core::format_number(w.unit.phi) +
+                  ", Re = " + core::format_number(w.unit.re_target) +
+                  ", d = " + core::format_number(w.unit.resolution) + ") goes to another rank";
+        }
+        notes.push_back(note);
+        report(note);
+      }
+
+      // Idle workers get the next units, or a ping while others finish theirs.
+      for (auto& [r, w] : workers) {
+        if (!w.alive || !w.idle) continue;
+        if (!queue_empty && hand_out(r, w)) continue;
+        if (seconds_since(w.last_ping) > kPingSeconds) {
+          w.last_ping = Clock::now();
+          if (!mpi::send(r, kPing, "", kSendSeconds)) w.alive = w.reachable = false;
+        }
+      }
+      report("");
+    }
+    stop_all();
+  } catch (...) {
+    stop_all();
+    throw;
+  }
+
+  CampaignStatus status = campaign_status(db, std::to_string(opened.id));
+  std::vector<WorkerReport> reports;
+  for (const auto& [r, w] : workers) reports.push_back(w.report);
+  status.session =
+      session_report("mpi", seconds_since(start), worker_threads(options), std::move(reports));
+  status.session.notes = notes;
+  if (status.units_pending + status.units_running > 0) {
+    status.session.notes.push_back(
+        "every worker rank is gone with units left: continue with --resume");
+  }
+  return status;
+}
+
+// ---- ranks 1..N-1 ---------------------------------------------------------------------------
+
+/// Sends a heartbeat every kHeartbeatSeconds from its own thread, also while the rank computes.
+/// Needs MPI_THREAD_MULTIPLE; without it the rank sends none and rank 0 cannot tell it from a
+/// dead one (it waits for its result, as a single-process run waits for a unit).
+class Heartbeat {
+ public:
+  Heartbeat(std::atomic<double>* fraction, std::atomic<std::int64_t>* unit)
+      : fraction_(fraction), unit_(unit), host_(mpi::host_name()) {
+    if (!mpi::threads_multiple()) return;
+    thread_ = std::thread([this] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      while (!done_) {
+        cv_.wait_for(lock, std::chrono::duration<double>(kHeartbeatSeconds));
+        if (done_) break;
+        beat();
+      }
+    });
+  }
+  ~Heartbeat() {
+    {
+      std::lock_guard<std::mutex> g(mutex_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  Heartbeat(const Heartbeat&) = delete;
+  Heartbeat& operator=(const Heartbeat&) = delete;
+
+  bool beating() const { return thread_.joinable(); }
+
+ private:
+  void beat() {
+    mpi::send(
+        0, kHeartbeat,
+        nlohmann::json{{"unit", unit_->load()}, {"fraction", fraction_->load()}, {"host", host_}}
+            .dump(),
+        kSendSeconds);
+  }
+  std::atomic<double>* fraction_;
+  std::atomic<std::int64_t>* unit_;
+  std::string host_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+CampaignStatus run_worker(const RunCampaignOptions& options) {
+  std::string go;
+  mpi::broadcast(&go);
+  const nlohmann::json g = nlohmann::json::parse(go);
+  if (!g.at("ok").get<bool>()) throw mpi::EndedByRank0(g.at("exit_code").get<int>());
+  // The spec as rank 0 read it: the workers need no copy of the spec file.
+  const CampaignSpec spec = internal::spec_from_json(g.at("spec").get<std::string>());
+  const int threads = worker_threads(options);
+
+  std::atomic<double> fraction{0.0};
+  std::atomic<std::int64_t> current{-1};
+  Heartbeat heartbeat(&fraction, &current);
+  const std::string ready =
+      nlohmann::json{{"host", mpi::host_name()}, {"heartbeat", heartbeat.beating()}}.dump();
+  if (!mpi::send(0, kReady, ready, kSendSeconds)) {
+    throw Error(ErrorCode::kIo, "rank " + std::to_string(mpi::rank()) + ": rank 0 is gone");
+  }
+  auto heard = Clock::now();
+  for (;;) {
+    mpi::Message m;
+    if (!mpi::receive(&m, 1.0, 0)) {
+      if (seconds_since(heard) > kRank0SilenceSeconds) {
+        throw Error(ErrorCode::kIo, "rank " + std::to_string(mpi::rank()) +
+                                        ": rank 0 sent nothing for " +
+                                        core::format_number(kRank0SilenceSeconds) +
+                                        " s and is presumed dead; continue with --resume");
+      }
+      continue;
+    }
+    heard = Clock::now();
+    if (m.tag == kStop) {
+      const auto j = nlohmann::json::parse(m.text, nullptr, false);
+      if (j.is_object() && j.value("peer_lost", false)) mpi::mark_peer_lost();
+      break;
+    }
+    if (m.tag != kUnit) continue;  // a ping
+    const ClaimedUnit unit = unit_from_json(nlohmann::json::parse(m.text));
+    fraction.store(0.0);
+    current.store(unit.id);
+    const UnitOutcome o = execute_unit(spec, unit, threads, &fraction);
+    current.store(-1);
+    if (!mpi::send(0, kResult, outcome_to_json(o).dump(), kSendSeconds)) {
+      throw Error(ErrorCode::kIo, "rank " + std::to_string(mpi::rank()) +
+                                      ": rank 0 did not take a result; continue with --resume");
+    }
+    heard = Clock::now();
+  }
+  return CampaignStatus{};
+}
+
+}  // namespace
+
+CampaignStatus run_campaign_distributed(const std::string& db_path, const CampaignSpec& spec,
+                                        const RunCampaignOptions& options) {
+  return mpi::rank() == 0 ? run_rank0(db_path, spec, options) : run_worker(options);
+}
+
+}  // namespace runner
+}  // namespace campaign
+}  // namespace draglab

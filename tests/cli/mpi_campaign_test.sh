@@ -1,0 +1,141 @@
+#!/usr/bin/env bash
+# Campaigns across MPI ranks (mpirun on loopback, oversubscribed), against the single-process
+# runner as the reference:
+#   1. the same campaign on 1 process and on 3 ranks (rank 0 + 2 workers), one thread per unit
+#      in both, gives the same dataset id (the same F for every unit, bit for bit);
+#   2. a worker rank killed (SIGKILL) while it runs a unit, under `mpirun --enable-recovery`:
+#      rank 0 presumes it dead after --worker-timeout, hands its unit to the other worker, and
+#      the campaign completes with the reference dataset id, each unit once, `db check` clean;
+#   3. the whole job killed (SIGKILL to mpirun and every rank) with units in flight, then
+#      `--resume` on 3 ranks: complete, the reference dataset id, no duplicate, `db check` clean;
+#   4. bad input: another command under several ranks, exit 2 with a message, nothing written.
+# Usage: mpi_campaign_test.sh DRAGLAB SPEC MPIRUN
+set -u
+draglab="$(realpath "$1")"
+spec_src="$(realpath "$2")"
+mpirun="$3"
+work="$(mktemp -d)"
+pids_to_kill=()
+cleanup() {
+  for p in "${pids_to_kill[@]}"; do kill -9 -- "-$p" 2>/dev/null; done
+  rm -rf "$work"
+}
+trap cleanup EXIT
+cd "$work" || exit 1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # CI machines run as root
+export OMPI_MCA_rmaps_base_oversubscribe=1
+fail=0
+check() {  # check DESCRIPTION COMMAND...
+  if "${@:2}"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi
+}
+dataset_id() {  # dataset_id OUTPUT_FILE: the id printed by campaign run
+  sed -n 's/^dataset *\([0-9a-f]*\) .*/\1/p' "$1" | head -1
+}
+pids_of() {  # pids_of TEXT: processes whose command line contains TEXT (no procps needed)
+  local f p
+  for f in /proc/[0-9]*/cmdline; do
+    p="${f#/proc/}"
+    p="${p%/cmdline}"
+    [ "$p" = "$$" ] && continue
+    tr '\0' ' ' <"$f" 2>/dev/null | grep -qF -- "$1" && echo "$p"
+  done
+}
+units() {  # units DB STATUS
+  sqlite3 "$1" "SELECT count(*) FROM campaign_units WHERE status = '$2'"
+}
+# Units of a few seconds on one thread, so that a kill lands inside one.
+sed 's/^resolutions = .*/resolutions = [12]/' "$spec_src" >spec.toml
+
+# --- 1. one process and three ranks ------------------------------------------------------------
+"$draglab" --db one.db campaign run spec.toml --jobs 1 --threads-per-unit 1 >one.out 2>one.err ||
+  { echo "FAIL: the single-process reference run"; cat one.err; exit 1; }
+ref="$(dataset_id one.out)"
+[ -n "$ref" ] || { echo "FAIL: no dataset id from the reference run"; cat one.out; exit 1; }
+units_total="$(sqlite3 one.db 'SELECT count(*) FROM campaign_units')"
+"$mpirun" -np 3 "$draglab" --db three.db campaign run spec.toml --threads-per-unit 1 \
+  >three.out 2>three.err
+rc=$?
+check "3 ranks: exit 0 (got $rc)" test "$rc" -eq 0
+check "3 ranks: the reference dataset id $ref (got $(dataset_id three.out))" \
+  test "$(dataset_id three.out)" = "$ref"
+check "3 ranks: both workers ran units" \
+  test "$(grep -cE '^rank [12] .* [1-9][0-9]* ' three.out)" -eq 2
+check "3 ranks: the session reports the parallel efficiency" grep -q "parallel efficiency" three.out
+
+# --- 2. a worker killed mid-unit ---------------------------------------------------------------
+setsid "$mpirun" --enable-recovery -np 3 "$draglab" --db kill.db campaign run spec.toml \
+  --threads-per-unit 1 --worker-timeout 5 >kill.out 2>kill.err &
+job=$!
+pids_to_kill+=("$job")
+victim=""
+for _ in $(seq 1 600); do
+  # rank 2 holding a unit: its token ends in rank2
+  running=$(sqlite3 kill.db "SELECT count(*) FROM campaign_units WHERE status = 'running' AND \
+claimed_by LIKE '%:rank2'" 2>/dev/null || echo 0)
+  if [ "${running:-0}" -ge 1 ]; then
+    for p in $(pids_of "draglab --db kill.db"); do
+      if tr '\0' '\n' <"/proc/$p/environ" 2>/dev/null | grep -qx 'OMPI_COMM_WORLD_RANK=2'; then
+        victim=$p
+      fi
+    done
+    [ -n "$victim" ] && break
+  fi
+  sleep 0.1
+done
+check "a unit of rank 2 was caught running" test -n "$victim"
+[ -n "$victim" ] && kill -9 "$victim"
+wait "$job"
+rc=$?
+check "worker killed: the job ends with exit 0 (got $rc)" test "$rc" -eq 0
+check "worker killed: every unit done" test "$(units kill.db done)" -eq "$units_total"
+check "worker killed: the dead rank is reported" grep -q "rank 2 silent .* presumed dead" kill.out
+check "worker killed: the reference dataset id" test "$(dataset_id kill.out)" = "$ref"
+check "worker killed: db check clean" "$draglab" --db kill.db db check
+if [ "$rc" -ne 0 ]; then tail -5 kill.err; fi
+
+# --- 3. the whole job killed, then resumed -------------------------------------------------------
+setsid "$mpirun" -np 3 "$draglab" --db whole.db campaign run spec.toml --threads-per-unit 1 \
+  >whole1.out 2>whole1.err &
+job=$!
+pids_to_kill+=("$job")
+caught=0
+for _ in $(seq 1 600); do
+  done_now=$(units whole.db done 2>/dev/null || echo 0)
+  running=$(units whole.db running 2>/dev/null || echo 0)
+  if [ "${done_now:-0}" -ge 1 ] && [ "${running:-0}" -ge 1 ]; then
+    caught=1
+    break
+  fi
+  sleep 0.1
+done
+check "the whole job was caught with units done and in flight" test "$caught" -eq 1
+# mpirun puts each rank in a process group of its own: every process of the job is killed by
+# name, at once, as a batch system ends a job (mpirun's command line names the database too).
+kill -9 $(pids_of "draglab --db whole.db") 2>/dev/null
+wait "$job" 2>/dev/null
+for _ in $(seq 1 50); do
+  [ -z "$(pids_of 'draglab --db whole.db')" ] && break
+  sleep 0.1
+done
+check "the whole job is gone" test -z "$(pids_of 'draglab --db whole.db')"
+check "units were left running by the kill" test "$(units whole.db running)" -ge 1
+"$mpirun" -np 3 "$draglab" --db whole.db campaign run spec.toml --threads-per-unit 1 --resume \
+  >whole2.out 2>whole2.err
+rc=$?
+check "resume on 3 ranks: exit 0 (got $rc)" test "$rc" -eq 0
+check "resume: every unit done" test "$(units whole.db done)" -eq "$units_total"
+check "resume: no duplicate unit" test "$(sqlite3 whole.db 'SELECT count(*) FROM campaign_units')" \
+  -eq "$units_total"
+check "resume: the reference dataset id" test "$(dataset_id whole2.out)" = "$ref"
+check "resume: db check clean" "$draglab" --db whole.db db check
+if [ "$rc" -ne 0 ]; then tail -5 whole2.err; fi
+
+# --- 4. bad input under several ranks -------------------------------------------------------------
+"$mpirun" -np 2 "$draglab" --db other.db law list >other.out 2>other.err
+rc=$?
+check "law list on 2 ranks: exit 2 (got $rc)" test "$rc" -eq 2
+check "law list on 2 ranks: says only campaign run runs across ranks" \
+  grep -q "only .draglab campaign run. runs across ranks" other.err
+check "law list on 2 ranks: no database written" test ! -e other.db
+
+exit "$fail"
