@@ -137,8 +137,8 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
 
   // A rank presumed dead may only be slow: it is told to stop too, with a short wait.
   auto stop_all = [&] {
-    const bool lost = std::any_of(workers.begin(), workers.end(),
-                                  [](const auto& e) { return !e.second.alive; });
+    const bool lost =
+        std::any_of(workers.begin(), workers.end(), [](const auto& e) { return !e.second.alive; });
     if (lost) mpi::mark_peer_lost();
     const std::string stop = nlohmann::json{{"peer_lost", lost}}.dump();
     for (auto& [r, w] : workers) {

@@ -496,9 +496,9 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
                     " is outside [0, 1024] (0 = cores / jobs)");
   }
   if (!(options.worker_timeout_s >= 1.0 && options.worker_timeout_s <= 86400.0)) {
-    throw Error(
-        ErrorCode::kInvalidArgument,
-        "worker timeout = " + core::format_number(options.worker_timeout_s) + " s is outside [1, 86400]");
+    throw Error(ErrorCode::kInvalidArgument,
+                "worker timeout = " + core::format_number(options.worker_timeout_s) +
+                    " s is outside [1, 86400]");
   }
   if (mpi::size() > 1) return run_campaign_distributed(db_path, spec, options);
 
