@@ -181,8 +181,6 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
 }
 
 void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
-  // The whole spec is checked before the database is opened: bad input writes nothing.
-  const campaign::CampaignSpec spec = campaign::parse_campaign_spec(resolve_spec_path(c.spec));
   if (c.jobs < 0) throw UsageError("--jobs must be >= 0 (0 = all cores)");
   if (!(c.worker_timeout_s >= 1.0 && c.worker_timeout_s <= 86400.0)) {
     throw UsageError("--worker-timeout must be in [1, 86400] seconds");
@@ -193,14 +191,23 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
   options.threads_per_unit = c.threads_per_unit;
   options.worker_timeout_s = c.worker_timeout_s;
   const bool distributed = mpi::size() > 1;
+  if (distributed && mpi::rank() != 0) {
+    // A worker: the spec comes from rank 0 (no copy of the file needed here), no output.
+    campaign::run_campaign(ctx.resolved_db_path(), campaign::CampaignSpec{}, options);
+    return;
+  }
+  // The whole spec is checked before the database is opened: bad input writes nothing.
+  campaign::CampaignSpec spec;
+  try {
+    spec = campaign::parse_campaign_spec(resolve_spec_path(c.spec));
+  } catch (const Error& e) {
+    campaign::cancel_distributed_run(e.is_bad_input() ? 2 : 1);
+    throw;
+  }
   if (!distributed && mpi::started_by_launcher()) {
     ctx.info(
         "note: started by an MPI launcher with one rank: running as the single-process "
         "runner (--jobs workers); start 2 or more ranks to distribute the units");
-  }
-  if (distributed && mpi::rank() != 0) {
-    campaign::run_campaign(ctx.resolved_db_path(), spec, options);  // a worker: no output
-    return;
   }
   auto printer = std::make_shared<CampaignProgressPrinter>(!ctx.quiet);
   options.progress = [printer](std::int64_t finished, std::int64_t total, const std::string& line) {

@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     mpi_session = std::make_unique<mpi::Session>(&argc, &argv);
   } catch (const draglab::Error& e) {
     std::cerr << "error: " << e.what() << '\n';
-    return 2;
+    return e.is_bad_input() ? 2 : 1;
   }
   CliContext ctx;
   CLI::App app{

@@ -62,10 +62,15 @@ double seconds_since(Clock::time_point t) {
 }
 
 /// Threads of a unit on a worker rank: the node's cores shared among the workers on it.
+int workers_on_this_node();
+
 int worker_threads(const RunCampaignOptions& options) {
   if (options.threads_per_unit > 0) return options.threads_per_unit;
-  const int workers_here = std::max(1, mpi::local_size() - (mpi::rank0_is_local() ? 1 : 0));
-  return std::max(1, cores() / workers_here);
+  return std::max(1, cores() / workers_on_this_node());
+}
+
+int workers_on_this_node() {
+  return std::max(1, mpi::local_size() - (mpi::rank0_is_local() ? 1 : 0));
 }
 
 // ---- rank 0 -------------------------------------------------------------------------------
@@ -85,24 +90,25 @@ struct WorkerState {
   std::string token;
 };
 
+std::string go_message(bool ok, int exit_code, const std::string& spec_json) {
+  return nlohmann::json{{"ok", ok}, {"exit_code", exit_code}, {"spec", spec_json}}.dump();
+}
+
 CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
                          const RunCampaignOptions& options) {
   const int ranks = mpi::size();
-  std::string go;
   OpenedCampaign opened;
   try {
-    // Rank 0's node runs rank 0 plus its workers; other nodes check their own memory.
-    opened = open_campaign(db_path, spec, options, std::max(1, mpi::local_size() - 1));
-    go = nlohmann::json{{"ok", true}, {"spec", spec.to_json()}}.dump();
+    validate_run(spec, options);
+    opened = open_campaign(db_path, spec, options, workers_on_this_node());
   } catch (const Error& e) {
-    go = nlohmann::json{{"ok", false}, {"exit_code", e.is_bad_input() ? 2 : 1}}.dump();
-    mpi::broadcast(&go);
+    broadcast_no_go(e.is_bad_input() ? 2 : 1);
     throw;
-  } catch (const std::exception&) {
-    go = nlohmann::json{{"ok", false}, {"exit_code", 1}}.dump();
-    mpi::broadcast(&go);
+  } catch (...) {
+    broadcast_no_go(1);
     throw;
   }
+  std::string go = go_message(true, 0, spec.to_json());
   mpi::broadcast(&go);
 
   Database& db = *opened.db;
@@ -117,6 +123,7 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
   double cost_done = 0.0;
   bool queue_empty = false;  // no pending unit was found at the last claim
   std::vector<std::string> notes;
+  std::string refusal;  // a worker that cannot run the units (its node's memory)
   const auto start = Clock::now();
   auto last_line = Clock::now() - std::chrono::seconds(10);
 
@@ -135,12 +142,13 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
                                    seconds_since(start), event));
   };
 
-  // A rank presumed dead may only be slow: it is told to stop too, with a short wait.
-  auto stop_all = [&] {
+  // A rank presumed dead may only be slow: it is told to stop too, with a short wait. The
+  // exit code tells the workers how the run ended.
+  auto stop_all = [&](int exit_code) {
     const bool lost =
         std::any_of(workers.begin(), workers.end(), [](const auto& e) { return !e.second.alive; });
     if (lost) mpi::mark_peer_lost();
-    const std::string stop = nlohmann::json{{"peer_lost", lost}}.dump();
+    const std::string stop = nlohmann::json{{"peer_lost", lost}, {"exit_code", exit_code}}.dump();
     for (auto& [r, w] : workers) {
       if (w.reachable) mpi::send(r, kStop, stop, w.alive ? kSendSeconds : 2.0);
       w.alive = false;
@@ -170,61 +178,83 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
     return true;
   };
 
+  auto handle = [&](const mpi::Message& m) {
+    auto it = workers.find(m.source);
+    if (it == workers.end() || !it->second.reachable) return;
+    WorkerState& w = it->second;
+    w.last_heard = Clock::now();
+    if (!w.alive) {
+      // Presumed dead but only slow: back in service. Its unit went to another rank; a late
+      // result for it is dropped (the claim is no longer its own).
+      w.alive = true;
+      notes.push_back(w.report.name + " answered again after being presumed dead");
+    }
+    const auto j = nlohmann::json::parse(m.text, nullptr, false);
+    if (m.tag == kHeartbeat) {
+      if (w.has_unit && j.is_object() && j.value("unit", std::int64_t{-1}) == w.unit.id) {
+        w.fraction = std::clamp(j.value("fraction", 0.0), 0.0, 1.0);
+      }
+    } else if (m.tag == kReady) {
+      w.idle = true;
+      if (j.is_object()) {
+        w.report.host = j.value("host", "");
+        w.heartbeat = j.value("heartbeat", false);
+        const std::string memory = j.value("memory_error", "");
+        if (!memory.empty() && refusal.empty()) refusal = w.report.name + ": " + memory;
+      }
+      if (!w.heartbeat) {
+        notes.push_back(w.report.name +
+                        " sends no heartbeat (MPI without MPI_THREAD_MULTIPLE): rank 0 waits "
+                        "for its results however long, as for a unit in one process");
+      }
+    } else if (m.tag == kResult) {
+      w.idle = true;
+      if (!w.has_unit) return;  // the result of a unit handed on: dropped
+      const UnitOutcome o = outcome_from_json(nlohmann::json::parse(m.text));
+      const bool ours = commit_unit(db, w.unit, w.token, o);
+      w.has_unit = false;
+      --in_flight;
+      cost_done += w.unit_cost;
+      ++w.report.units;
+      w.report.busy_s += o.wall_s;
+      if (ours) {
+        ++finished;
+        if (!o.done) ++failed_session;
+        report(unit_event(w.unit, o) + " (" + w.report.name + ")");
+      }
+    }
+  };
+
   try {
     report("");
+    auto last_pass = Clock::now();
     for (;;) {
       const bool any_alive =
           std::any_of(workers.begin(), workers.end(), [](const auto& e) { return e.second.alive; });
       if (!any_alive) break;
       if (queue_empty && in_flight == 0) break;
+      if (!refusal.empty()) {
+        throw Error(ErrorCode::kInvalidArgument, refusal);
+      }
 
+      // Every waiting message first, then the silences: a backlog is not a death.
       mpi::Message m;
       if (mpi::receive(&m, 0.25)) {
-        auto it = workers.find(m.source);
-        if (it != workers.end() && it->second.alive) {
-          WorkerState& w = it->second;
-          w.last_heard = Clock::now();
-          if (m.tag == kHeartbeat) {
-            const auto j = nlohmann::json::parse(m.text, nullptr, false);
-            if (w.has_unit && j.is_object() && j.value("unit", std::int64_t{-1}) == w.unit.id) {
-              w.fraction = std::clamp(j.value("fraction", 0.0), 0.0, 1.0);
-            }
-            if (w.report.host.empty() && j.is_object()) w.report.host = j.value("host", "");
-          } else if (m.tag == kReady) {
-            const auto j = nlohmann::json::parse(m.text, nullptr, false);
-            w.idle = true;
-            if (j.is_object()) {
-              w.report.host = j.value("host", "");
-              w.heartbeat = j.value("heartbeat", false);
-            }
-            if (!w.heartbeat) {
-              notes.push_back(w.report.name +
-                              " sends no heartbeat (MPI without MPI_THREAD_MULTIPLE): its death "
-                              "is not detected");
-            }
-          } else if (m.tag == kResult && w.has_unit) {
-            const UnitOutcome o = outcome_from_json(nlohmann::json::parse(m.text));
-            const bool ours = commit_unit(db, w.unit, w.token, o);
-            w.has_unit = false;
-            w.idle = true;
-            --in_flight;
-            cost_done += w.unit_cost;
-            ++w.report.units;
-            w.report.busy_s += o.wall_s;
-            if (ours) {
-              ++finished;
-              if (!o.done) ++failed_session;
-              report(unit_event(w.unit, o) + " (" + w.report.name + ")");
-            }
-          }
-        }
+        handle(m);
+        while (mpi::receive(&m, 0.0)) handle(m);
       }
+      // Rank 0 itself stalled (a suspended job, a slow disk): nobody's silence counts.
+      if (seconds_since(last_pass) > 0.5 * options.worker_timeout_s) {
+        for (auto& [r, w] : workers) w.last_heard = Clock::now();
+      }
+      last_pass = Clock::now();
 
       // Presume silent workers dead; their units go back to the queue.
       for (auto& [r, w] : workers) {
         if (!w.alive || !w.heartbeat) continue;
         if (seconds_since(w.last_heard) <= options.worker_timeout_s) continue;
         w.alive = false;
+        w.idle = false;
         std::string note = w.report.name + " silent for " +
                            core::format_number(options.worker_timeout_s) + " s: presumed dead";
         if (w.has_unit) {
@@ -251,22 +281,27 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
       }
       report("");
     }
-    stop_all();
+  } catch (const Error& e) {
+    stop_all(e.is_bad_input() ? 2 : 1);
+    throw;
   } catch (...) {
-    stop_all();
+    stop_all(1);
     throw;
   }
+  stop_all(0);
 
   CampaignStatus status = campaign_status(db, std::to_string(opened.id));
+  const std::int64_t left = status.units_pending + status.units_running;
+  if (left > 0) {
+    throw Error(ErrorCode::kIo, "every worker rank is gone with " + std::to_string(left) +
+                                    " unit(s) of campaign '" + spec.name +
+                                    "' left: continue with --resume");
+  }
   std::vector<WorkerReport> reports;
   for (const auto& [r, w] : workers) reports.push_back(w.report);
   status.session =
       session_report("mpi", seconds_since(start), worker_threads(options), std::move(reports));
   status.session.notes = notes;
-  if (status.units_pending + status.units_running > 0) {
-    status.session.notes.push_back(
-        "every worker rank is gone with units left: continue with --resume");
-  }
   return status;
 }
 
@@ -281,11 +316,13 @@ class Heartbeat {
       : fraction_(fraction), unit_(unit), host_(mpi::host_name()) {
     if (!mpi::threads_multiple()) return;
     thread_ = std::thread([this] {
-      std::unique_lock<std::mutex> lock(mutex_);
-      while (!done_) {
-        cv_.wait_for(lock, std::chrono::duration<double>(kHeartbeatSeconds));
-        if (done_) break;
-        beat();
+      for (;;) {
+        {
+          std::unique_lock<std::mutex> lock(mutex_);
+          cv_.wait_for(lock, std::chrono::duration<double>(kHeartbeatSeconds));
+          if (done_) return;
+        }
+        beat();  // outside the lock: a slow send never holds up the destructor's notify
       }
     });
   }
@@ -304,11 +341,9 @@ class Heartbeat {
 
  private:
   void beat() {
-    mpi::send(
-        0, kHeartbeat,
-        nlohmann::json{{"unit", unit_->load()}, {"fraction", fraction_->load()}, {"host", host_}}
-            .dump(),
-        kSendSeconds);
+    mpi::send(0, kHeartbeat,
+              nlohmann::json{{"unit", unit_->load()}, {"fraction", fraction_->load()}}.dump(),
+              kSendSeconds);
   }
   std::atomic<double>* fraction_;
   std::atomic<std::int64_t>* unit_;
@@ -319,6 +354,13 @@ class Heartbeat {
   std::thread thread_;
 };
 
+/// A worker that finds rank 0 gone ends at once, without MPI_Finalize (which would wait for it).
+[[noreturn]] void rank0_gone(const std::string& what) {
+  mpi::mark_peer_lost();
+  throw Error(ErrorCode::kIo, "rank " + std::to_string(mpi::rank()) + ": " + what +
+                                  "; the campaign continues with --resume");
+}
+
 CampaignStatus run_worker(const RunCampaignOptions& options) {
   std::string go;
   mpi::broadcast(&go);
@@ -327,24 +369,31 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
   // The spec as rank 0 read it: the workers need no copy of the spec file.
   const CampaignSpec spec = internal::spec_from_json(g.at("spec").get<std::string>());
   const int threads = worker_threads(options);
+  // This node's memory, for its workers' largest units: a refusal goes to rank 0, which stops
+  // the run with it (exit 2 on every rank).
+  std::string memory_error;
+  try {
+    check_memory(spec, workers_on_this_node());
+  } catch (const Error& e) {
+    memory_error = e.what();
+  }
 
   std::atomic<double> fraction{0.0};
   std::atomic<std::int64_t> current{-1};
   Heartbeat heartbeat(&fraction, &current);
-  const std::string ready =
-      nlohmann::json{{"host", mpi::host_name()}, {"heartbeat", heartbeat.beating()}}.dump();
-  if (!mpi::send(0, kReady, ready, kSendSeconds)) {
-    throw Error(ErrorCode::kIo, "rank " + std::to_string(mpi::rank()) + ": rank 0 is gone");
-  }
+  const std::string ready = nlohmann::json{
+      {"host", mpi::host_name()},
+      {"heartbeat", heartbeat.beating()},
+      {"memory_error",
+       memory_error}}.dump();
+  if (!mpi::send(0, kReady, ready, kSendSeconds)) rank0_gone("rank 0 did not take a message");
   auto heard = Clock::now();
   for (;;) {
     mpi::Message m;
     if (!mpi::receive(&m, 1.0, 0)) {
       if (seconds_since(heard) > kRank0SilenceSeconds) {
-        throw Error(ErrorCode::kIo, "rank " + std::to_string(mpi::rank()) +
-                                        ": rank 0 sent nothing for " +
-                                        core::format_number(kRank0SilenceSeconds) +
-                                        " s and is presumed dead; continue with --resume");
+        rank0_gone("rank 0 sent nothing for " + core::format_number(kRank0SilenceSeconds) +
+                   " s and is presumed dead");
       }
       continue;
     }
@@ -352,6 +401,8 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
     if (m.tag == kStop) {
       const auto j = nlohmann::json::parse(m.text, nullptr, false);
       if (j.is_object() && j.value("peer_lost", false)) mpi::mark_peer_lost();
+      const int exit_code = j.is_object() ? j.value("exit_code", 0) : 0;
+      if (exit_code != 0) throw mpi::EndedByRank0(exit_code);
       break;
     }
     if (m.tag != kUnit) continue;  // a ping
@@ -361,8 +412,7 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
     const UnitOutcome o = execute_unit(spec, unit, threads, &fraction);
     current.store(-1);
     if (!mpi::send(0, kResult, outcome_to_json(o).dump(), kSendSeconds)) {
-      throw Error(ErrorCode::kIo, "rank " + std::to_string(mpi::rank()) +
-                                      ": rank 0 did not take a result; continue with --resume");
+      rank0_gone("rank 0 did not take a result");
     }
     heard = Clock::now();
   }
@@ -370,6 +420,11 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
 }
 
 }  // namespace
+
+void broadcast_no_go(int exit_code) {
+  std::string go = go_message(false, exit_code, "");
+  mpi::broadcast(&go);
+}
 
 CampaignStatus run_campaign_distributed(const std::string& db_path, const CampaignSpec& spec,
                                         const RunCampaignOptions& options) {

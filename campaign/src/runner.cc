@@ -475,15 +475,7 @@ UnitOutcome outcome_from_json(const nlohmann::json& j) {
   return o;
 }
 
-}  // namespace runner
-
-using db::Statement;
-using runner::format_duration;
-using runner::require_campaign_tables;
-
-CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
-                            const RunCampaignOptions& options) {
-  using namespace runner;
+void validate_run(const CampaignSpec& spec, const RunCampaignOptions& options) {
   std::string error;
   if (!spec.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, error);
   if (options.jobs < 0 || options.jobs > 1024) {
@@ -500,8 +492,25 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
                 "worker timeout = " + core::format_number(options.worker_timeout_s) +
                     " s is outside [1, 86400]");
   }
-  if (mpi::size() > 1) return run_campaign_distributed(db_path, spec, options);
+}
 
+}  // namespace runner
+
+using db::Statement;
+using runner::format_duration;
+using runner::require_campaign_tables;
+
+void cancel_distributed_run(int exit_code) {
+  if (mpi::size() > 1 && mpi::rank() == 0) runner::broadcast_no_go(exit_code);
+}
+
+CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
+                            const RunCampaignOptions& options) {
+  using namespace runner;
+  // Under MPI every check happens on rank 0 inside the distributed runner, which tells the
+  // workers the outcome: a rank that failed alone would leave the others waiting.
+  if (mpi::size() > 1) return run_campaign_distributed(db_path, spec, options);
+  validate_run(spec, options);
   const int jobs = options.jobs == 0 ? cores() : options.jobs;
   OpenedCampaign opened = open_campaign(db_path, spec, options, jobs);
   const std::int64_t id = opened.id;

@@ -61,6 +61,10 @@ struct OpenedCampaign {
   double session_cost = 0.0;  ///< Estimated cost of the pending units (for the ETA).
 };
 
+/// Refuses (Error(kInvalidArgument)) a spec whose largest unit, `workers` at once, needs more
+/// than 80 % of this node's memory.
+void check_memory(const CampaignSpec& spec, int workers);
+
 /// Checks the memory of `workers_per_node` units at once, then opens the campaign as above.
 OpenedCampaign open_campaign(const std::string& db_path, const CampaignSpec& spec,
                              const RunCampaignOptions& options, int workers_per_node);
@@ -93,6 +97,12 @@ int cores();
 /// The session report of a run: its wall time and what each worker did.
 SessionReport session_report(const std::string& mode, double wall_s, int threads_per_unit,
                              std::vector<WorkerReport> workers);
+
+/// Every check of a run before any work: the spec and the options (Error(kInvalidArgument)).
+void validate_run(const CampaignSpec& spec, const RunCampaignOptions& options);
+
+/// Rank 0: tells the workers waiting for the run's start that it will not start.
+void broadcast_no_go(int exit_code);
 
 /// The MPI runner (distributed_runner.cc); called by run_campaign on every rank when the world
 /// has several.

@@ -3,8 +3,11 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <memory>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -26,7 +29,7 @@ struct State {
   bool multiple = false;
   int local_size = 1;
   bool rank0_local = true;
-  bool peer_lost = false;
+  std::atomic<bool> peer_lost{false};  // also set by a heartbeat thread's failed send
 };
 
 State& state() {
@@ -82,7 +85,11 @@ void init(int* argc, char*** argv) {
   MPI_Initialized(&already);
   if (!already) {
     int provided = MPI_THREAD_SINGLE;
-    MPI_Init_thread(argc, argv, MPI_THREAD_MULTIPLE, &provided);
+    if (MPI_Init_thread(argc, argv, MPI_THREAD_MULTIPLE, &provided) != MPI_SUCCESS) {
+      throw Error(ErrorCode::kIo,
+                  "MPI_Init_thread failed: the MPI launcher's environment is "
+                  "set, but MPI could not start");
+    }
     s.initialized_here = true;
     s.multiple = provided >= MPI_THREAD_MULTIPLE;
   }
@@ -116,7 +123,7 @@ void finalize() {
   s.initialized_here = false;
   // MPI_Finalize's closing fence would wait forever for a dead rank; the process ends without it
   // (the launcher reports it, the work is committed).
-  if (s.peer_lost) return;
+  if (s.peer_lost.load()) return;
   int finalized = 0;
   MPI_Finalized(&finalized);
   if (!finalized) MPI_Finalize();
@@ -154,14 +161,24 @@ void abort(int code) {
 
 bool send(int dest, int tag, const std::string& text, double seconds) {
 #if DRAGLAB_HAVE_MPI
+  // The buffer outlives a send that timed out: MPI may still read it (a started send cannot be
+  // cancelled), so it is kept, not freed, and the peer is taken for lost.
+  auto buffer = std::make_unique<std::string>(text);
   MPI_Request request;
-  if (MPI_Isend(text.data(), static_cast<int>(text.size()), MPI_CHAR, dest, tag, MPI_COMM_WORLD,
-                &request) != MPI_SUCCESS) {
+  if (MPI_Isend(buffer->data(), static_cast<int>(buffer->size()), MPI_CHAR, dest, tag,
+                MPI_COMM_WORLD, &request) != MPI_SUCCESS) {
+    mark_peer_lost();
     return false;
   }
   if (wait_for(&request, seconds)) return true;
-  MPI_Cancel(&request);
   MPI_Request_free(&request);
+  static std::mutex abandoned_mutex;
+  static std::vector<std::unique_ptr<std::string>> abandoned;
+  {
+    std::lock_guard<std::mutex> g(abandoned_mutex);
+    abandoned.push_back(std::move(buffer));
+  }
+  mark_peer_lost();
   return false;
 #else
   (void)dest, (void)tag, (void)text, (void)seconds;
@@ -176,7 +193,10 @@ bool receive(Message* message, double seconds, int source) {
   MPI_Status status;
   for (;;) {
     int flag = 0;
-    if (MPI_Iprobe(from, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &status) != MPI_SUCCESS) return false;
+    if (MPI_Iprobe(from, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &status) != MPI_SUCCESS) {
+      std::this_thread::sleep_for(kPoll);  // an error is not a message: the caller must not spin
+      return false;
+    }
     if (flag) break;
     if (std::chrono::steady_clock::now() > deadline) return false;
     std::this_thread::sleep_for(kPoll);

@@ -145,6 +145,11 @@ struct RunCampaignOptions {
 CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec,
                             const RunCampaignOptions& options);
 
+/// Rank 0 of a multi-rank job that fails before calling run_campaign (its spec file does not
+/// parse, say) calls this so that the worker ranks, already waiting in run_campaign, end with
+/// `exit_code` instead of waiting forever. Does nothing in a one-rank world.
+void cancel_distributed_run(int exit_code);
+
 /// Predicted cost of one (phi, Re, resolution) point of a spec (all its realizations).
 struct PlannedPoint {
   double phi = 0.0, re = 0.0, resolution = 0.0;

@@ -62,7 +62,9 @@ struct Message {
 };
 
 /// Sends `text` to rank `dest` with `tag` (0 <= tag < 32768) and waits until MPI no longer
-/// needs the buffer, at most `seconds`: false if that did not happen in time (the peer is gone).
+/// needs the buffer, at most `seconds`: false if that did not happen in time. Small messages
+/// complete at once whatever the peer does, so this rarely detects a dead peer (heartbeats do);
+/// it bounds the wait for a large one. A send that failed marks a peer lost (mark_peer_lost).
 bool send(int dest, int tag, const std::string& text, double seconds);
 
 /// Waits up to `seconds` for a message from `source` (kAnySource: any rank); false on timeout.
