@@ -34,8 +34,8 @@ struct CliContext {
   bool quiet = false;   ///< --quiet: no informational messages on stderr.
   /// The action of the selected subcommand (set by its parse callback, run by main()).
   std::function<void()> action;
-  /// Set by the commands that run across MPI ranks (campaign run); main() refuses the others
-  /// when started with several ranks.
+  /// Set by the commands that run across MPI ranks (campaign run, lbm run); main() refuses the
+  /// others when started with several ranks.
   bool runs_on_ranks = false;
 
   std::string resolved_db_path() const {

@@ -26,6 +26,8 @@
 #include "draglab/lbm/convergence.h"
 #include "draglab/lbm/fields_io.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/mpi/communicator.h"
+#include "draglab/mpi/world.h"
 #include "draglab/workflows/bed_results.h"
 #include "draglab/workflows/convergence_plot.h"
 
@@ -159,13 +161,52 @@ lbm::RunOptions run_options(const SolverOptions& s) {
   return r;
 }
 
+/// Exit code main() gives an exception (see cli_context.h).
+int exit_code_of(const std::exception& e) {
+  if (dynamic_cast<const UsageError*>(&e) != nullptr) return 2;
+  if (const auto* error = dynamic_cast<const Error*>(&e)) return error->is_bad_input() ? 2 : 1;
+  return 1;
+}
+
+/// Runs `step` on every rank of `group`, then ends every rank if it failed on any: rank 0
+/// reports the failure of the lowest failing rank (its message and exit code), the others end
+/// silently with that code. So that no rank is left waiting in a collective call for a rank
+/// that stopped at bad input.
+void on_every_rank(const mpi::Communicator& group, const std::function<void()>& step) {
+  if (group.size() == 1) {
+    step();
+    return;
+  }
+  std::string outcome = "0";
+  try {
+    step();
+  } catch (const std::exception& e) {
+    outcome = std::to_string(exit_code_of(e)) + e.what();
+  }
+  for (const std::string& o : group.allgather(outcome)) {
+    if (o == "0") continue;
+    const int code = o[0] - '0';
+    if (!group.is_root()) throw mpi::EndedByRank0(code);
+    if (code == 2) throw UsageError(o.substr(1));
+    throw std::runtime_error(o.substr(1));
+  }
+}
+
 void run_lbm(const CliContext& ctx, const RunCommand& c) {
+  // Launched with several ranks, the ranks share the box (slabs of z-planes): each reads the
+  // input, rank 0 alone checks the outputs, prints and writes.
+  const mpi::Communicator group = mpi::Communicator::world();
+  const bool root = group.is_root();
   // Everything the user typed is checked before the (possibly long) run.
-  lbm::RunOptions options = run_options(c.solver);
-  if (std::isnan(c.d)) throw UsageError("--d is required (lattice units per sphere diameter)");
-  const Case the_case = load_case(c.case_options);
-  lbm::check_run_size(the_case.packing, c.d, options, "--d");
-  if (!c.fields.empty()) core::check_output_file(c.fields, "--fields");
+  lbm::RunOptions options;
+  Case the_case;
+  on_every_rank(group, [&] {
+    options = run_options(c.solver);
+    if (std::isnan(c.d)) throw UsageError("--d is required (lattice units per sphere diameter)");
+    the_case = load_case(c.case_options);
+    lbm::check_run_size(the_case.packing, c.d, options, "--d");
+    if (!c.fields.empty() && root) core::check_output_file(c.fields, "--fields");
+  });
   if (c.d_hydro != 0.0 && c.calibrate) throw UsageError("give --d-hydro or --calibrate, not both");
   if (c.d_hydro != 0.0) {
     if (!std::isfinite(c.d_hydro) || c.d_hydro < 0.5 * c.d || c.d_hydro > 1.5 * c.d) {
@@ -180,21 +221,23 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
   }
   if (c.calibrate && c.d > 128.0) throw UsageError("--calibrate works for --d up to 128");
 
-  ProgressLine progress(!ctx.quiet);
+  ProgressLine progress(!ctx.quiet && root);
   auto report = [&progress](const std::string& stage) {
     return [&progress, stage](double f, const std::string&) { progress.update(f, stage); };
   };
   nlohmann::json calibration_json;
   if (c.calibrate) {
+    // On every rank alone (a small box): each gets the same d_h.
     lbm::CalibrationOptions co;
     co.diameter = c.d;
     co.run = options;
     const lbm::CalibrationResult cal =
         lbm::calibrate_hydrodynamic_diameter(co, report("lbm calibrate"));
     progress.finish();
-    ctx.info(fmt::format("calibration: d_h/d = {:.5f} ({} at d = {:.4g}, {:.1f} s)", cal.ratio,
-                         lbm::Scheme{options.collision, options.boundary}.name(), cal.diameter,
-                         cal.wall_s));
+    if (root)
+      ctx.info(fmt::format("calibration: d_h/d = {:.5f} ({} at d = {:.4g}, {:.1f} s)", cal.ratio,
+                           lbm::Scheme{options.collision, options.boundary}.name(), cal.diameter,
+                           cal.wall_s));
     calibration_json = {{"d_h_over_d", cal.ratio},
                         {"phi", cal.calibration.phi},
                         {"F_input", cal.calibration.F_input},
@@ -217,12 +260,28 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     options.hydrodynamic_diameter *= grid.resolution() / c.d;  // the realised d
   }
   options.throw_on_failure = false;  // report a failed run with its diagnosis, then exit 1
+  options.ranks = group;
   lbm::Fields fields;
   const double phi_exact = the_case.packing.phi();
-  const lbm::RunResult r =
-      c.fields.empty() ? lbm::run(grid, phi_exact, options, report("lbm run"))
-                       : lbm::run_with_fields(grid, phi_exact, options, &fields, report("lbm run"));
+  lbm::RunResult r;
+  try {
+    r = c.fields.empty()
+            ? lbm::run(grid, phi_exact, options, report("lbm run"))
+            : lbm::run_with_fields(grid, phi_exact, options, &fields, report("lbm run"));
+  } catch (const std::exception& e) {
+    // Bad input the run finds (too many ranks for the box, memory) is found on every rank
+    // alike: rank 0 reports it. Anything else may be this rank's alone: end the whole job.
+    if (root || group.size() == 1) throw;
+    const int code = exit_code_of(e);
+    if (code == 2) throw mpi::EndedByRank0(code);
+    std::cerr << "error: rank " << group.rank() << ": " << e.what() << '\n';
+    mpi::abort(code);
+  }
   progress.finish();
+  if (!root) {
+    if (!r.converged) throw mpi::EndedByRank0(1);  // rank 0 prints the diagnosis
+    return;
+  }
 
   nlohmann::json j = nlohmann::json::parse(r.ToJson(options));
   j["re_target"] = c.solver.re;
@@ -608,8 +667,12 @@ void add_lbm_commands(CLI::App& app, CliContext& ctx) {
       "  draglab lbm run --array fcc --phi 0.5 --d 24 --re 100 --collision rr\n"
       "  draglab lbm run --array sc --phi 0.5235987755982988 --d 24 --re 0   # touching\n"
       "  draglab lbm run --array sc --phi 0.2 --d 12 --re 0 --boundary bb --calibrate\n"
-      "  draglab lbm run --array sc --phi 0.1 --d 16 --re 0 --fields flow.h5");
-  run->callback([&ctx, rc] { ctx.action = [&ctx, rc] { run_lbm(ctx, *rc); }; });
+      "  draglab lbm run --array sc --phi 0.1 --d 16 --re 0 --fields flow.h5\n"
+      "  mpirun -np 4 draglab lbm run --packing p.h5 --d 64 --re 100   # one box on 4 ranks");
+  run->callback([&ctx, rc] {
+    ctx.runs_on_ranks = true;  // the ranks share the box
+    ctx.action = [&ctx, rc] { run_lbm(ctx, *rc); };
+  });
 
   auto bc = std::make_shared<BenchCommand>();
   auto* bench = lbm->add_subcommand(

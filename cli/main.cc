@@ -159,7 +159,8 @@ int main(int argc, char** argv) {
   if (mpi::size() > 1 && !ctx.runs_on_ranks) {
     if (mpi::rank() == 0) {
       std::cerr << "error: started with " << mpi::size()
-                << " MPI ranks, but only `draglab campaign run` runs across ranks: start this "
+                << " MPI ranks, but only `draglab campaign run` and `draglab lbm run` run across "
+                   "ranks: start this "
                    "command without mpirun/srun (or with one rank)\n";
     }
     return 2;

@@ -42,6 +42,7 @@
 #include "collision.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/mpi/world.h"
 #include "error_model.h"
 #include "lattice.h"
 #include "solver.h"
@@ -75,18 +76,22 @@ std::string fmt(const char* format, double x) {
   return buffer;
 }
 
-std::string node_text(const SparseLattice& lattice, std::int64_t n) {
-  if (n < 0) return "(unknown node)";
-  const auto c = lattice.coordinates(n);
-  return "node (" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " +
-         std::to_string(c[2]) + ")";
+/// `dense`: a node index in the whole box.
+std::string node_text(const SparseLattice& lattice, std::int64_t dense) {
+  if (dense < 0) return "(unknown node)";
+  const auto& n = lattice.dims();
+  return "node (" + std::to_string(dense % n[0]) + ", " + std::to_string((dense / n[0]) % n[1]) +
+         ", " + std::to_string(dense / (n[0] * n[1])) + ")";
 }
 
-int resolve_threads(int requested) {
+/// 0 = all cores, shared among the ranks that run on this node.
+int resolve_threads(int requested, const mpi::Communicator& group) {
 #if defined(_OPENMP)
-  return requested > 0 ? requested : std::max(1, omp_get_max_threads());
+  if (requested > 0) return requested;
+  const int ranks_here = group.size() > 1 ? std::max(1, mpi::local_size()) : 1;
+  return std::max(1, omp_get_max_threads() / ranks_here);
 #else
-  (void)requested;
+  (void)requested, (void)group;
   return 1;
 #endif
 }
@@ -194,24 +199,44 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
                 ") is within 1e-3 of 1/2; remedy: lower tau or raise Lambda");
   }
 
-  // Lattice, links, solver.
-  const int threads = resolve_threads(options.threads);
+  // Lattice, links, solver. Several ranks share the box in slabs of z-planes (lattice.h).
+  const mpi::Communicator& group = options.ranks;
+  const int threads = resolve_threads(options.threads, group);
   const std::size_t element = options.precision == Precision::kFloat ? 4 : 8;
-  const SparseLattice lattice(grid, threads, element);
+  PlaneRange planes;
+  if (group.size() > 1) {
+    const std::vector<std::int64_t> split = split_planes(grid, group.size());
+    planes.begin = split[static_cast<std::size_t>(group.rank())];
+    planes.end = split[static_cast<std::size_t>(group.rank()) + 1];
+    planes.decomposed = true;
+  }
+  const SparseLattice lattice(grid, threads, element, planes);
   {
     // Refuse what cannot fit rather than let the system kill the process half-way.
     const double needed = static_cast<double>(d3q19::kQ) * static_cast<double>(element) *
                               static_cast<double>(lattice.stride()) +
                           static_cast<double>(lattice.memory_bytes()) +
-                          48.0 * static_cast<double>(grid.num_links());
+                          48.0 * static_cast<double>(grid.num_links()) / group.size();
+    // Every rank takes the decision from the largest share (the ranks of a node share its
+    // memory), so that all of them refuse together.
+    const double largest = group.size() > 1
+                               ? [&] {
+                                   const std::vector<double> all = group.allgather(std::vector<double>{needed});
+                                   return *std::max_element(all.begin(), all.end());
+                                 }()
+                               : needed;
+    const double ranks_here = group.size() > 1 ? std::max(1, mpi::local_size()) : 1;
     const double available = machine_memory_bytes();
-    if (available > 0.0 && needed > 0.9 * available) {
-      throw Error(ErrorCode::kInvalidArgument,
-                  "lbm run: the lattice needs about " + fmt("%.3g", needed / 1073741824.0) +
-                      " GiB (" + std::to_string(lattice.num_stored()) +
-                      " stored nodes), more than 90 % of this machine's " +
-                      fmt("%.3g", available / 1073741824.0) +
-                      " GiB; lower the resolution or use --precision float");
+    if (available > 0.0 && largest * ranks_here > 0.9 * available) {
+      throw Error(
+          ErrorCode::kInvalidArgument,
+          "lbm run: the lattice needs about " + fmt("%.3g", largest * ranks_here / 1073741824.0) +
+              " GiB (" + std::to_string(lattice.num_stored()) + " stored nodes" +
+              (group.size() > 1 ? " on this rank, " + fmt("%g", ranks_here) + " ranks on this node"
+                                : std::string()) +
+              "), more than 90 % of this machine's " + fmt("%.3g", available / 1073741824.0) +
+              " GiB; lower the resolution, use --precision float" +
+              (group.size() > 1 ? ", or spread the ranks over more nodes" : ""));
     }
   }
   const bool interpolated = options.boundary == Boundary::kInterpolated;
@@ -225,14 +250,17 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   settings.force_x = force;
   settings.interpolated = interpolated;
   std::unique_ptr<SolverBase> solver =
-      make_solver(options.precision, lattice, links, settings, threads);
-  const std::int64_t fluid = lattice.num_fluid();
+      make_solver(options.precision, lattice, links, settings, threads, group);
+  // Counts over the whole box (every rank's share).
+  const std::int64_t fluid = group.sum(lattice.num_fluid());
   const double total_nodes = static_cast<double>(grid.num_nodes());
   const std::size_t bodies = links.num_bodies();
   result.fluid_nodes = fluid;
-  result.boundary_links = static_cast<std::int64_t>(links.size());
-  result.fallback_links = links.fallback_links;
-  result.memory_bytes = solver->bytes() + lattice.memory_bytes() + links.memory_bytes();
+  result.ranks = group.size();
+  result.boundary_links = group.sum(static_cast<std::int64_t>(links.size()));
+  result.fallback_links = group.sum(links.fallback_links);
+  result.memory_bytes = static_cast<std::size_t>(group.sum(
+      static_cast<std::int64_t>(solver->bytes() + lattice.memory_bytes() + links.memory_bytes())));
   result.narrow_gap_pairs = grid.gaps.narrow_pairs;
   result.smallest_gap_nodes = grid.gaps.smallest_gap_nodes;
   result.narrow_gap_fluid_fraction = grid.gaps.narrow_fluid_fraction();
@@ -245,9 +273,9 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
         " % of the fluid nodes lie in gaps one node wide: under-resolved gaps, run as the "
         "literature does (first-order bounce-back there); extrapolate in d for the error");
   }
-  if (links.fallback_links > 0) {
+  if (result.fallback_links > 0) {
     result.warnings.push_back(
-        std::to_string(links.fallback_links) + " of " + std::to_string(links.size()) +
+        std::to_string(result.fallback_links) + " of " + std::to_string(result.boundary_links) +
         " interpolated links fell back to halfway bounce-back (the node behind them is solid: "
         "one-node gaps); the wall is first order there");
   }

@@ -38,45 +38,116 @@ std::int64_t SparseLattice::padded_stride(std::int64_t num_stored, std::size_t b
   return row_bytes / b;
 }
 
-SparseLattice::SparseLattice(const arrays::VoxelGrid& grid, int threads, std::size_t element_bytes)
-    : dims_(grid.dims) {
+std::vector<std::int64_t> split_planes(const arrays::VoxelGrid& grid, int ranks) {
+  const std::int64_t nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
+  ranks = std::max(1, ranks);
+  if (nz < kMinPlanesPerRank * ranks) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "lbm: the box has " + std::to_string(nz) + " z-planes, fewer than " +
+                    std::to_string(kMinPlanesPerRank) + " per rank for " + std::to_string(ranks) +
+                    " ranks; use at most " + std::to_string(nz / kMinPlanesPerRank) +
+                    " ranks for this box (or a higher resolution)");
+  }
+  std::vector<std::int64_t> fluid(static_cast<std::size_t>(nz), 0);
+  for (std::int64_t k = 0; k < nz; ++k) {
+    for (std::int64_t n = k * nx * ny; n < (k + 1) * nx * ny; ++n) {
+      fluid[static_cast<std::size_t>(k)] += grid.solid[static_cast<std::size_t>(n)] ? 0 : 1;
+    }
+  }
+  std::int64_t total = 0;
+  for (std::int64_t f : fluid) total += f;
+  std::vector<std::int64_t> begin(static_cast<std::size_t>(ranks) + 1, nz);
+  begin[0] = 0;
+  std::int64_t k = 0, done = 0;
+  for (int r = 1; r < ranks; ++r) {
+    const std::int64_t target = total * r / ranks;
+    const std::int64_t lowest = begin[static_cast<std::size_t>(r) - 1] + kMinPlanesPerRank;
+    const std::int64_t highest = nz - kMinPlanesPerRank * (ranks - r);
+    while (k < highest && (k < lowest || done + fluid[static_cast<std::size_t>(k)] <= target)) {
+      done += fluid[static_cast<std::size_t>(k)];
+      ++k;
+    }
+    begin[static_cast<std::size_t>(r)] = k;
+  }
+  return begin;
+}
+
+std::int64_t SparseLattice::local_plane(std::int64_t k) const {
+  const std::int64_t p = wrap(k - first_plane_, dims_[2]);
+  return p < local_planes_ ? p : -1;
+}
+
+std::int32_t SparseLattice::stored_index(std::int64_t dense) const {
+  const std::int64_t plane_nodes = dims_[0] * dims_[1];
+  const std::int64_t p = local_plane(dense / plane_nodes);
+  return p < 0 ? -1
+               : stored_index_[static_cast<std::size_t>(dense % plane_nodes + plane_nodes * p)];
+}
+
+SparseLattice::SparseLattice(const arrays::VoxelGrid& grid, int threads, std::size_t element_bytes,
+                             PlaneRange planes)
+    : dims_(grid.dims), planes_(planes) {
   const std::int64_t nx = dims_[0], ny = dims_[1], nz = dims_[2];
   const std::int64_t total = nx * ny * nz;
   if (nx <= 0 || ny <= 0 || nz <= 0 || static_cast<std::int64_t>(grid.solid.size()) != total) {
     throw Error(ErrorCode::kInvalidArgument,
                 "lbm: voxel grid with inconsistent dimensions (solid flags do not match dims)");
   }
+  if (!planes_.decomposed) {
+    planes_.begin = 0;
+    planes_.end = nz;
+    first_plane_ = 0;
+    local_planes_ = nz;
+  } else {
+    if (planes_.begin < 0 || planes_.end > nz || planes_.end - planes_.begin < kMinPlanesPerRank ||
+        planes_.end - planes_.begin > nz - 2) {
+      throw Error(ErrorCode::kInvalidArgument, "lbm: invalid plane range of a decomposed box");
+    }
+    first_plane_ = wrap(planes_.begin - 1, nz);
+    local_planes_ = planes_.end - planes_.begin + 2;
+  }
   threads = std::max(1, threads);
   const auto& solid = grid.solid;
   auto dense = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
     return wrap(i, nx) + nx * (wrap(j, ny) + ny * wrap(k, nz));
   };
+  // Fluid that this rank updates.
+  auto owned_fluid = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    if (solid[static_cast<std::size_t>(dense(i, j, k))]) return false;
+    const std::int64_t p = local_plane(wrap(k, nz));
+    return p >= 0 && owned_plane(p);
+  };
+  const std::int64_t planes_here = local_planes_;
+  const std::int64_t local_total = nx * ny * planes_here;
 
-  // Stored nodes: fluid, and solid nodes with a fluid neighbour (ghosts). D3Q19 neighbourhood
-  // is symmetric, so a solid node is a ghost exactly when one of its own neighbours is fluid.
-  std::vector<std::uint8_t> stored(static_cast<std::size_t>(total), 0);
+  // Stored nodes: owned fluid, and the nodes with an owned fluid neighbour (ghosts and halo).
+  // D3Q19 neighbourhood is symmetric, so a node is needed exactly when one of its own
+  // neighbours is owned fluid.
+  std::vector<std::uint8_t> stored(static_cast<std::size_t>(local_total), 0);
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (std::int64_t k = 0; k < nz; ++k) {
+  for (std::int64_t p = 0; p < planes_here; ++p) {
+    const std::int64_t k = first_plane_ + p;
     for (std::int64_t j = 0; j < ny; ++j) {
       for (std::int64_t i = 0; i < nx; ++i) {
-        const std::int64_t d = i + nx * (j + ny * k);
-        bool keep = !solid[static_cast<std::size_t>(d)];
+        bool keep = owned_fluid(i, j, k);
         for (int q = 1; q < kQ && !keep; ++q) {
-          keep = !solid[static_cast<std::size_t>(dense(i + kC[q][0], j + kC[q][1], k + kC[q][2]))];
+          keep = owned_fluid(i + kC[q][0], j + kC[q][1], k + kC[q][2]);
         }
-        stored[static_cast<std::size_t>(d)] = keep ? 1 : 0;
+        stored[static_cast<std::size_t>(i + nx * (j + ny * p))] = keep ? 1 : 0;
       }
     }
   }
 
-  // Numbering row by row (rows r = j + ny k, x fastest).
-  const std::int64_t rows = ny * nz;
-  stored_index_.assign(static_cast<std::size_t>(total), -1);
+  // Numbering row by row (local rows r = j + ny p, x fastest).
+  const std::int64_t rows = ny * planes_here;
+  stored_index_.assign(static_cast<std::size_t>(local_total), -1);
   row_storage_begin_.assign(static_cast<std::size_t>(rows) + 1, 0);
   std::int64_t count = 0;
   for (std::int64_t r = 0; r < rows; ++r) {
     row_storage_begin_[static_cast<std::size_t>(r)] = count;
     const std::int64_t row = nx * r;
+    const std::int64_t global_row = nx * (r % ny + ny * wrap(first_plane_ + r / ny, nz));
+    const bool owned = owned_plane(r / ny);
     for (std::int64_t i = 0; i < nx; ++i) {
       if (!stored[static_cast<std::size_t>(row + i)]) continue;
       if (count >= std::numeric_limits<std::int32_t>::max()) {
@@ -84,24 +155,30 @@ SparseLattice::SparseLattice(const arrays::VoxelGrid& grid, int threads, std::si
                     "lbm: more than 2^31 - 1 stored nodes; lower the resolution");
       }
       stored_index_[static_cast<std::size_t>(row + i)] = static_cast<std::int32_t>(count++);
-      node_.push_back(row + i);
-      if (!solid[static_cast<std::size_t>(row + i)]) ++num_fluid_;
+      node_.push_back(global_row + i);
+      if (owned && !solid[static_cast<std::size_t>(global_row + i)]) ++num_fluid_;
     }
   }
   row_storage_begin_[static_cast<std::size_t>(rows)] = count;
   std::vector<std::uint8_t>().swap(stored);
-  if (num_fluid_ == 0) {
+  if (num_fluid_ == 0 && !planes_.decomposed) {
     throw Error(ErrorCode::kInvalidArgument, "lbm: the lattice has no fluid node");
   }
   stride_ = padded_stride(count, element_bytes);
+  auto local_index = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    const std::int64_t p = local_plane(wrap(k, nz));
+    return p < 0
+               ? -1
+               : stored_index_[static_cast<std::size_t>(wrap(i, nx) + nx * (wrap(j, ny) + ny * p))];
+  };
 
   // Solid-neighbour masks.
   mask_.assign(static_cast<std::size_t>(count), 0);
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (std::int64_t n = 0; n < count; ++n) {
     const std::int64_t d = node_[static_cast<std::size_t>(n)];
-    if (solid[static_cast<std::size_t>(d)]) continue;
     const std::int64_t i = d % nx, j = (d / nx) % ny, k = d / (nx * ny);
+    if (!owned_fluid(i, j, k)) continue;  // ghosts and halo nodes are never collided
     std::uint32_t m = 0;
     for (int q = 1; q < kQ; ++q) {
       if (solid[static_cast<std::size_t>(dense(i + kC[q][0], j + kC[q][1], k + kC[q][2]))]) {
@@ -116,8 +193,9 @@ SparseLattice::SparseLattice(const arrays::VoxelGrid& grid, int threads, std::si
 #pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
   for (std::int64_t r = 0; r < rows; ++r) {
     std::vector<Segment>& out = per_row[static_cast<std::size_t>(r)];
-    const std::int64_t j = r % ny, k = r / ny;
-    const std::int64_t row = nx * r;
+    if (!owned_plane(r / ny)) continue;
+    const std::int64_t j = r % ny, k = wrap(first_plane_ + r / ny, nz);
+    const std::int64_t row = nx * (j + ny * k);
     std::int64_t i = 0;
     while (i < nx) {
       if (solid[static_cast<std::size_t>(row + i)]) {
@@ -129,12 +207,11 @@ SparseLattice::SparseLattice(const arrays::VoxelGrid& grid, int threads, std::si
         while (end < nx - 1 && !solid[static_cast<std::size_t>(row + end)]) ++end;
       }
       Segment seg;
-      seg.first = stored_index_[static_cast<std::size_t>(row + i)];
+      seg.first = local_index(i, j, k);
       seg.length = end - i;
       seg.write[0] = seg.first;
       for (int q = 1; q < kQ; ++q) {
-        const std::int64_t nb = stored_index_[static_cast<std::size_t>(
-            dense(i + kC[q][0], j + kC[q][1], k + kC[q][2]))];
+        const std::int64_t nb = local_index(i + kC[q][0], j + kC[q][1], k + kC[q][2]);
         seg.write[q] = q * stride_ + nb;
       }
       for (std::int64_t n = seg.first; n < seg.first + seg.length; ++n) {
@@ -171,6 +248,46 @@ SparseLattice::SparseLattice(const arrays::VoxelGrid& grid, int threads, std::si
       ++r;
     }
     range_row_begin_[static_cast<std::size_t>(t)] = r;
+  }
+  if (planes_.decomposed) build_halo_plan(grid);
+}
+
+void SparseLattice::build_halo_plan(const arrays::VoxelGrid& grid) {
+  const std::int64_t nx = dims_[0], ny = dims_[1], nz = dims_[2];
+  auto fluid = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return !grid.solid[static_cast<std::size_t>(wrap(i, nx) +
+                                                nx * (wrap(j, ny) + ny * wrap(k, nz)))];
+  };
+  // Row i at the fluid nodes of local plane p for every i with c_iz = dz whose upstream node
+  // x - c_i (in the plane p - dz) is fluid; nodes in x-fastest order, then direction.
+  auto crossing = [&](std::int64_t p, int dz) {
+    std::vector<std::int64_t> out;
+    const std::int64_t k = first_plane_ + p;
+    for (std::int64_t j = 0; j < ny; ++j) {
+      for (std::int64_t i = 0; i < nx; ++i) {
+        if (!fluid(i, j, k)) continue;
+        const std::int32_t n = stored_index_[static_cast<std::size_t>(i + nx * (j + ny * p))];
+        for (int q = 1; q < kQ; ++q) {
+          if (kC[q][2] != dz || !fluid(i - kC[q][0], j - kC[q][1], k - kC[q][2])) continue;
+          if (n < 0) {
+            throw Error(ErrorCode::kInvalidArgument, "lbm: halo node not stored (internal error)");
+          }
+          out.push_back(q * stride_ + n);
+        }
+      }
+    }
+    return out;
+  };
+  const std::int64_t last = local_planes_ - 1;
+  halo_.low_halo = crossing(0, -1);
+  halo_.low_owned = crossing(1, +1);
+  halo_.high_owned = crossing(last - 1, -1);
+  halo_.high_halo = crossing(last, +1);
+  halo_.boundary_rows.clear();
+  halo_.interior_rows.clear();
+  for (std::int64_t r = ny; r < ny * last; ++r) {
+    const std::int64_t p = r / ny;
+    (p == 1 || p == last - 1 ? halo_.boundary_rows : halo_.interior_rows).push_back(r);
   }
 }
 
@@ -224,8 +341,10 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, bool interpo
         throw Error(ErrorCode::kInvalidArgument,
                     "lbm: voxel grid has a boundary link that does not start at a fluid node");
       }
-      raw.push_back({stored_index_[static_cast<std::size_t>(d)], static_cast<std::int32_t>(s),
-                     static_cast<std::uint8_t>(q), link.q});
+      const std::int64_t p = local_plane(d / (dims_[0] * dims_[1]));
+      if (p < 0 || !owned_plane(p)) continue;  // another rank's node
+      raw.push_back(
+          {stored_index(d), static_cast<std::int32_t>(s), static_cast<std::uint8_t>(q), link.q});
     }
   }
   std::stable_sort(raw.begin(), raw.end(), [](const Raw& x, const Raw& y) {
@@ -253,8 +372,7 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, bool interpo
     const std::int64_t i = d % nx, j = (d / nx) % ny, k = d / (nx * ny);
     const std::int64_t d2 =
         wrap(i - kC[q][0], nx) + nx * (wrap(j - kC[q][1], ny) + ny * wrap(k - kC[q][2], nz));
-    const std::int32_t r2 =
-        grid.solid[static_cast<std::size_t>(d2)] ? -1 : stored_index_[static_cast<std::size_t>(d2)];
+    const std::int32_t r2 = grid.solid[static_cast<std::size_t>(d2)] ? -1 : stored_index(d2);
     double kappa = 0.0;
     std::int64_t a = self, b = self;
     if (interpolated) {

@@ -13,11 +13,16 @@
 //
 // Blocks. The x-rows are grouped into slabs of kSlabPlanes z-planes; a slab's stored nodes,
 // segments and links are contiguous and every neighbour of a slab lies in the slab or the two
-// adjacent ones, so a slab is a self-contained unit of work: an MPI decomposition along z would
-// give each rank a range of slabs and route the offsets that leave it (the ones that point into
-// the first or last plane of a neighbouring range) through halo planes. No MPI is done here:
-// OpenMP threads get contiguous, fluid-node-balanced ranges of x-rows (static schedule), and
-// the same ranges first-touch the memory.
+// adjacent ones. OpenMP threads get contiguous, fluid-node-balanced ranges of x-rows (static
+// schedule), and the same ranges first-touch the memory.
+//
+// Decomposition across ranks (PlaneRange): a rank owns the z-planes [begin, end) and stores two
+// halo planes besides, begin - 1 and end (periodic). Its lattice is built exactly as above with
+// "fluid" read as "owned fluid": halo nodes are stored when an owned fluid node neighbours them
+// and are never collided, like ghosts, so the kernels run unchanged; only the populations that
+// cross the two plane interfaces travel between ranks (HaloPlan, solver.cc). Rows, segments and
+// links are local (the halo planes are the first and last local planes); node() stays the
+// dense index in the whole box.
 //
 // AA pattern (Bailey et al. 2009), one buffer, no write-allocate traffic:
 //  - even step: node n reads f_i from row i at n, collides, and writes the post-collision f*_i to
@@ -84,6 +89,37 @@ struct LinkTable {
   }
 };
 
+/// The z-planes [begin, end) of a box one rank owns; `decomposed` false: the whole periodic box
+/// on one rank (no halo planes).
+struct PlaneRange {
+  std::int64_t begin = 0;
+  std::int64_t end = 0;
+  bool decomposed = false;
+};
+
+/// Contiguous plane ranges for `ranks` ranks, balanced by fluid nodes, at least
+/// kMinPlanesPerRank planes each: result[r] .. result[r + 1] for rank r. Throws
+/// Error(kInvalidArgument) when the box has fewer than kMinPlanesPerRank planes per rank.
+constexpr std::int64_t kMinPlanesPerRank = 2;
+std::vector<std::int64_t> split_planes(const arrays::VoxelGrid& grid, int ranks);
+
+/// The populations that cross a rank's two plane interfaces, as flat offsets (row i * stride +
+/// stored node) in the order both ranks of an interface enumerate them (the plane's nodes in
+/// x-fastest order, then direction). For the lower interface (between the low halo plane and
+/// the first owned plane): `low_halo` lists row i at halo fluid node h for c_i pointing down
+/// with h - c_i owned fluid, `low_owned` row i at first-plane fluid node y for c_i pointing up
+/// with y - c_i halo fluid; the upper interface the same with up and down swapped. After an
+/// even step a rank sends its `*_owned` values and receives its `*_halo` ones (the post-
+/// collision values the odd step reads across the interface); after an odd step it sends its
+/// `*_halo` values (written there by its own nodes) and receives its `*_owned` ones. Each list
+/// equals the neighbour's opposite list entry by entry.
+struct HaloPlan {
+  std::vector<std::int64_t> low_halo, low_owned, high_owned, high_halo;
+  /// Local rows of the first and last owned planes (updated first, so that the exchange
+  /// overlaps the interior), and of the planes in between.
+  std::vector<std::int64_t> boundary_rows, interior_rows;
+};
+
 class SparseLattice {
  public:
   /// z-planes per slab (the unit an MPI decomposition would distribute).
@@ -92,12 +128,19 @@ class SparseLattice {
   /// Builds the stored-node list, segments and thread ranges. `threads` >= 1 is the number of
   /// work ranges (one per OpenMP thread); `element_bytes` (4 or 8) the population storage size,
   /// which sets the padded row stride the offsets use. Throws Error(kInvalidArgument) if the
-  /// lattice has no fluid node or more than 2^31 - 1 stored nodes.
-  SparseLattice(const arrays::VoxelGrid& grid, int threads, std::size_t element_bytes);
+  /// lattice has no fluid node or more than 2^31 - 1 stored nodes. `planes` selects a rank's
+  /// share of a decomposed box (default: the whole box).
+  SparseLattice(const arrays::VoxelGrid& grid, int threads, std::size_t element_bytes,
+                PlaneRange planes = {});
 
   const std::array<std::int64_t, 3>& dims() const { return dims_; }
   std::int64_t num_nodes() const { return dims_[0] * dims_[1] * dims_[2]; }
+  /// Owned fluid nodes (all of them without decomposition).
   std::int64_t num_fluid() const { return num_fluid_; }
+  const PlaneRange& planes() const { return planes_; }
+  bool decomposed() const { return planes_.decomposed; }
+  /// Empty without decomposition.
+  const HaloPlan& halo() const { return halo_; }
   /// Fluid plus ghost nodes.
   std::int64_t num_stored() const { return static_cast<std::int64_t>(node_.size()); }
   /// Row length of the population buffer (>= num_stored(), padded).
@@ -106,17 +149,15 @@ class SparseLattice {
   static std::int64_t padded_stride(std::int64_t num_stored, std::size_t bytes);
   /// Dense (voxel) index of stored node n.
   std::int64_t node(std::int64_t n) const { return node_[static_cast<std::size_t>(n)]; }
-  /// Stored index of a dense node, -1 if not stored.
-  std::int32_t stored_index(std::int64_t dense) const {
-    return stored_index_[static_cast<std::size_t>(dense)];
-  }
+  /// Stored index of a dense node (of the whole box), -1 if not stored here.
+  std::int32_t stored_index(std::int64_t dense) const;
   /// Bit i set: the neighbour x + c_i of stored fluid node n is solid (0 for ghosts).
   std::uint32_t solid_mask(std::int64_t n) const { return mask_[static_cast<std::size_t>(n)]; }
   const std::uint32_t* solid_masks() const { return mask_.data(); }
   std::array<std::int64_t, 3> coordinates(std::int64_t n) const;
 
-  /// x-rows (ny nz of them); row r = j + ny k.
-  std::int64_t num_rows() const { return dims_[1] * dims_[2]; }
+  /// Local x-rows (ny per local plane); row r = j + ny p, p the local plane.
+  std::int64_t num_rows() const { return dims_[1] * local_planes_; }
   /// Segments of row r: [row_segment_begin(r), row_segment_begin(r+1)).
   std::int64_t row_segment_begin(std::int64_t r) const {
     return row_segment_begin_[static_cast<std::size_t>(r)];
@@ -133,7 +174,7 @@ class SparseLattice {
   }
   std::int64_t range_segment_begin(int t) const { return row_segment_begin(range_row_begin(t)); }
   std::int64_t range_storage_begin(int t) const { return row_storage_begin(range_row_begin(t)); }
-  std::int64_t num_slabs() const { return (dims_[2] + kSlabPlanes - 1) / kSlabPlanes; }
+  std::int64_t num_slabs() const { return (local_planes_ + kSlabPlanes - 1) / kSlabPlanes; }
   /// Fluid nodes with a solid neighbour.
   std::int64_t num_wall() const { return num_wall_; }
   /// Mean segment length (fluid nodes per run of the neighbour table).
@@ -146,7 +187,18 @@ class SparseLattice {
   std::size_t memory_bytes() const;
 
  private:
+  /// Local plane of global plane k, -1 if not stored here.
+  std::int64_t local_plane(std::int64_t k) const;
+  bool owned_plane(std::int64_t p) const {
+    return !planes_.decomposed || (p > 0 && p + 1 < local_planes_);
+  }
+  void build_halo_plan(const arrays::VoxelGrid& grid);
+
   std::array<std::int64_t, 3> dims_{0, 0, 0};
+  PlaneRange planes_;
+  std::int64_t first_plane_ = 0;   ///< Global plane of local plane 0.
+  std::int64_t local_planes_ = 0;  ///< Stored planes (owned plus halo).
+  HaloPlan halo_;
   std::int64_t stride_ = 0;
   std::int64_t num_fluid_ = 0;
   std::int64_t num_wall_ = 0;

@@ -171,7 +171,8 @@ std::string RunResult::FullReport() const {
       << "steps                " << steps << " (characteristic time " << characteristic_steps
       << " steps)\n"
       << "wall time            " << format("%.4g", wall_s) << " s, " << format("%.4g", mflups)
-      << " MFLUPS, " << format("%.4g", static_cast<double>(memory_bytes) / 1048576.0) << " MiB\n";
+      << " MFLUPS, " << format("%.4g", static_cast<double>(memory_bytes) / 1048576.0) << " MiB"
+      << (ranks > 1 ? " on " + std::to_string(ranks) + " ranks" : std::string()) << "\n";
   for (const std::string& w : warnings) out << "warning              " << w << "\n";
   if (!history.empty()) {
     out << "history (last points): step, F, Re, relative change per characteristic time\n";
@@ -221,6 +222,7 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"boundary_links", boundary_links},
                       {"warnings", warnings}};
   if (o.collision == Collision::kTrt) j["magic"] = o.magic;
+  if (ranks > 1) j["ranks"] = ranks;  // a one-rank run's record stays as it always was
   j["d_hydrodynamic"] =
       o.use_hydrodynamic_diameter ? nlohmann::json(o.hydrodynamic_diameter) : nlohmann::json();
   // JSON has no NaN: what a failed run did not measure is null.

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 
@@ -275,11 +276,12 @@ template <typename T>
 class Solver final : public SolverBase {
  public:
   Solver(const SparseLattice& lattice, const LinkTable& links, const SolverSettings& settings,
-         int threads)
+         int threads, const mpi::Communicator& group)
       : lattice_(lattice),
         links_(links),
         settings_(settings),
         threads_(std::max(1, threads)),
+        group_(group),
         populations_(lattice, threads_) {
     // Small lattices: below ~32k fluid nodes per thread a step takes well under a millisecond
     // and the parallel region costs more than it saves (and much more when other processes
@@ -291,7 +293,12 @@ class Solver final : public SolverBase {
     for (std::size_t l = 0; l < links.size(); ++l) {
       if (l == 0 || links.node[l] != links.node[l - 1]) ++boundary_nodes_;
     }
-    boundary_nodes_ = std::max<std::int64_t>(1, boundary_nodes_);
+    boundary_nodes_ = std::max<std::int64_t>(1, group_.sum(boundary_nodes_));
+    const HaloPlan& plan = lattice.halo();
+    send_down_.resize(std::max(plan.low_owned.size(), plan.low_halo.size()));
+    send_up_.resize(std::max(plan.high_owned.size(), plan.high_halo.size()));
+    receive_down_.resize(send_down_.size());
+    receive_up_.resize(send_up_.size());
     set_force(settings.force_x);
   }
 
@@ -346,7 +353,7 @@ class Solver final : public SolverBase {
               jz += g * kC[i][2];
             }
             if (!finite) {
-              if (m.nonfinite_node < 0) m.nonfinite_node = n;
+              if (m.nonfinite_node < 0) m.nonfinite_node = lattice_.node(n);
               continue;
             }
             const double rho = 1.0 + drho;
@@ -359,11 +366,11 @@ class Solver final : public SolverBase {
             const double speed2 = ux * ux + uy * uy + uz * uz;
             if (speed2 > m.max_speed2 || m.max_speed_node < 0) {
               m.max_speed2 = speed2;
-              m.max_speed_node = n;
+              m.max_speed_node = lattice_.node(n);
             }
             if (rho < m.min_rho || m.min_rho_node < 0) {
               m.min_rho = rho;
-              m.min_rho_node = n;
+              m.min_rho_node = lattice_.node(n);
             }
           }
         }
@@ -374,6 +381,7 @@ class Solver final : public SolverBase {
         partial[static_cast<std::size_t>(r)] = m;
       }
     }
+    if (group_.size() > 1) partial = gather_moments(partial);
     MomentSummary total;
     for (const MomentSummary& m : partial) {
       for (int c = 0; c < 3; ++c) total.sum_u[c] += m.sum_u[c];
@@ -413,17 +421,21 @@ class Solver final : public SolverBase {
   }
 
   void fill_fields(Fields* fields) const override {
-    const std::int64_t total = lattice_.num_nodes();
-    fields->dims = lattice_.dims();
-    fields->velocity.assign(static_cast<std::size_t>(3 * total), 0.0f);
-    fields->density.assign(static_cast<std::size_t>(total), 0.0f);
-    fields->solid.assign(static_cast<std::size_t>(total), 1);
+    // This rank's planes of the dense grid (all of them without decomposition).
+    const PlaneRange& planes = lattice_.planes();
+    const std::int64_t plane_nodes = lattice_.dims()[0] * lattice_.dims()[1];
+    const std::int64_t offset = planes.begin * plane_nodes;
+    const std::int64_t total = (planes.end - planes.begin) * plane_nodes;
+    Fields local;
+    local.velocity.assign(static_cast<std::size_t>(3 * total), 0.0f);
+    local.density.assign(static_cast<std::size_t>(total), 0.0f);
+    local.solid.assign(static_cast<std::size_t>(total), 1);
     const T* base = populations_.data();
     const std::int64_t stride = populations_.stride();
     const double half_force = 0.5 * settings_.force_x;
     for (const Segment& sg : lattice_.segments()) {
       for (std::int64_t n = sg.first; n < sg.first + sg.length; ++n) {
-        const std::size_t d = static_cast<std::size_t>(lattice_.node(n));
+        const std::size_t d = static_cast<std::size_t>(lattice_.node(n) - offset);
         double drho = 0.0, j[3] = {half_force, 0.0, 0.0};
         for (int i = 0; i < kQ; ++i) {
           const double g = base[i * stride + n];
@@ -431,11 +443,22 @@ class Solver final : public SolverBase {
           for (int c = 0; c < 3; ++c) j[c] += g * kC[i][c];
         }
         const double inv = settings_.stokes ? 1.0 : 1.0 / (1.0 + drho);
-        for (int c = 0; c < 3; ++c) fields->velocity[3 * d + c] = static_cast<float>(j[c] * inv);
-        fields->density[d] = static_cast<float>(1.0 + drho);
-        fields->solid[d] = 0;
+        for (int c = 0; c < 3; ++c) local.velocity[3 * d + c] = static_cast<float>(j[c] * inv);
+        local.density[d] = static_cast<float>(1.0 + drho);
+        local.solid[d] = 0;
       }
     }
+    fields->dims = lattice_.dims();
+    if (group_.size() == 1) {
+      fields->velocity = std::move(local.velocity);
+      fields->density = std::move(local.density);
+      fields->solid = std::move(local.solid);
+      return;
+    }
+    // Rank r owns the planes after rank r - 1's: the gather in rank order is the dense order.
+    group_.gather_to_root(local.velocity, &fields->velocity);
+    group_.gather_to_root(local.density, &fields->density);
+    group_.gather_to_root(local.solid, &fields->solid);
   }
 
   std::size_t bytes() const override { return populations_.bytes(); }
@@ -467,6 +490,10 @@ class Solver final : public SolverBase {
 
   template <CollisionKernel K, bool kStokes>
   void step_with(int parity, std::vector<double>* body_force) {
+    if (lattice_.decomposed()) {
+      step_decomposed<K, kStokes>(parity, body_force);
+      return;
+    }
     T* base = populations_.data();
     const std::int64_t stride = populations_.stride();
     const KernelParams<T> p = params_;
@@ -513,20 +540,168 @@ class Solver final : public SolverBase {
         }
       }
     }
+    finish_step(parity, update, body_force);
+  }
+
+  /// The sums of a step's link pass: the mass defect and the body forces, over the work ranges
+  /// in a fixed order (the same result whatever the thread timing) and then over the ranks.
+  void finish_step(int parity, bool update, std::vector<double>* body_force) {
+    const std::size_t bodies = links_.num_bodies();
     if (update) {
       pending_defect_ = 0.0;
       for (double d : partial_defect_) pending_defect_ += d;
     }
-    if (body_force != nullptr) {
-      // Fixed summation order: the same result whatever the thread timing.
-      body_force->assign(3 * bodies, 0.0);
-      double magnitude = 0.0;
-      for (const auto& partial : partial_force_) {
-        for (std::size_t k = 0; k < 3 * bodies; ++k) (*body_force)[k] += partial[k];
-        magnitude += partial[3 * bodies];
-      }
-      force_magnitude_ = parity == 1 ? 0.5 * (force_magnitude_ + magnitude) : magnitude;
+    if (body_force == nullptr) {
+      if (update) pending_defect_ = group_.sum(pending_defect_);
+      return;
     }
+    std::vector<double> sums(3 * bodies + 2, 0.0);
+    for (const auto& partial : partial_force_) {
+      for (std::size_t k = 0; k <= 3 * bodies; ++k) sums[k] += partial[k];
+    }
+    sums[3 * bodies + 1] = pending_defect_;
+    group_.sum(&sums);  // one collective for the forces, their magnitude and the defect
+    if (update) pending_defect_ = sums[3 * bodies + 1];
+    body_force->assign(sums.begin(), sums.begin() + static_cast<std::ptrdiff_t>(3 * bodies));
+    const double magnitude = sums[3 * bodies];
+    force_magnitude_ = parity == 1 ? 0.5 * (force_magnitude_ + magnitude) : magnitude;
+  }
+
+  /// One step of a rank of a decomposed box: the sweep of the two boundary planes, then the
+  /// interior sweep while the populations crossing the interfaces travel (see HaloPlan), then
+  /// the link pass once they have arrived (links next to an interface read them).
+  template <CollisionKernel K, bool kStokes>
+  void step_decomposed(int parity, std::vector<double>* body_force) {
+    T* base = populations_.data();
+    const std::int64_t stride = populations_.stride();
+    const KernelParams<T> p = params_;
+    const int ranges = lattice_.num_ranges();
+    const Segment* segments = lattice_.segments().data();
+    const std::uint32_t* masks = lattice_.solid_masks();
+    const bool update = settings_.interpolated;
+    const bool links = update || body_force != nullptr;
+    const std::size_t bodies = links_.num_bodies();
+    if (body_force != nullptr) {
+      for (auto& partial : partial_force_) partial.assign(3 * bodies + 1, 0.0);
+    }
+    for (auto& d : partial_defect_) d = 0.0;
+    const double correction = settings_.mass_correction && update
+                                  ? pending_defect_ / static_cast<double>(boundary_nodes_)
+                                  : 0.0;
+    const HaloPlan& plan = lattice_.halo();
+    // Even step: the owned values go out, the halo's come in; odd step: the values this rank's
+    // nodes wrote into the halo go back to their owners.
+    const auto& send_down = parity == 0 ? plan.low_owned : plan.low_halo;
+    const auto& send_up = parity == 0 ? plan.high_owned : plan.high_halo;
+    const auto& receive_down = parity == 0 ? plan.low_halo : plan.low_owned;
+    const auto& receive_up = parity == 0 ? plan.high_halo : plan.high_owned;
+    auto sweep = [&](std::int64_t r) {
+      const Segment* first = segments + lattice_.row_segment_begin(r);
+      const Segment* last = segments + lattice_.row_segment_begin(r + 1);
+      if (parity == 0) {
+        even_sweep<T, K, kStokes>(base, stride, first, last, p);
+      } else {
+        odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p);
+      }
+    };
+    const std::int64_t boundary_rows = static_cast<std::int64_t>(plan.boundary_rows.size());
+    const std::int64_t interior_rows = static_cast<std::int64_t>(plan.interior_rows.size());
+    std::exception_ptr failure;
+#pragma omp parallel num_threads(threads_)
+    {
+#pragma omp for schedule(dynamic, 4)
+      for (std::int64_t b = 0; b < boundary_rows; ++b) {
+        sweep(plan.boundary_rows[static_cast<std::size_t>(b)]);
+      }
+#pragma omp master
+      {
+        try {
+          for (std::size_t k = 0; k < send_down.size(); ++k) send_down_[k] = base[send_down[k]];
+          for (std::size_t k = 0; k < send_up.size(); ++k) send_up_[k] = base[send_up[k]];
+          exchange_.start(group_, send_down_.data(), send_down.size() * sizeof(T), send_up_.data(),
+                          send_up.size() * sizeof(T), receive_down_.data(),
+                          receive_down.size() * sizeof(T), receive_up_.data(),
+                          receive_up.size() * sizeof(T));
+        } catch (...) {
+          failure = std::current_exception();
+        }
+      }
+#pragma omp for schedule(dynamic, 16)
+      for (std::int64_t b = 0; b < interior_rows; ++b) {
+        sweep(plan.interior_rows[static_cast<std::size_t>(b)]);
+      }
+#pragma omp master
+      {
+        if (!failure) {
+          try {
+            exchange_.wait();
+            for (std::size_t k = 0; k < receive_down.size(); ++k) {
+              base[receive_down[k]] = receive_down_[k];
+            }
+            for (std::size_t k = 0; k < receive_up.size(); ++k)
+              base[receive_up[k]] = receive_up_[k];
+          } catch (...) {
+            failure = std::current_exception();
+          }
+        }
+      }
+#pragma omp barrier
+      if (links && !failure) {
+        for (int t = thread_id(); t < ranges; t += team_size()) {
+          const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
+          for (std::int64_t r = r0; r < r1; ++r) {
+            link_row(t, r, parity, update, body_force != nullptr, correction);
+          }
+        }
+      }
+    }
+    if (failure) std::rethrow_exception(failure);
+    finish_step(parity, update, body_force);
+  }
+
+  /// Every rank's work-range summaries, in rank order (nodes are dense indices already).
+  std::vector<MomentSummary> gather_moments(const std::vector<MomentSummary>& mine) const {
+    constexpr std::size_t kFields = 9;
+    // The ranks may have different numbers of work ranges: gather one summary per rank.
+    MomentSummary own;
+    for (const MomentSummary& m : mine) {
+      for (int c = 0; c < 3; ++c) own.sum_u[c] += m.sum_u[c];
+      own.sum_drho += m.sum_drho;
+      if (m.nonfinite_node >= 0 && own.nonfinite_node < 0) own.nonfinite_node = m.nonfinite_node;
+      if (m.max_speed_node >= 0 && (own.max_speed_node < 0 || m.max_speed2 > own.max_speed2)) {
+        own.max_speed2 = m.max_speed2;
+        own.max_speed_node = m.max_speed_node;
+      }
+      if (m.min_rho_node >= 0 && (own.min_rho_node < 0 || m.min_rho < own.min_rho)) {
+        own.min_rho = m.min_rho;
+        own.min_rho_node = m.min_rho_node;
+      }
+    }
+    const std::vector<double> one = {own.sum_u[0],
+                                     own.sum_u[1],
+                                     own.sum_u[2],
+                                     own.sum_drho,
+                                     own.max_speed2,
+                                     static_cast<double>(own.max_speed_node),
+                                     own.min_rho,
+                                     static_cast<double>(own.min_rho_node),
+                                     static_cast<double>(own.nonfinite_node)};
+    const std::vector<double> all = group_.allgather(one);
+    std::vector<MomentSummary> out(static_cast<std::size_t>(group_.size()));
+    for (std::size_t r = 0; r < out.size(); ++r) {
+      const double* v = all.data() + kFields * r;
+      MomentSummary& m = out[r];
+      m.sum_u[0] = v[0];
+      m.sum_u[1] = v[1];
+      m.sum_u[2] = v[2];
+      m.sum_drho = v[3];
+      m.max_speed2 = v[4];
+      m.max_speed_node = static_cast<std::int64_t>(v[5]);
+      m.min_rho = v[6];
+      m.min_rho_node = static_cast<std::int64_t>(v[7]);
+      m.nonfinite_node = static_cast<std::int64_t>(v[8]);
+    }
+    return out;
   }
 
   /// The links of x-row `row` (see solver.h): interpolated bounce-back with the mass
@@ -589,7 +764,10 @@ class Solver final : public SolverBase {
   const LinkTable& links_;
   SolverSettings settings_;
   int threads_;
+  mpi::Communicator group_;
   Populations<T> populations_;
+  mpi::Communicator::RingExchange exchange_;
+  std::vector<T> send_down_, send_up_, receive_down_, receive_up_;  ///< Halo message buffers.
   KernelParams<T> params_;
   std::vector<double> even_force_;
   std::vector<std::vector<double>> partial_force_;  ///< Per work range.
@@ -603,11 +781,11 @@ class Solver final : public SolverBase {
 
 std::unique_ptr<SolverBase> make_solver(Precision precision, const SparseLattice& lattice,
                                         const LinkTable& links, const SolverSettings& settings,
-                                        int threads) {
+                                        int threads, const mpi::Communicator& group) {
   if (precision == Precision::kFloat) {
-    return std::make_unique<Solver<float>>(lattice, links, settings, threads);
+    return std::make_unique<Solver<float>>(lattice, links, settings, threads, group);
   }
-  return std::make_unique<Solver<double>>(lattice, links, settings, threads);
+  return std::make_unique<Solver<double>>(lattice, links, settings, threads, group);
 }
 
 }  // namespace lbm

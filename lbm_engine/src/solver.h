@@ -25,12 +25,14 @@
 
 #include "collision.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/mpi/communicator.h"
 #include "lattice.h"
 
 namespace draglab {
 namespace lbm {
 
-/// Reductions of the moment sweep (velocities u = j/rho, or j in Stokes mode).
+/// Reductions of the moment sweep (velocities u = j/rho, or j in Stokes mode), over every rank
+/// of a decomposed box. Nodes are dense indices in the whole box.
 struct MomentSummary {
   double sum_u[3] = {0, 0, 0};  ///< Sum over fluid nodes.
   double max_speed2 = 0.0;      ///< max |u|^2.
@@ -67,7 +69,8 @@ class SolverBase {
   /// Multiplies every population deviation g_i = f_i - w_i by `factor` (rescales a Stokes
   /// solution exactly when the force is rescaled by the same factor).
   virtual void scale_deviations(double factor) = 0;
-  /// Velocity (3 per node), density and solid mask on the dense grid, x fastest.
+  /// Velocity (3 per node), density and solid mask on the dense grid, x fastest; gathered on
+  /// the first rank of a decomposed box (the others get the dims only). Collective.
   virtual void fill_fields(Fields* fields) const = 0;
   virtual std::size_t bytes() const = 0;
   /// g_i = f_i - w_i of fluid node n in the streamed layout (pre-collision, as after
@@ -76,10 +79,14 @@ class SolverBase {
   virtual void set_deviation(int i, std::int64_t n, double value) = 0;
 };
 
-/// Makes a solver storing populations in double or float (computing in the same type).
+/// Makes a solver storing populations in double or float (computing in the same type). A
+/// decomposed lattice needs `group`, the ranks of its box in plane order (the solver's steps,
+/// moments and field output are then collective); the body forces, the force magnitude and
+/// the moments it returns are sums over all ranks, the same bits on each.
 std::unique_ptr<SolverBase> make_solver(Precision precision, const SparseLattice& lattice,
                                         const LinkTable& links, const SolverSettings& settings,
-                                        int threads);
+                                        int threads,
+                                        const mpi::Communicator& group = mpi::Communicator::self());
 
 }  // namespace lbm
 }  // namespace draglab

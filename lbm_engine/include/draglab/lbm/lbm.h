@@ -77,6 +77,7 @@
 
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/voxelization.h"
+#include "draglab/mpi/communicator.h"
 
 namespace draglab {
 namespace lbm {
@@ -125,7 +126,11 @@ struct RunOptions {
   double min_gap_nodes = 0.0;
   bool use_hydrodynamic_diameter = false;  ///< Normalise with a calibrated d_h (bounce-back).
   double hydrodynamic_diameter = 0.0;      ///< d_h in lattice units when the above is set.
-  int threads = 0;                         ///< OpenMP threads; 0 = all.
+  int threads = 0;  ///< OpenMP threads per rank; 0 = all (shared by the ranks of a node).
+  /// The ranks that share this box, each a slab of z-planes (at least 2 planes per rank), in
+  /// rank order along z: every rank of the group calls run() with the same grid and options,
+  /// and gets the same result (fields on the group's rank 0 only). Default: this process alone.
+  mpi::Communicator ranks = mpi::Communicator::self();
   bool throw_on_failure = true;  ///< Throw draglab::Error on divergence / non-convergence.
   bool IsValid(std::string* error) const;
 };
@@ -163,6 +168,7 @@ struct RunResult {
   // Additions (engine diagnostics).
   std::vector<std::string> warnings;  ///< Non-fatal findings (Mach above 0.1, boundary fallbacks).
   std::int64_t fluid_nodes = 0;       ///< Fluid nodes updated per step.
+  int ranks = 1;                      ///< MPI ranks that shared the box.
   std::int64_t boundary_links = 0;    ///< Links of all bodies.
   /// Interpolated links that fell back to halfway bounce-back (second node solid).
   std::int64_t fallback_links = 0;
