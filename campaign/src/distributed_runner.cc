@@ -11,6 +11,12 @@
 // rank, and a late result from it is refused by the token check. When rank 0 dies, the workers
 // notice its silence and end; `--resume` on any number of ranks finishes the campaign.
 //
+// Units on several ranks ([lbm] ranks_per_unit = k > 1): the workers form groups of k
+// consecutive ranks (the last one smaller if k does not divide N - 1), each with its own
+// communicator. Rank 0 talks to each group's first rank, the leader, exactly as to a worker; the
+// leader passes every unit (and the stop) on to its group by a broadcast, and the group runs the
+// unit's box together (lbm::RunOptions::ranks), the leader sending the outcome back.
+//
 // Messages (tags below) are JSON text.
 #include <unistd.h>
 
@@ -30,6 +36,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/mpi/communicator.h"
 #include "draglab/mpi/world.h"
 #include "runner_internal.h"
 
@@ -73,6 +80,20 @@ int workers_on_this_node() {
   return std::max(1, mpi::local_size() - (mpi::rank0_is_local() ? 1 : 0));
 }
 
+/// Units run at once on this node: its worker ranks, k of them per unit.
+int units_on_this_node(int ranks_per_unit) {
+  return std::max(1, (workers_on_this_node() + ranks_per_unit - 1) / ranks_per_unit);
+}
+
+/// The group of a worker rank (ranks 1..N-1 in groups of k consecutive ranks); rank 0 alone.
+/// Collective over the world; only when k > 1.
+mpi::Communicator unit_group(int ranks_per_unit) {
+  const int r = mpi::rank();
+  return mpi::Communicator::world().split(r == 0 ? 0 : 1 + (r - 1) / ranks_per_unit, r);
+}
+
+bool leads_a_group(int rank, int ranks_per_unit) { return (rank - 1) % ranks_per_unit == 0; }
+
 // ---- rank 0 -------------------------------------------------------------------------------
 
 struct WorkerState {
@@ -90,8 +111,11 @@ struct WorkerState {
   std::string token;
 };
 
-std::string go_message(bool ok, int exit_code, const std::string& spec_json) {
-  return nlohmann::json{{"ok", ok}, {"exit_code", exit_code}, {"spec", spec_json}}.dump();
+std::string go_message(bool ok, int exit_code, const std::string& spec_json,
+                       int ranks_per_unit = 1) {
+  return nlohmann::json{
+      {"ok", ok}, {"exit_code", exit_code}, {"spec", spec_json}, {"ranks_per_unit", ranks_per_unit}}
+      .dump();
 }
 
 CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
@@ -100,7 +124,7 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
   OpenedCampaign opened;
   try {
     validate_run(spec, options);
-    opened = open_campaign(db_path, spec, options, workers_on_this_node());
+    opened = open_campaign(db_path, spec, options, units_on_this_node(spec.ranks_per_unit));
   } catch (const Error& e) {
     broadcast_no_go(e.is_bad_input() ? 2 : 1);
     throw;
@@ -108,15 +132,20 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
     broadcast_no_go(1);
     throw;
   }
-  std::string go = go_message(true, 0, spec.to_json());
+  const int k = spec.ranks_per_unit;
+  std::string go = go_message(true, 0, spec.to_json(), k);
   mpi::broadcast(&go);
+  if (k > 1) unit_group(k);  // rank 0 takes part in the split, alone in its group
 
   Database& db = *opened.db;
   const std::string base_token = mpi::host_name() + ":" + std::to_string(::getpid()) + ":rank";
-  std::map<int, WorkerState> workers;
+  std::map<int, WorkerState> workers;  // by rank; with groups, their leaders
   for (int r = 1; r < ranks; ++r) {
+    if (!leads_a_group(r, k)) continue;
+    const int last = std::min(ranks - 1, r + k - 1);
     workers[r].token = base_token + std::to_string(r);
-    workers[r].report.name = "rank " + std::to_string(r);
+    workers[r].report.name = last == r ? "rank " + std::to_string(r)
+                                       : "ranks " + std::to_string(r) + "-" + std::to_string(last);
   }
   std::int64_t finished = opened.finished_before, failed_session = 0;
   std::int64_t in_flight = 0;
@@ -361,6 +390,25 @@ class Heartbeat {
                                   "; the campaign continues with --resume");
 }
 
+/// A rank of a unit group other than its leader: runs the units its leader passes on, with the
+/// group, until the leader passes on the stop.
+CampaignStatus run_group_member(const CampaignSpec& spec, const mpi::Communicator& group,
+                                int threads) {
+  std::atomic<double> fraction{0.0};
+  for (;;) {
+    std::string text;
+    group.broadcast(&text);
+    const nlohmann::json j = nlohmann::json::parse(text);
+    if (j.contains("stop")) {
+      if (j.value("peer_lost", false)) mpi::mark_peer_lost();
+      const int exit_code = j.value("exit_code", 0);
+      if (exit_code != 0) throw mpi::EndedByRank0(exit_code);
+      return CampaignStatus{};
+    }
+    execute_unit(spec, unit_from_json(j.at("unit")), threads, &fraction, group);
+  }
+}
+
 CampaignStatus run_worker(const RunCampaignOptions& options) {
   std::string go;
   mpi::broadcast(&go);
@@ -368,12 +416,21 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
   if (!g.at("ok").get<bool>()) throw mpi::EndedByRank0(g.at("exit_code").get<int>());
   // The spec as rank 0 read it: the workers need no copy of the spec file.
   const CampaignSpec spec = internal::spec_from_json(g.at("spec").get<std::string>());
+  const int k = g.value("ranks_per_unit", 1);
+  const mpi::Communicator group = k > 1 ? unit_group(k) : mpi::Communicator::self();
   const int threads = worker_threads(options);
+  if (!leads_a_group(mpi::rank(), k)) return run_group_member(spec, group, threads);
+  // The leader passes the stop on to its group before it ends (or throws).
+  auto pass_stop = [&group](bool peer_lost, int exit_code) {
+    std::string text =
+        nlohmann::json{{"stop", true}, {"peer_lost", peer_lost}, {"exit_code", exit_code}}.dump();
+    group.broadcast(&text);
+  };
   // This node's memory, for its workers' largest units: a refusal goes to rank 0, which stops
   // the run with it (exit 2 on every rank).
   std::string memory_error;
   try {
-    check_memory(spec, workers_on_this_node());
+    check_memory(spec, units_on_this_node(k));
   } catch (const Error& e) {
     memory_error = e.what();
   }
@@ -400,16 +457,23 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
     heard = Clock::now();
     if (m.tag == kStop) {
       const auto j = nlohmann::json::parse(m.text, nullptr, false);
-      if (j.is_object() && j.value("peer_lost", false)) mpi::mark_peer_lost();
+      const bool lost = j.is_object() && j.value("peer_lost", false);
+      if (lost) mpi::mark_peer_lost();
       const int exit_code = j.is_object() ? j.value("exit_code", 0) : 0;
+      pass_stop(lost, exit_code);
       if (exit_code != 0) throw mpi::EndedByRank0(exit_code);
       break;
     }
     if (m.tag != kUnit) continue;  // a ping
-    const ClaimedUnit unit = unit_from_json(nlohmann::json::parse(m.text));
+    const nlohmann::json unit_json = nlohmann::json::parse(m.text);
+    const ClaimedUnit unit = unit_from_json(unit_json);
+    if (group.size() > 1) {
+      std::string text = nlohmann::json{{"unit", unit_json}}.dump();
+      group.broadcast(&text);
+    }
     fraction.store(0.0);
     current.store(unit.id);
-    const UnitOutcome o = execute_unit(spec, unit, threads, &fraction);
+    const UnitOutcome o = execute_unit(spec, unit, threads, &fraction, group);
     current.store(-1);
     if (!mpi::send(0, kResult, outcome_to_json(o).dump(), kSendSeconds)) {
       rank0_gone("rank 0 did not take a result");

@@ -152,7 +152,7 @@ bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token
 }
 
 UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int threads,
-                         std::atomic<double>* fraction) {
+                         std::atomic<double>* fraction, const mpi::Communicator& group) {
   UnitOutcome out;
   const auto start = Clock::now();
   try {
@@ -168,6 +168,7 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
     ro.tolerance = spec.tolerance;
     ro.max_steps = spec.max_steps;
     ro.threads = threads;
+    ro.ranks = group;
     ro.throw_on_failure = false;  // a failed unit is a result: recorded with its diagnosis
     out.run = lbm::run(packing, unit.resolution, ro, [fraction](double f, const std::string&) {
       fraction->store(std::clamp(f, 0.0, 1.0));
@@ -491,6 +492,16 @@ void validate_run(const CampaignSpec& spec, const RunCampaignOptions& options) {
     throw Error(ErrorCode::kInvalidArgument,
                 "worker timeout = " + core::format_number(options.worker_timeout_s) +
                     " s is outside [1, 86400]");
+  }
+  const int job = mpi::size();
+  if (spec.ranks_per_unit > 1 && spec.ranks_per_unit > job - 1) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "[lbm] ranks_per_unit = " + std::to_string(spec.ranks_per_unit) +
+                    " is larger than the job: a unit on " + std::to_string(spec.ranks_per_unit) +
+                    " ranks needs at least " + std::to_string(spec.ranks_per_unit + 1) +
+                    " (rank 0 holds the database), and this job has " + std::to_string(job) +
+                    "; start it with mpirun -np " + std::to_string(spec.ranks_per_unit + 1) +
+                    " or more, or lower ranks_per_unit");
   }
 }
 

@@ -13,6 +13,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/mpi/communicator.h"
 
 namespace draglab {
 namespace campaign {
@@ -75,9 +76,11 @@ DatabaseOptions worker_db_options();
 bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token,
                 ClaimedUnit* unit);
 
-/// Generates the unit's packing and runs the LBM engine; failures are outcomes, not exceptions.
+/// Generates the unit's packing and runs the LBM engine, on the ranks of `group` together
+/// (every one of them calls it with the same unit); failures are outcomes, not exceptions.
 UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int threads,
-                         std::atomic<double>* fraction);
+                         std::atomic<double>* fraction,
+                         const mpi::Communicator& group = mpi::Communicator::self());
 
 /// Commits an outcome; false if the unit was no longer claimed by `token` (nothing written).
 bool commit_unit(Database& db, const ClaimedUnit& unit, const std::string& token,

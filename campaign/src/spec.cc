@@ -41,7 +41,7 @@ const core::toml_schema::Schema& sections() {
       {"grid", {"phi", "re", "realizations", "seed"}},
       {"packing",
        {"spheres", "box_size", "distribution", "size_ratio", "large_fraction", "sigma", "min_gap"}},
-      {"lbm", {"resolutions", "collision", "boundary", "tolerance", "max_steps"}},
+      {"lbm", {"resolutions", "collision", "boundary", "tolerance", "max_steps", "ranks_per_unit"}},
       {"dataset", {"extrapolation"}},
   };
   return s;
@@ -141,6 +141,10 @@ bool CampaignSpec::IsValid(std::string* error) const {
   if (max_steps < 1 || max_steps > 100000000) {
     return fail(error,
                 "[lbm] max_steps = " + std::to_string(max_steps) + " is outside [1, 100000000]");
+  }
+  if (ranks_per_unit < 1 || ranks_per_unit > kMaxRanksPerUnit) {
+    return fail(error, "[lbm] ranks_per_unit = " + std::to_string(ranks_per_unit) +
+                           " is outside [1, " + std::to_string(kMaxRanksPerUnit) + "]");
   }
   if (extrapolation != "richardson" && extrapolation != "inverse_d" && extrapolation != "finest") {
     return fail(error, "[dataset] extrapolation = '" + extrapolation +
@@ -283,6 +287,14 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
         bad(field + " = " + std::to_string(v) + " is outside [1, 100000000]");
       }
       s.max_steps = v;
+    }
+    if (id == "lbm.ranks_per_unit") {
+      const std::int64_t v = integer();
+      if (v < 1 || v > kMaxRanksPerUnit) {
+        bad(field + " = " + std::to_string(v) + " is outside [1, " +
+            std::to_string(kMaxRanksPerUnit) + "] (MPI ranks that share one unit's box)");
+      }
+      s.ranks_per_unit = static_cast<int>(v);
     }
     if (id == "dataset.extrapolation") s.extrapolation = text();
   });

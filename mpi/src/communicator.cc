@@ -71,6 +71,37 @@ Communicator Communicator::world() {
   return self();
 }
 
+Communicator Communicator::split(int color, int key) const {
+  if (size_ == 1) return *this;
+#if DRAGLAB_HAVE_MPI
+  MPI_Comm part = MPI_COMM_NULL;
+  check(MPI_Comm_split(comm(handle_), color, key, &part), "MPI_Comm_split");
+  int rank = 0, size = 1;
+  MPI_Comm_rank(part, &rank);
+  MPI_Comm_size(part, &size);
+  // Kept for the life of the process (MPI_Finalize frees it): a handful per run.
+  return Communicator(static_cast<int>(MPI_Comm_c2f(part)), rank, size);
+#else
+  (void)color, (void)key;
+  throw std::logic_error("mpi: a communicator of several ranks in a build without MPI");
+#endif
+}
+
+void Communicator::broadcast(std::string* text) const {
+  if (size_ == 1) return;
+#if DRAGLAB_HAVE_MPI
+  long long length = static_cast<long long>(text->size());
+  check(MPI_Bcast(&length, 1, MPI_LONG_LONG, 0, comm(handle_)), "MPI_Bcast");
+  text->resize(static_cast<std::size_t>(length));
+  check(MPI_Bcast(text->data(), checked_count(text->size(), "a broadcast text"), MPI_CHAR, 0,
+                  comm(handle_)),
+        "MPI_Bcast");
+#else
+  (void)text;
+  throw std::logic_error("mpi: a communicator of several ranks in a build without MPI");
+#endif
+}
+
 std::vector<double> Communicator::allgather(const std::vector<double>& mine) const {
   if (size_ == 1) return mine;
 #if DRAGLAB_HAVE_MPI

@@ -155,6 +155,30 @@ TEST(CampaignSpec, OtherRangesAndTypes) {
             std::string::npos);
 }
 
+TEST(CampaignSpec, RanksPerUnitIsCheckedAndNotPartOfTheIdentity) {
+  const CampaignSpec one = parse_campaign_spec_text(kValid, "spec.toml");
+  EXPECT_EQ(one.ranks_per_unit, 1);  // default: a unit on one rank
+  const CampaignSpec four = parse_campaign_spec_text(
+      edit("max_steps = 50000", "max_steps = 50000\nranks_per_unit = 4"), "spec.toml");
+  EXPECT_EQ(four.ranks_per_unit, 4);
+  // How a unit is computed, not what: the same canonical text, so the same campaign resumes.
+  EXPECT_EQ(four.to_json(), one.to_json());
+  EXPECT_NE(parse_error(edit("max_steps = 50000", "max_steps = 50000\nranks_per_unit = 0"))
+                .find("[lbm] ranks_per_unit = 0 is outside [1, 4096]"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("max_steps = 50000", "max_steps = 50000\nranks_per_unit = 5000"))
+                .find("[lbm] ranks_per_unit = 5000 is outside [1, 4096]"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("max_steps = 50000", "max_steps = 50000\nranks_per_unit = 1.5"))
+                .find("[lbm] ranks_per_unit must be an integer"),
+            std::string::npos);
+  CampaignSpec bad = one;
+  bad.ranks_per_unit = -2;
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("[lbm] ranks_per_unit = -2"), std::string::npos) << error;
+}
+
 TEST(CampaignSpec, ForcedGapThatJamsIsRefusedWithTheLimit) {
   // phi = 0.5 with a forced gap of 0.12 d: padded solids fraction 0.5 * 1.12^3 = 0.70 > 0.62;
   // the gap may be at most (0.62/0.5)^(1/3) - 1 = 0.0743 d.

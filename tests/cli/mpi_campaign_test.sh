@@ -9,7 +9,11 @@
 #   3. the whole job killed (SIGKILL to mpirun and every rank) with units in flight, then
 #      `--resume` on 3 ranks: complete, the reference dataset id, no duplicate, `db check` clean;
 #   4. bad input: another command under several ranks, and a spec rank 0 cannot read: exit 2 on
-#      every rank with a message, no rank left waiting, nothing written.
+#      every rank with a message, no rank left waiting, nothing written;
+#   5. units on several ranks ([lbm] ranks_per_unit = 2) on 4 ranks (a group of 2 and one of 1):
+#      every unit's F equals the reference to 1e-10 relative (the decomposed box sums in another
+#      order: round-off, see mpi_lbm_test.sh); ranks_per_unit larger than the job, on 3 ranks and
+#      in one process: exit 2, named once, nothing written.
 # Usage: mpi_campaign_test.sh DRAGLAB SPEC MPIRUN
 set -u
 draglab="$(realpath "$1")"
@@ -143,8 +147,8 @@ if [ "$rc" -ne 0 ]; then tail -5 whole2.err; fi
 run_mpi -np 2 "$draglab" --db "$work/other.db" law list >other.out 2>other.err
 rc=$?
 check "law list on 2 ranks: exit 2 (got $rc)" test "$rc" -eq 2
-check "law list on 2 ranks: says only campaign run runs across ranks" \
-  grep -q "only .draglab campaign run. runs across ranks" other.err
+check "law list on 2 ranks: says only campaign run and lbm run run across ranks" \
+  grep -q "only .draglab campaign run. and .draglab lbm run. run across" other.err
 check "law list on 2 ranks: no database written" test ! -e "$work/other.db"
 
 run_mpi -np 3 "$draglab" --db "$work/nospec.db" campaign run "$work/nosuch.toml" \
@@ -155,5 +159,36 @@ check "a spec rank 0 cannot read, on 3 ranks: exit 2, no rank left waiting (got 
 check "a spec rank 0 cannot read: named once, by rank 0" \
   test "$(grep -c 'nosuch.toml' nospec.err)" -eq 1
 check "a spec rank 0 cannot read: no database written" test ! -e "$work/nospec.db"
+
+# --- 5. units on several ranks -------------------------------------------------------------------
+sed 's/^resolutions = .*/resolutions = [12]\nranks_per_unit = 2/' "$spec_src" >spec2.toml
+run_mpi -np 4 "$draglab" --db "$work/group.db" campaign run spec2.toml --threads-per-unit 1 \
+  >group.out 2>group.err
+rc=$?
+check "ranks_per_unit = 2 on 4 ranks: exit 0 (got $rc)" test "$rc" -eq 0
+check "ranks_per_unit = 2: every unit done" test "$(units "$work/group.db" done)" -eq "$units_total"
+same_units=$(sqlite3 one.db "ATTACH '$work/group.db' AS g; SELECT count(*) FROM campaign_units a
+  JOIN g.campaign_units b USING (phi_index, re_index, realization, resolution_index)
+  WHERE a.status = 'done' AND b.status = 'done' AND abs(b.F / a.F - 1) < 1e-10")
+check "ranks_per_unit = 2: every unit's F equals the reference to 1e-10 ($same_units of $units_total)" \
+  test "$same_units" -eq "$units_total"
+check "ranks_per_unit = 2: units ran on 2 ranks" \
+  test "$(sqlite3 "$work/group.db" "SELECT count(*) FROM campaign_units WHERE json_extract(result_json, '\$.ranks') = 2")" -ge 1
+check "ranks_per_unit = 2: the groups are reported (ranks 1-2, rank 3)" \
+  bash -c "grep -q '^ranks 1-2 ' group.out && grep -q '^rank 3 ' group.out"
+check "ranks_per_unit = 2: db check clean" "$draglab" --db "$work/group.db" db check
+
+sed 's/^resolutions = .*/resolutions = [12]\nranks_per_unit = 3/' "$spec_src" >spec3.toml
+run_mpi -np 3 "$draglab" --db "$work/big.db" campaign run spec3.toml >big.out 2>big.err
+rc=$?
+check "ranks_per_unit = 3 on 3 ranks: exit 2 (got $rc)" test "$rc" -eq 2
+check "ranks_per_unit = 3 on 3 ranks: named once, with the job size it needs" \
+  test "$(grep -c 'ranks_per_unit = 3 is larger than the job.*at least 4' big.err)" -eq 1
+check "ranks_per_unit = 3 on 3 ranks: no database written" test ! -e "$work/big.db"
+"$draglab" --db "$work/big1.db" campaign run spec3.toml >big1.out 2>big1.err
+rc=$?
+check "ranks_per_unit = 3 in one process: exit 2 (got $rc)" test "$rc" -eq 2
+check "ranks_per_unit = 3 in one process: named, no database written" \
+  bash -c "grep -q 'ranks_per_unit = 3 is larger than the job' big1.err && [ ! -e '$work/big1.db' ]"
 
 exit "$fail"

@@ -29,6 +29,8 @@ namespace campaign {
 
 /// A campaign spec (TOML). Every field is validated by IsValid and by parse_campaign_spec, which
 /// names the field and the allowed range in its Error(kInvalidArgument).
+constexpr int kMaxRanksPerUnit = 4096;
+
 struct CampaignSpec {
   std::string name;                   ///< [campaign] name, non-empty.
   std::string description;            ///< [campaign] description (optional).
@@ -49,6 +51,11 @@ struct CampaignSpec {
   std::string boundary = "ibb";     ///< [lbm] ibb or bb.
   double tolerance = 1e-5;          ///< [lbm] convergence tolerance (relative change per T).
   std::int64_t max_steps = 200000;  ///< [lbm] step limit of one unit.
+  /// [lbm] MPI ranks that share each unit's box (slabs of z-planes, lbm::RunOptions::ranks), [1,
+  /// kMaxRanksPerUnit]; > 1 needs a job of at least 1 + ranks_per_unit ranks. How a unit is
+  /// computed, not what: it is not part of the spec's identity (to_json), so a campaign may be
+  /// resumed with another value (the drag agrees to round-off).
+  int ranks_per_unit = 1;
   std::string extrapolation = "richardson";  ///< [dataset] richardson, inverse_d or finest.
   bool IsValid(std::string* error) const;
   /// Canonical JSON text (stored with the campaign; its hash identifies the spec).

@@ -29,6 +29,12 @@ class Communicator {
   int size() const { return size_; }
   bool is_root() const { return rank_ == 0; }
 
+  /// The ranks of this communicator that pass the same `color` (>= 0), ordered by `key` then
+  /// rank: a new communicator per color. Collective over this communicator.
+  Communicator split(int color, int key) const;
+  /// Rank 0's `text` to every rank of the group (the others' is replaced). Collective.
+  void broadcast(std::string* text) const;
+
   /// Every rank's `mine` (the same length on every rank), concatenated in rank order, on every
   /// rank. Collective.
   std::vector<double> allgather(const std::vector<double>& mine) const;
