@@ -122,6 +122,23 @@ CampaignLock::CampaignLock(const std::string& db_path, std::int64_t campaign_id,
     [[maybe_unused]] const ssize_t w = ::pwrite(fd_, me.data(), me.size(), 0);
   }
 }
+void CampaignLock::check_filesystem(const std::string& db_path) {
+  const std::string probe = db_path + ".campaign-probe-" + std::to_string(::getpid()) + ".lock";
+  const int fd = ::open(probe.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) return;  // a folder that cannot be written: the database reports it
+  const int locked = ::flock(fd, LOCK_EX | LOCK_NB);
+  const int error = errno;
+  ::close(fd);
+  ::unlink(probe.c_str());
+  if (locked != 0) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "cannot lock '" + probe + "': " + std::strerror(error) +
+                    ": the database's filesystem does not support locks (a network "
+                    "filesystem?); put the database on a local disk of the node that runs "
+                    "the campaign (rank 0 under MPI)");
+  }
+}
+
 CampaignLock::~CampaignLock() {
   if (fd_ >= 0) ::close(fd_);  // releases the flock
 }
@@ -308,6 +325,8 @@ void check_memory(const CampaignSpec& spec, int workers) {
 OpenedCampaign open_campaign(const std::string& db_path, const CampaignSpec& spec,
                              const RunCampaignOptions& options, int workers_per_node) {
   check_memory(spec, workers_per_node);
+  // Before anything is written: a campaign that could not be locked must not leave a database.
+  CampaignLock::check_filesystem(db_path);
   OpenedCampaign c;
   c.db = std::make_unique<Database>(db_path);
   Database& db = *c.db;

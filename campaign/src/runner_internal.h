@@ -27,6 +27,9 @@ class CampaignLock {
  public:
   CampaignLock(const std::string& db_path, std::int64_t campaign_id, const std::string& name);
   ~CampaignLock();
+  /// Throws Error(kInvalidArgument) when the filesystem of `db_path` cannot take a lock (a
+  /// probe file next to it, removed again), before the campaign writes anything.
+  static void check_filesystem(const std::string& db_path);
   CampaignLock(const CampaignLock&) = delete;
   CampaignLock& operator=(const CampaignLock&) = delete;
 
