@@ -182,6 +182,8 @@ void on_every_rank(const mpi::Communicator& group, const std::function<void()>& 
     step();
   } catch (const std::exception& e) {
     outcome = std::to_string(exit_code_of(e)) + e.what();
+  } catch (...) {
+    outcome = "1unknown error";
   }
   for (const std::string& o : group.allgather(outcome)) {
     if (o == "0") continue;
@@ -202,24 +204,27 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
   Case the_case;
   on_every_rank(group, [&] {
     options = run_options(c.solver);
+    options.ranks = group;  // the calibration runs, and the run, share the box
     if (std::isnan(c.d)) throw UsageError("--d is required (lattice units per sphere diameter)");
     the_case = load_case(c.case_options);
     lbm::check_run_size(the_case.packing, c.d, options, "--d");
     if (!c.fields.empty() && root) core::check_output_file(c.fields, "--fields");
-  });
-  if (c.d_hydro != 0.0 && c.calibrate) throw UsageError("give --d-hydro or --calibrate, not both");
-  if (c.d_hydro != 0.0) {
-    if (!std::isfinite(c.d_hydro) || c.d_hydro < 0.5 * c.d || c.d_hydro > 1.5 * c.d) {
-      throw UsageError(fmt::format("--d-hydro = {} is outside [0.5 d, 1.5 d] = [{}, {}]", c.d_hydro,
-                                   0.5 * c.d, 1.5 * c.d));
+    if (c.d_hydro != 0.0 && c.calibrate) {
+      throw UsageError("give --d-hydro or --calibrate, not both");
     }
-  }
-  if (c.calibrate && options.re > 0.0 && options.tau == 0.0) {
-    throw UsageError(
-        "--calibrate at --re > 0 needs --tau: d_h depends on tau and the "
-        "calibration runs in Stokes flow");
-  }
-  if (c.calibrate && c.d > 128.0) throw UsageError("--calibrate works for --d up to 128");
+    if (c.d_hydro != 0.0) {
+      if (!std::isfinite(c.d_hydro) || c.d_hydro < 0.5 * c.d || c.d_hydro > 1.5 * c.d) {
+        throw UsageError(fmt::format("--d-hydro = {} is outside [0.5 d, 1.5 d] = [{}, {}]",
+                                     c.d_hydro, 0.5 * c.d, 1.5 * c.d));
+      }
+    }
+    if (c.calibrate && options.re > 0.0 && options.tau == 0.0) {
+      throw UsageError(
+          "--calibrate at --re > 0 needs --tau: d_h depends on tau and the "
+          "calibration runs in Stokes flow");
+    }
+    if (c.calibrate && c.d > 128.0) throw UsageError("--calibrate works for --d up to 128");
+  });
 
   ProgressLine progress(!ctx.quiet && root);
   auto report = [&progress](const std::string& stage) {
@@ -227,7 +232,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
   };
   nlohmann::json calibration_json;
   if (c.calibrate) {
-    // On every rank alone (a small box): each gets the same d_h.
+    // On the ranks together, like the run: every rank gets the same d_h.
     lbm::CalibrationOptions co;
     co.diameter = c.d;
     co.run = options;
@@ -260,7 +265,6 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     options.hydrodynamic_diameter *= grid.resolution() / c.d;  // the realised d
   }
   options.throw_on_failure = false;  // report a failed run with its diagnosis, then exit 1
-  options.ranks = group;
   lbm::Fields fields;
   const double phi_exact = the_case.packing.phi();
   lbm::RunResult r;
@@ -269,11 +273,15 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
             ? lbm::run(grid, phi_exact, options, report("lbm run"))
             : lbm::run_with_fields(grid, phi_exact, options, &fields, report("lbm run"));
   } catch (const std::exception& e) {
-    // Bad input the run finds (too many ranks for the box, memory) is found on every rank
-    // alike: rank 0 reports it. Anything else may be this rank's alone: end the whole job.
-    if (root || group.size() == 1) throw;
+    // The engine agrees on bad input (too many ranks for the box, memory) across the ranks
+    // before any of them goes on: rank 0 reports it. Anything else may be this rank's alone
+    // (an MPI failure): end the whole job rather than leave the others waiting.
+    if (group.size() == 1) throw;
     const int code = exit_code_of(e);
-    if (code == 2) throw mpi::EndedByRank0(code);
+    if (code == 2) {
+      if (root) throw;
+      throw mpi::EndedByRank0(code);
+    }
     std::cerr << "error: rank " << group.rank() << ": " << e.what() << '\n';
     mpi::abort(code);
   }

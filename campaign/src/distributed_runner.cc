@@ -11,8 +11,8 @@
 // rank, and a late result from it is refused by the token check. When rank 0 dies, the workers
 // notice its silence and end; `--resume` on any number of ranks finishes the campaign.
 //
-// Units on several ranks ([lbm] ranks_per_unit = k > 1): the workers form groups of k
-// consecutive ranks (the last one smaller if k does not divide N - 1), each with its own
+// Units on several ranks ([lbm] ranks_per_unit = k > 1, dividing N - 1): the workers form groups
+// of k consecutive ranks, each with its own
 // communicator. Rank 0 talks to each group's first rank, the leader, exactly as to a worker; the
 // leader passes every unit (and the stop) on to its group by a broadcast, and the group runs the
 // unit's box together (lbm::RunOptions::ranks), the leader sending the outcome back.
@@ -142,7 +142,7 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
   std::map<int, WorkerState> workers;  // by rank; with groups, their leaders
   for (int r = 1; r < ranks; ++r) {
     if (!leads_a_group(r, k)) continue;
-    const int last = std::min(ranks - 1, r + k - 1);
+    const int last = r + k - 1;
     workers[r].token = base_token + std::to_string(r);
     workers[r].report.name = last == r ? "rank " + std::to_string(r)
                                        : "ranks " + std::to_string(r) + "-" + std::to_string(last);
@@ -420,12 +420,25 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
   const mpi::Communicator group = k > 1 ? unit_group(k) : mpi::Communicator::self();
   const int threads = worker_threads(options);
   if (!leads_a_group(mpi::rank(), k)) return run_group_member(spec, group, threads);
-  // The leader passes the stop on to its group before it ends (or throws).
-  auto pass_stop = [&group](bool peer_lost, int exit_code) {
-    std::string text =
-        nlohmann::json{{"stop", true}, {"peer_lost", peer_lost}, {"exit_code", exit_code}}.dump();
-    group.broadcast(&text);
-  };
+  // The leader passes the stop on to its group before it ends, however it ends (rank 0 gone, a
+  // message it cannot read): the group's other ranks wait for nothing else.
+  struct StopRelay {
+    const mpi::Communicator& group;
+    bool passed = false;
+    void pass(bool peer_lost, int exit_code) {
+      if (passed || group.size() == 1) return;
+      passed = true;
+      std::string text =
+          nlohmann::json{{"stop", true}, {"peer_lost", peer_lost}, {"exit_code", exit_code}}.dump();
+      group.broadcast(&text);
+    }
+    ~StopRelay() {
+      try {
+        pass(true, 1);
+      } catch (...) {  // the group is gone too: nothing left to tell
+      }
+    }
+  } relay{group};
   // This node's memory, for its workers' largest units: a refusal goes to rank 0, which stops
   // the run with it (exit 2 on every rank).
   std::string memory_error;
@@ -460,7 +473,7 @@ CampaignStatus run_worker(const RunCampaignOptions& options) {
       const bool lost = j.is_object() && j.value("peer_lost", false);
       if (lost) mpi::mark_peer_lost();
       const int exit_code = j.is_object() ? j.value("exit_code", 0) : 0;
-      pass_stop(lost, exit_code);
+      relay.pass(lost, exit_code);
       if (exit_code != 0) throw mpi::EndedByRank0(exit_code);
       break;
     }

@@ -522,6 +522,17 @@ void validate_run(const CampaignSpec& spec, const RunCampaignOptions& options) {
                     "; start it with mpirun -np " + std::to_string(spec.ranks_per_unit + 1) +
                     " or more, or lower ranks_per_unit");
   }
+  if (spec.ranks_per_unit > 1 && (job - 1) % spec.ranks_per_unit != 0) {
+    // A smaller last group could not hold the units sized for ranks_per_unit ranks.
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        "[lbm] ranks_per_unit = " + std::to_string(spec.ranks_per_unit) +
+            " does not divide the job's " + std::to_string(job - 1) +
+            " worker ranks (rank 0 holds the database); start it with mpirun -np " +
+            std::to_string(1 + (job - 1) / spec.ranks_per_unit * spec.ranks_per_unit) + " or -np " +
+            std::to_string(1 + ((job - 1) / spec.ranks_per_unit + 1) * spec.ranks_per_unit) +
+            ", or choose a ranks_per_unit that divides " + std::to_string(job - 1));
+  }
 }
 
 }  // namespace runner

@@ -34,6 +34,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <string>
@@ -69,6 +70,9 @@ constexpr int kMaxAdjustments = 30;
 constexpr double kProgressInterval = 0.2;  ///< Seconds between progress reports.
 constexpr std::int64_t kMaxCheckInterval = 5000;
 constexpr double kFloatBalanceFloor = 1e-4;  ///< Momentum-balance convergence floor in float.
+/// Bytes per node every rank of a decomposed box holds for the whole box (the voxel grid's
+/// solid flags, with room for its links).
+constexpr double kWholeGridBytesPerNode = 2.0;
 
 std::string fmt(const char* format, double x) {
   char buffer[64];
@@ -84,16 +88,47 @@ std::string node_text(const SparseLattice& lattice, std::int64_t dense) {
          ", " + std::to_string(dense / (n[0] * n[1])) + ")";
 }
 
+/// Ranks of `group` on this node (they share its memory and cores).
+int ranks_on_this_node(const mpi::Communicator& group) {
+  return group.size() > 1 ? std::max(1, std::min(group.size(), mpi::local_size())) : 1;
+}
+
 /// 0 = all cores, shared among the ranks that run on this node.
 int resolve_threads(int requested, const mpi::Communicator& group) {
 #if defined(_OPENMP)
   if (requested > 0) return requested;
-  const int ranks_here = group.size() > 1 ? std::max(1, mpi::local_size()) : 1;
-  return std::max(1, omp_get_max_threads() / ranks_here);
+  // OMP_NUM_THREADS, when set, is already per process (per rank).
+  if (std::getenv("OMP_NUM_THREADS") != nullptr) return std::max(1, omp_get_max_threads());
+  return std::max(1, omp_get_max_threads() / ranks_on_this_node(group));
 #else
   (void)requested, (void)group;
   return 1;
 #endif
+}
+
+/// Runs `step` on every rank of `group`; when it throws on any rank, every rank throws the error
+/// of the lowest failing one (the same code and text), so that no rank goes on into a
+/// collective call the others never reach (a refusal for memory on one node, an allocation
+/// that fails on one rank).
+template <typename Step>
+void on_all_ranks(const mpi::Communicator& group, Step&& step) {
+  if (group.size() == 1) {
+    step();
+    return;
+  }
+  std::string failure;
+  try {
+    step();
+  } catch (const Error& e) {
+    failure = std::to_string(static_cast<int>(e.code())) + ":" + e.what();
+  } catch (const std::exception& e) {
+    failure = std::to_string(static_cast<int>(ErrorCode::kInternal)) + ":" + e.what();
+  }
+  for (const std::string& f : group.allgather(failure)) {
+    if (f.empty()) continue;
+    const std::size_t colon = f.find(':');
+    throw Error(static_cast<ErrorCode>(std::stoi(f.substr(0, colon))), f.substr(colon + 1));
+  }
 }
 
 double machine_memory_bytes() {
@@ -199,48 +234,12 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
                 ") is within 1e-3 of 1/2; remedy: lower tau or raise Lambda");
   }
 
-  // Lattice, links, solver. Several ranks share the box in slabs of z-planes (lattice.h).
+  // Lattice, links, solver. Several ranks share the box in slabs of z-planes (lattice.h); what
+  // one rank cannot build (memory), none goes on with.
   const mpi::Communicator& group = options.ranks;
   const int threads = resolve_threads(options.threads, group);
   const std::size_t element = options.precision == Precision::kFloat ? 4 : 8;
-  PlaneRange planes;
-  if (group.size() > 1) {
-    const std::vector<std::int64_t> split = split_planes(grid, group.size());
-    planes.begin = split[static_cast<std::size_t>(group.rank())];
-    planes.end = split[static_cast<std::size_t>(group.rank()) + 1];
-    planes.decomposed = true;
-  }
-  const SparseLattice lattice(grid, threads, element, planes);
-  {
-    // Refuse what cannot fit rather than let the system kill the process half-way.
-    const double needed = static_cast<double>(d3q19::kQ) * static_cast<double>(element) *
-                              static_cast<double>(lattice.stride()) +
-                          static_cast<double>(lattice.memory_bytes()) +
-                          48.0 * static_cast<double>(grid.num_links()) / group.size();
-    // Every rank takes the decision from the largest share (the ranks of a node share its
-    // memory), so that all of them refuse together.
-    const double largest = group.size() > 1
-                               ? [&] {
-                                   const std::vector<double> all = group.allgather(std::vector<double>{needed});
-                                   return *std::max_element(all.begin(), all.end());
-                                 }()
-                               : needed;
-    const double ranks_here = group.size() > 1 ? std::max(1, mpi::local_size()) : 1;
-    const double available = machine_memory_bytes();
-    if (available > 0.0 && largest * ranks_here > 0.9 * available) {
-      throw Error(
-          ErrorCode::kInvalidArgument,
-          "lbm run: the lattice needs about " + fmt("%.3g", largest * ranks_here / 1073741824.0) +
-              " GiB (" + std::to_string(lattice.num_stored()) + " stored nodes" +
-              (group.size() > 1 ? " on this rank, " + fmt("%g", ranks_here) + " ranks on this node"
-                                : std::string()) +
-              "), more than 90 % of this machine's " + fmt("%.3g", available / 1073741824.0) +
-              " GiB; lower the resolution, use --precision float" +
-              (group.size() > 1 ? ", or spread the ranks over more nodes" : ""));
-    }
-  }
   const bool interpolated = options.boundary == Boundary::kInterpolated;
-  const LinkTable links = lattice.build_links(grid, interpolated);
   SolverSettings settings;
   settings.kernel = options.collision == Collision::kRegularized ? CollisionKernel::kRegularized
                                                                  : CollisionKernel::kTrt;
@@ -249,8 +248,45 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   settings.omega_minus = 1.0 / tau_minus;
   settings.force_x = force;
   settings.interpolated = interpolated;
-  std::unique_ptr<SolverBase> solver =
-      make_solver(options.precision, lattice, links, settings, threads, group);
+  std::unique_ptr<SparseLattice> lattice_storage;
+  std::unique_ptr<LinkTable> links_storage;
+  std::unique_ptr<SolverBase> solver;
+  on_all_ranks(group, [&] {
+    PlaneRange planes;
+    if (group.size() > 1) {
+      const std::vector<std::int64_t> split = split_planes(grid, group.size());
+      planes.begin = split[static_cast<std::size_t>(group.rank())];
+      planes.end = split[static_cast<std::size_t>(group.rank()) + 1];
+      planes.decomposed = true;
+    }
+    lattice_storage = std::make_unique<SparseLattice>(grid, threads, element, planes);
+    const SparseLattice& lattice = *lattice_storage;
+    // Refuse what cannot fit rather than let the system kill the process half-way (the ranks
+    // on one node share its memory).
+    const double ranks_here = ranks_on_this_node(group);
+    const double needed =
+        ranks_here * (static_cast<double>(d3q19::kQ) * static_cast<double>(element) *
+                          static_cast<double>(lattice.stride()) +
+                      static_cast<double>(lattice.memory_bytes()) +
+                      48.0 * static_cast<double>(grid.num_links()) / group.size());
+    const double available = machine_memory_bytes();
+    if (available > 0.0 && needed > 0.9 * available) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  "lbm run: the lattice needs about " + fmt("%.3g", needed / 1073741824.0) +
+                      " GiB (" + std::to_string(lattice.num_stored()) + " stored nodes" +
+                      (group.size() > 1 ? " on rank " + std::to_string(group.rank()) + ", " +
+                                              fmt("%g", ranks_here) + " ranks on its node"
+                                        : std::string()) +
+                      "), more than 90 % of this machine's " +
+                      fmt("%.3g", available / 1073741824.0) +
+                      " GiB; lower the resolution or use --precision float" +
+                      (group.size() > 1 ? ", or spread the ranks over more nodes" : ""));
+    }
+    links_storage = std::make_unique<LinkTable>(lattice.build_links(grid, interpolated));
+    solver = make_solver(options.precision, lattice, *links_storage, settings, threads, group);
+  });
+  const SparseLattice& lattice = *lattice_storage;
+  const LinkTable& links = *links_storage;
   // Counts over the whole box (every rank's share).
   const std::int64_t fluid = group.sum(lattice.num_fluid());
   const double total_nodes = static_cast<double>(grid.num_nodes());
@@ -627,15 +663,26 @@ void check_run_size(const arrays::Packing& packing, double resolution, const Run
   const double dx = packing.box_length[0] / nx;
   const double nodes =
       nx * std::round(packing.box_length[1] / dx) * std::round(packing.box_length[2] / dx);
-  const double bytes = estimated_run_bytes(nodes, options.precision);
+  // Decomposed across ranks, each holds its share of the lattice and the whole voxel grid; the
+  // ranks on one node share its memory.
+  const int ranks = options.ranks.size();
+  const double per_rank = ranks > 1 ? estimated_run_bytes(nodes, options.precision) / ranks +
+                                          kWholeGridBytesPerNode * nodes
+                                    : estimated_run_bytes(nodes, options.precision);
+  const double bytes = per_rank * ranks_on_this_node(options.ranks);
   const double memory = machine_memory_bytes();
   if (memory > 0.0 && bytes > 0.8 * memory) {
-    throw Error(ErrorCode::kInvalidArgument,
-                field + " = " + fmt("%g", resolution) + " needs about " +
-                    fmt("%.1f", bytes / 1073741824.0) + " GiB for " + fmt("%.3g", nodes) +
-                    " lattice nodes, more than 80 % of this machine's " +
-                    fmt("%.1f", memory / 1073741824.0) + " GiB; lower " + field +
-                    " (or use --precision float)");
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        field + " = " + fmt("%g", resolution) + " needs about " +
+            fmt("%.1f", bytes / 1073741824.0) + " GiB for " + fmt("%.3g", nodes) +
+            " lattice nodes" +
+            (ranks > 1 ? " on this node (" + std::to_string(ranks_on_this_node(options.ranks)) +
+                             " of the " + std::to_string(ranks) + " ranks)"
+                       : std::string()) +
+            ", more than 80 % of this machine's " + fmt("%.1f", memory / 1073741824.0) +
+            " GiB; lower " + field + " (or use --precision float" +
+            (ranks > 1 ? ", or spread the ranks over more nodes)" : ")"));
   }
 }
 
@@ -643,7 +690,8 @@ RunResult run(const arrays::Packing& packing, double resolution, const RunOption
               const ProgressCallback& progress) {
   std::string error;
   if (!options.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, "lbm run: " + error);
-  check_run_size(packing, resolution, options, "lbm run: resolution");
+  on_all_ranks(options.ranks,
+               [&] { check_run_size(packing, resolution, options, "lbm run: resolution"); });
   arrays::VoxelizationOptions vox;
   vox.resolution = resolution;
   const arrays::VoxelGrid grid = arrays::voxelize(packing, vox);

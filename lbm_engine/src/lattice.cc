@@ -270,7 +270,8 @@ void SparseLattice::build_halo_plan(const arrays::VoxelGrid& grid) {
         for (int q = 1; q < kQ; ++q) {
           if (kC[q][2] != dz || !fluid(i - kC[q][0], j - kC[q][1], k - kC[q][2])) continue;
           if (n < 0) {
-            throw Error(ErrorCode::kInvalidArgument, "lbm: halo node not stored (internal error)");
+            throw Error(ErrorCode::kInternal,
+                        "lbm: a halo node is not stored (a bug: please report it)");
           }
           out.push_back(q * stride_ + n);
         }

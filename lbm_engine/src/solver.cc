@@ -1,6 +1,8 @@
 // solver.cc: the AA sweeps (SIMD over nodes), the link pass and the moment sweep.
 #include "solver.h"
 
+#include "draglab/drag_db/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -293,7 +295,10 @@ class Solver final : public SolverBase {
     for (std::size_t l = 0; l < links.size(); ++l) {
       if (l == 0 || links.node[l] != links.node[l - 1]) ++boundary_nodes_;
     }
-    boundary_nodes_ = std::max<std::int64_t>(1, group_.sum(boundary_nodes_));
+    if (lattice.decomposed() != (group.size() > 1)) {
+      throw Error(ErrorCode::kInternal,
+                  "lbm: a decomposed lattice needs the group of its ranks, and only it does");
+    }
     const HaloPlan& plan = lattice.halo();
     send_down_.resize(std::max(plan.low_owned.size(), plan.low_halo.size()));
     send_up_.resize(std::max(plan.high_owned.size(), plan.high_halo.size()));
@@ -324,6 +329,15 @@ class Solver final : public SolverBase {
   }
 
   double force_magnitude() const override { return force_magnitude_; }
+
+  /// Boundary nodes of the whole box (summed over the ranks at the first step: the constructor
+  /// stays local, so that a rank that cannot build its solver fails alone and reports it).
+  std::int64_t boundary_nodes() {
+    if (global_boundary_nodes_ < 0) {
+      global_boundary_nodes_ = std::max<std::int64_t>(1, group_.sum(boundary_nodes_));
+    }
+    return global_boundary_nodes_;
+  }
 
   MomentSummary moments() const override {
     const int ranges = lattice_.num_ranges();
@@ -456,9 +470,10 @@ class Solver final : public SolverBase {
       return;
     }
     // Rank r owns the planes after rank r - 1's: the gather in rank order is the dense order.
-    group_.gather_to_root(local.velocity, &fields->velocity);
-    group_.gather_to_root(local.density, &fields->density);
-    group_.gather_to_root(local.solid, &fields->solid);
+    const std::size_t plane = static_cast<std::size_t>(plane_nodes);
+    group_.gather_to_root(local.velocity, 3 * plane, &fields->velocity);
+    group_.gather_to_root(local.density, plane, &fields->density);
+    group_.gather_to_root(local.solid, plane, &fields->solid);
   }
 
   std::size_t bytes() const override { return populations_.bytes(); }
@@ -513,7 +528,7 @@ class Solver final : public SolverBase {
     // and correcting them locally would perturb the second-order wall), so the total mass stays
     // constant to within one step's leak.
     const double correction = settings_.mass_correction && update
-                                  ? pending_defect_ / static_cast<double>(boundary_nodes_)
+                                  ? pending_defect_ / static_cast<double>(boundary_nodes())
                                   : 0.0;
 #pragma omp parallel num_threads(threads_)
     {
@@ -586,7 +601,7 @@ class Solver final : public SolverBase {
     }
     for (auto& d : partial_defect_) d = 0.0;
     const double correction = settings_.mass_correction && update
-                                  ? pending_defect_ / static_cast<double>(boundary_nodes_)
+                                  ? pending_defect_ / static_cast<double>(boundary_nodes())
                                   : 0.0;
     const HaloPlan& plan = lattice_.halo();
     // Even step: the owned values go out, the halo's come in; odd step: the values this rank's
@@ -772,9 +787,10 @@ class Solver final : public SolverBase {
   std::vector<double> even_force_;
   std::vector<std::vector<double>> partial_force_;  ///< Per work range.
   std::vector<double> partial_defect_;              ///< Per work range.
-  double pending_defect_ = 0.0;   ///< Net mass added by the last interpolation pass.
-  double force_magnitude_ = 0.0;  ///< See force_magnitude().
-  std::int64_t boundary_nodes_ = 0;
+  double pending_defect_ = 0.0;      ///< Net mass added by the last interpolation pass.
+  double force_magnitude_ = 0.0;     ///< See force_magnitude().
+  std::int64_t boundary_nodes_ = 0;  ///< This rank's.
+  std::int64_t global_boundary_nodes_ = -1;
 };
 
 }  // namespace

@@ -15,6 +15,7 @@ namespace draglab {
 namespace mpi {
 namespace {
 
+#if DRAGLAB_HAVE_MPI
 // Tags of the ring exchange: what travels down arrives from above, and vice versa.
 constexpr int kTagDown = 7101;
 constexpr int kTagUp = 7102;
@@ -28,7 +29,6 @@ int checked_count(std::size_t n, const char* what) {
   return static_cast<int>(n);
 }
 
-#if DRAGLAB_HAVE_MPI
 MPI_Comm comm(int handle) { return MPI_Comm_f2c(static_cast<MPI_Fint>(handle)); }
 
 void check(int code, const char* what) {
@@ -38,23 +38,33 @@ void check(int code, const char* what) {
 }
 
 template <typename T>
-void gather(int handle, int size, const std::vector<T>& mine, std::vector<T>* all,
-            MPI_Datatype type, bool root) {
-  const int count = checked_count(mine.size(), "a gathered field");
-  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(counts.size(), 0);
-  check(MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm(handle)), "MPI_Gather");
-  if (root) {
-    std::size_t total = 0;
-    for (std::size_t r = 0; r < counts.size(); ++r) {
-      offsets[r] = checked_count(total, "a gathered field");
-      total += static_cast<std::size_t>(counts[r]);
-    }
-    checked_count(total, "a gathered field");
-    all->resize(total);
+void gather(int handle, int size, const std::vector<T>& mine, std::size_t block,
+            std::vector<T>* all, MPI_Datatype element, bool root) {
+  // Every rank checks the same limit before the first collective call (block is the same on all).
+  const int block_count = checked_count(block, "a gathered block");
+  if (block == 0 || mine.size() % block != 0) {
+    throw std::logic_error("mpi: a gathered vector is not a whole number of blocks");
   }
-  check(MPI_Gatherv(mine.data(), count, type, root ? all->data() : nullptr, counts.data(),
-                    offsets.data(), type, 0, comm(handle)),
-        "MPI_Gatherv");
+  MPI_Datatype type = MPI_DATATYPE_NULL;
+  check(MPI_Type_contiguous(block_count, element, &type), "MPI_Type_contiguous");
+  MPI_Type_commit(&type);
+  const int count = static_cast<int>(mine.size() / block);  // blocks: planes of a box
+  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(counts.size(), 0);
+  const int gathered = MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm(handle));
+  if (gathered == MPI_SUCCESS && root) {
+    long long total = 0;
+    for (std::size_t r = 0; r < counts.size(); ++r) {
+      offsets[r] = static_cast<int>(total);
+      total += counts[r];
+    }
+    all->resize(static_cast<std::size_t>(total) * block);
+  }
+  const int code = gathered != MPI_SUCCESS
+                       ? gathered
+                       : MPI_Gatherv(mine.data(), count, type, root ? all->data() : nullptr,
+                                     counts.data(), offsets.data(), type, 0, comm(handle));
+  MPI_Type_free(&type);
+  check(code, "MPI_Gatherv");
 }
 #endif
 
@@ -170,26 +180,27 @@ std::vector<std::string> Communicator::allgather(const std::string& mine) const 
 #endif
 }
 
-void Communicator::gather_to_root(const std::vector<float>& mine, std::vector<float>* all) const {
+void Communicator::gather_to_root(const std::vector<float>& mine, std::size_t block,
+                                  std::vector<float>* all) const {
   if (size_ == 1) {
     *all = mine;
     return;
   }
 #if DRAGLAB_HAVE_MPI
-  gather(handle_, size_, mine, all, MPI_FLOAT, is_root());
+  gather(handle_, size_, mine, block, all, MPI_FLOAT, is_root());
 #else
   throw std::logic_error("mpi: a communicator of several ranks in a build without MPI");
 #endif
 }
 
-void Communicator::gather_to_root(const std::vector<std::uint8_t>& mine,
+void Communicator::gather_to_root(const std::vector<std::uint8_t>& mine, std::size_t block,
                                   std::vector<std::uint8_t>* all) const {
   if (size_ == 1) {
     *all = mine;
     return;
   }
 #if DRAGLAB_HAVE_MPI
-  gather(handle_, size_, mine, all, MPI_UINT8_T, is_root());
+  gather(handle_, size_, mine, block, all, MPI_UINT8_T, is_root());
 #else
   throw std::logic_error("mpi: a communicator of several ranks in a build without MPI");
 #endif

@@ -10,10 +10,11 @@
 #      `--resume` on 3 ranks: complete, the reference dataset id, no duplicate, `db check` clean;
 #   4. bad input: another command under several ranks, and a spec rank 0 cannot read: exit 2 on
 #      every rank with a message, no rank left waiting, nothing written;
-#   5. units on several ranks ([lbm] ranks_per_unit = 2) on 4 ranks (a group of 2 and one of 1):
-#      every unit's F equals the reference to 1e-10 relative (the decomposed box sums in another
-#      order: round-off, see mpi_lbm_test.sh); ranks_per_unit larger than the job, on 3 ranks and
-#      in one process: exit 2, named once, nothing written.
+#   5. units on several ranks ([lbm] ranks_per_unit = 2) on 5 ranks (two groups of 2): every
+#      unit's F equals the reference to 1e-10 relative (the decomposed box sums in another
+#      order: round-off, see mpi_lbm_test.sh); ranks_per_unit larger than the job (on 3 ranks
+#      and in one process) or not dividing its worker ranks (on 4): exit 2, named once, nothing
+#      written.
 # Usage: mpi_campaign_test.sh DRAGLAB SPEC MPIRUN
 set -u
 draglab="$(realpath "$1")"
@@ -162,10 +163,10 @@ check "a spec rank 0 cannot read: no database written" test ! -e "$work/nospec.d
 
 # --- 5. units on several ranks -------------------------------------------------------------------
 sed 's/^resolutions = .*/resolutions = [12]\nranks_per_unit = 2/' "$spec_src" >spec2.toml
-run_mpi -np 4 "$draglab" --db "$work/group.db" campaign run spec2.toml --threads-per-unit 1 \
+run_mpi -np 5 "$draglab" --db "$work/group.db" campaign run spec2.toml --threads-per-unit 1 \
   >group.out 2>group.err
 rc=$?
-check "ranks_per_unit = 2 on 4 ranks: exit 0 (got $rc)" test "$rc" -eq 0
+check "ranks_per_unit = 2 on 5 ranks: exit 0 (got $rc)" test "$rc" -eq 0
 check "ranks_per_unit = 2: every unit done" test "$(units "$work/group.db" done)" -eq "$units_total"
 same_units=$(sqlite3 one.db "ATTACH '$work/group.db' AS g; SELECT count(*) FROM campaign_units a
   JOIN g.campaign_units b USING (phi_index, re_index, realization, resolution_index)
@@ -174,8 +175,8 @@ check "ranks_per_unit = 2: every unit's F equals the reference to 1e-10 ($same_u
   test "$same_units" -eq "$units_total"
 check "ranks_per_unit = 2: units ran on 2 ranks" \
   test "$(sqlite3 "$work/group.db" "SELECT count(*) FROM campaign_units WHERE json_extract(result_json, '\$.ranks') = 2")" -ge 1
-check "ranks_per_unit = 2: the groups are reported (ranks 1-2, rank 3)" \
-  bash -c "grep -q '^ranks 1-2 ' group.out && grep -q '^rank 3 ' group.out"
+check "ranks_per_unit = 2: the groups are reported (ranks 1-2, ranks 3-4)" \
+  bash -c "grep -q '^ranks 1-2 ' group.out && grep -q '^ranks 3-4 ' group.out"
 check "ranks_per_unit = 2: db check clean" "$draglab" --db "$work/group.db" db check
 
 sed 's/^resolutions = .*/resolutions = [12]\nranks_per_unit = 3/' "$spec_src" >spec3.toml
@@ -188,6 +189,11 @@ check "ranks_per_unit = 3 on 3 ranks: no database written" test ! -e "$work/big.
 "$draglab" --db "$work/big1.db" campaign run spec3.toml >big1.out 2>big1.err
 rc=$?
 check "ranks_per_unit = 3 in one process: exit 2 (got $rc)" test "$rc" -eq 2
+run_mpi -np 4 "$draglab" --db "$work/odd.db" campaign run spec2.toml >odd.out 2>odd.err
+rc=$?
+check "ranks_per_unit = 2 on 4 ranks (3 workers): exit 2 (got $rc)" test "$rc" -eq 2
+check "ranks_per_unit = 2 on 4 ranks: named once, with the job sizes that work, nothing written" \
+  bash -c "[ \"\$(grep -c 'ranks_per_unit = 2 does not divide the job.s 3 worker ranks.*-np 3 or -np 5' odd.err)\" = 1 ] && [ ! -e '$work/odd.db' ]"
 check "ranks_per_unit = 3 in one process: named, no database written" \
   bash -c "grep -q 'ranks_per_unit = 3 is larger than the job' big1.err && [ ! -e '$work/big1.db' ]"
 

@@ -45,10 +45,14 @@ class Communicator {
   std::int64_t sum(std::int64_t value) const;
   /// Every rank's text, in rank order, on every rank. Collective.
   std::vector<std::string> allgather(const std::string& mine) const;
-  /// Rank 0 receives every rank's `mine` (lengths may differ) concatenated in rank order into
-  /// `all` (resized); the other ranks' `all` is left alone. Collective.
-  void gather_to_root(const std::vector<float>& mine, std::vector<float>* all) const;
-  void gather_to_root(const std::vector<std::uint8_t>& mine, std::vector<std::uint8_t>* all) const;
+  /// Rank 0 receives every rank's `mine` (lengths may differ, each a multiple of `block`
+  /// elements, the same `block` on every rank) concatenated in rank order into `all` (resized);
+  /// the other ranks' `all` is left alone. Counted in blocks (planes of a box), so that a box
+  /// of more than 2^31 elements gathers as well. Collective.
+  void gather_to_root(const std::vector<float>& mine, std::size_t block,
+                      std::vector<float>* all) const;
+  void gather_to_root(const std::vector<std::uint8_t>& mine, std::size_t block,
+                      std::vector<std::uint8_t>* all) const;
 
   /// Non-blocking exchange of byte buffers with the ranks below and above this one in a ring
   /// (rank - 1 and rank + 1 modulo size, the same rank when size is 2): start() posts the
