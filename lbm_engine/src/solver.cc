@@ -271,6 +271,9 @@ void odd_sweep(T* base, std::int64_t stride, const std::uint32_t* masks, const S
   }
 }
 
+/// Interior rows between two calls that let the halo exchange progress.
+constexpr std::int64_t kProgressRows = 64;
+
 /// Links ahead that the link pass prefetches.
 constexpr std::int64_t kLinkPrefetch = 16;
 
@@ -644,6 +647,9 @@ class Solver final : public SolverBase {
 #pragma omp for schedule(dynamic, 16)
       for (std::int64_t b = 0; b < interior_rows; ++b) {
         sweep(plan.interior_rows[static_cast<std::size_t>(b)]);
+        // MPI moves a large message only inside its calls: the master thread lets it progress
+        // now and then while the interior is swept.
+        if (thread_id() == 0 && b % kProgressRows == 0 && !failure) exchange_.progress();
       }
 #pragma omp master
       {

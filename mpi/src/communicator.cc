@@ -252,6 +252,13 @@ void Communicator::RingExchange::start(const Communicator& group, const void* se
 #endif
 }
 
+void Communicator::RingExchange::progress() {
+#if DRAGLAB_HAVE_MPI
+  int done = 0;
+  MPI_Testall(4, requests_->request, &done, MPI_STATUSES_IGNORE);
+#endif
+}
+
 void Communicator::RingExchange::wait() {
 #if DRAGLAB_HAVE_MPI
   check(MPI_Waitall(4, requests_->request, MPI_STATUSES_IGNORE), "MPI_Waitall");

@@ -69,6 +69,9 @@ class Communicator {
                const void* send_up, std::size_t send_up_bytes, void* receive_down,
                std::size_t receive_down_bytes, void* receive_up, std::size_t receive_up_bytes);
     void wait();
+    /// Lets the transfer advance (MPI_Testall) without waiting; call it now and then between
+    /// start() and wait() from the thread that called start().
+    void progress();
 
    private:
     struct Requests;
