@@ -3,6 +3,8 @@
 # that takes file locks, not a parallel filesystem written by many nodes), every other task runs
 # units with --cpus-per-task OpenMP threads. Submit: sbatch scripts/slurm_campaign.sh [SPEC] [DB]
 # A killed or timed-out job is continued by submitting it again (--resume also starts a new one).
+# Units too large for one task: [lbm] ranks_per_unit = k in the spec runs each unit's box on k
+# tasks together (the tasks other than rank 0 must be a multiple of k).
 #SBATCH --job-name=draglab-campaign
 #SBATCH --nodes=4
 #SBATCH --ntasks-per-node=8
