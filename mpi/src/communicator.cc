@@ -189,6 +189,7 @@ void Communicator::gather_to_root(const std::vector<float>& mine, std::size_t bl
 #if DRAGLAB_HAVE_MPI
   gather(handle_, size_, mine, block, all, MPI_FLOAT, is_root());
 #else
+  (void)block;
   throw std::logic_error("mpi: a communicator of several ranks in a build without MPI");
 #endif
 }
@@ -202,6 +203,7 @@ void Communicator::gather_to_root(const std::vector<std::uint8_t>& mine, std::si
 #if DRAGLAB_HAVE_MPI
   gather(handle_, size_, mine, block, all, MPI_UINT8_T, is_root());
 #else
+  (void)block;
   throw std::logic_error("mpi: a communicator of several ranks in a build without MPI");
 #endif
 }
