@@ -4,6 +4,10 @@
 #
 #   scripts/setup.sh            # install what is missing, configure, build
 #   scripts/setup.sh --no-build # install only
+#   scripts/setup.sh --with-openfoam  # also OpenFOAM v1912 (openfoam, openfoam-examples) and the
+#                                     # source of Debian's openfoam package, whose headers the
+#                                     # drag-model plugin compiles against (adapters/openfoam),
+#                                     # into ~/.cache/draglab/openfoam-src
 #
 # DRAGLAB_BUILD_DIR: another build directory. DRAGLAB_SANITIZE=1: build with ASan + UBSan
 # (-DDRAGLAB_SANITIZE=ON, RelWithDebInfo) into build-sanitize/ unless DRAGLAB_BUILD_DIR says.
@@ -11,6 +15,14 @@
 # DRAGLAB_EXTRA_PACKAGES: more Debian packages to install the same way (scripts/fuzz.sh: clang).
 set -euo pipefail
 
+build=1 openfoam=0
+for arg in "$@"; do
+  case "$arg" in
+    --no-build) build=0 ;;
+    --with-openfoam) openfoam=1 ;;
+    *) echo "setup: unknown option '$arg' (--no-build, --with-openfoam)" >&2; exit 2 ;;
+  esac
+done
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 sanitize="${DRAGLAB_SANITIZE:-0}"
 if [ "$sanitize" = 1 ]; then
@@ -43,6 +55,8 @@ packages=(
 
 # shellcheck disable=SC2206  # a space-separated list of package names
 packages+=(${DRAGLAB_EXTRA_PACKAGES:-})
+# OpenFOAM v1912 for the drag-model plugin, its test and the side-by-side benchmarks.
+[ "$openfoam" = 1 ] && packages+=(openfoam openfoam-examples bzip2)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -66,7 +80,27 @@ if ((${#missing[@]})); then
   "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-[ "${1:-}" = "--no-build" ] && exit 0
+if [ "$openfoam" = 1 ]; then
+  # Debian ships OpenFOAM's libraries without its headers; the plugin compiles against the
+  # source of the same package version, fetched from Debian's archive as a source package.
+  cache="${HOME}/.cache/draglab/openfoam-src"
+  version="$(dpkg-query -W -f='${Version}' openfoam)"
+  upstream="${version%-*}"
+  if [ -z "$(ls -d "$cache"/openfoam-OpenFOAM-v* 2>/dev/null)" ]; then
+    echo "setup: fetching the source of Debian's openfoam $version into $cache" >&2
+    mkdir -p "$cache/lists/partial"
+    list="$cache/deb-src.sources"
+    printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: bookworm\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' >"$list"
+    apt_src=(-o Dir::Etc::SourceList=/dev/null -o Dir::Etc::SourceParts=/dev/null
+             -o Dir::Etc::sourcelist="$list" -o Dir::State::Lists="$cache/lists")
+    apt-get "${apt_src[@]}" update -qq
+    (cd "$cache" && apt-get "${apt_src[@]}" source --download-only -qq "openfoam=$version")
+    tar -xjf "$cache"/openfoam_"${upstream}".orig.tar.bz2 -C "$cache"
+    rm -rf "$cache/lists" "$cache"/openfoam_*.tar.* "$cache"/openfoam_*.dsc
+  fi
+fi
+
+[ "$build" = 0 ] && exit 0
 
 jobs="$(nproc 2>/dev/null || echo 2)"
 if [ "$sanitize" != 1 ] && [ -f "$build_dir/CMakeCache.txt" ] &&

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cfenv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -175,6 +176,32 @@ TEST_F(CApi, RangePolicies) {
   EXPECT_EQ(draglab_law_set_range_policy(law_, 7), DRAGLAB_INVALID_ARGUMENT);
   ASSERT_EQ(draglab_law_range_policy(law_, &policy), DRAGLAB_OK);
   EXPECT_EQ(policy, DRAGLAB_RANGE_EXTRAPOLATE);  // unchanged by the refused call
+}
+
+// A host solver that traps floating-point exceptions (OpenFOAM does, FOAM_SIGFPE; so do Fortran
+// codes built with -ffpe-trap) must survive every evaluation inside the validity box: bvk2007 at
+// Re = 0 computes pow(0, -x) in a term it then discards. Run in a child process, so that a trap
+// fails this test instead of killing the test runner; the child also checks that its own trap
+// settings and flags are as it left them.
+TEST_F(CApi, EvaluationsSurviveAHostThatTrapsFloatingPointExceptions) {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    feenableexcept(FE_DIVBYZERO | FE_INVALID | FE_OVERFLOW);
+    double value = 0.0;
+    const double phi[3] = {0.1, 0.3, 0.6}, re[3] = {0.0, 0.0, 10.0};
+    double out[3] = {0, 0, 0};
+    const bool ok = draglab_law_F(law_, 0.3, 0.0, &value) == DRAGLAB_OK && value > 0.0 &&
+                    draglab_law_F_n(law_, 3, phi, re, out) == DRAGLAB_OK && out[0] > 0.0 &&
+                    out[1] > 0.0 && out[2] > 0.0;
+    const bool traps_kept = fegetexcept() == (FE_DIVBYZERO | FE_INVALID | FE_OVERFLOW) &&
+                            !fetestexcept(FE_ALL_EXCEPT & ~FE_INEXACT);
+    _exit(ok && traps_kept ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the evaluation trapped (signal " << WTERMSIG(status) << ")";
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "wrong values, or the caller's traps were not restored";
 }
 
 TEST_F(CApi, NullPointersAreInvalidArguments) {

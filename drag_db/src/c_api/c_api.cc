@@ -3,9 +3,11 @@
 // Every entry point runs its body through guarded(): a draglab::Error becomes its ErrorCode as the
 // status, any other exception DRAGLAB_INTERNAL, and the message goes to a thread-local string for
 // draglab_last_error(). No exception crosses the ABI. Outputs are written only on success (the
-// array functions are the documented exception).
+// array functions are the documented exception). guarded() also holds the caller's
+// floating-point traps (see FloatingPointGuard).
 #include "draglab/draglab.h"
 
+#include <cfenv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -65,9 +67,26 @@ int fail(int status, const char* message) noexcept {
   return status;
 }
 
+/// Host solvers often trap floating-point exceptions (OpenFOAM's FOAM_SIGFPE, gfortran's
+/// -ffpe-trap). The forms are evaluated branch-free and may raise one in a value they then
+/// discard (pow(0, -x) masked by a select at Re = 0), so the traps are held while draglab
+/// computes and the caller's environment, its flags included, is restored afterwards. A result
+/// that is really not finite is still reported as an error.
+class FloatingPointGuard {
+ public:
+  FloatingPointGuard() noexcept { std::feholdexcept(&saved_); }
+  ~FloatingPointGuard() { std::fesetenv(&saved_); }
+  FloatingPointGuard(const FloatingPointGuard&) = delete;
+  FloatingPointGuard& operator=(const FloatingPointGuard&) = delete;
+
+ private:
+  std::fenv_t saved_;
+};
+
 /// Runs `body` (returning void) and maps exceptions to status codes.
 template <typename Body>
 int guarded(Body&& body) noexcept {
+  const FloatingPointGuard traps_held;
   try {
     body();
     return DRAGLAB_OK;
