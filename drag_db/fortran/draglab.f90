@@ -55,6 +55,7 @@ module draglab_mod
   public :: draglab_law_F, draglab_law_F_extra, draglab_law_F_n
   public :: draglab_law_beta_d2_over_mu, draglab_law_K
   public :: draglab_law_beta, draglab_law_dga, draglab_law_beta_n
+  public :: draglab_law_particle_drag
 
   ! The C functions, under c_-prefixed Fortran names.
   interface
@@ -192,6 +193,14 @@ module draglab_mod
       type(c_ptr), value :: law
       real(c_double), value :: eps_g, mu_g, rho_g, slip, d_p, rho_s
       real(c_double), intent(inout) :: beta
+      integer(c_int) :: status
+    end function
+    function c_draglab_law_particle_drag(law, eps_g, mu_g, rho_g, slip, d_i, d_mean, gamma, &
+        re) bind(C, name='draglab_law_particle_drag') result(status)
+      import :: c_ptr, c_int, c_double
+      type(c_ptr), value :: law
+      real(c_double), value :: eps_g, mu_g, rho_g, slip, d_i, d_mean
+      real(c_double), intent(inout) :: gamma, re
       integer(c_int) :: status
     end function
     function c_draglab_law_dga(law, eps_g, mu_g, rho_g, slip, d_p, rho_s, dga) &
@@ -463,6 +472,19 @@ contains
     integer(c_int) :: status
     status = c_draglab_law_dga(law%handle, eps_g, mu_g, rho_g, slip, d_p, rho_s, dga)
   end function draglab_law_dga
+
+  ! CFD-DEM per-particle drag: gamma [kg/s] with drag on the particle = gamma (u_f - u_p), and the
+  ! particle Reynolds number re; d_mean is the Sauter mean diameter around the particle, used by
+  ! polydisperse laws (y = d_i/d_mean) and ignored by the others. See draglab.h.
+  function draglab_law_particle_drag(law, eps_g, mu_g, rho_g, slip, d_i, d_mean, gamma, re) &
+      result(status)
+    type(draglab_law_t), intent(in) :: law
+    real(c_double), intent(in) :: eps_g, mu_g, rho_g, slip, d_i, d_mean
+    real(c_double), intent(inout) :: gamma, re
+    integer(c_int) :: status
+    status = c_draglab_law_particle_drag(law%handle, eps_g, mu_g, rho_g, slip, d_i, d_mean, &
+                                         gamma, re)
+  end function draglab_law_particle_drag
 
   ! Array path of beta over cells or particles (all arrays of the same size).
   function draglab_law_beta_n(law, eps_g, mu_g, rho_g, slip, d_p, beta) result(status)

@@ -54,17 +54,17 @@ Law::Law(LawRecord record, RangePolicy policy)
     : record_(std::move(record)), form_(&find_law_form(record_.form)), policy_(policy) {
   const auto& specs = form_->description.parameters;
   if (record_.parameters.size() != specs.size()) {
-    throw Error(ErrorCode::kInvalidArgument,
-                record_.reference() + ": form '" + record_.form + "' takes " +
-                    std::to_string(specs.size()) + " parameters, the record has " +
-                    std::to_string(record_.parameters.size()));
+    throw Error(ErrorCode::kInvalidArgument, record_.reference() + ": form '" + record_.form +
+                                                 "' takes " + std::to_string(specs.size()) +
+                                                 " parameters, the record has " +
+                                                 std::to_string(record_.parameters.size()));
   }
   for (std::size_t i = 0; i < specs.size(); ++i) {
     if (record_.parameters[i].name != specs[i].name) {
-      throw Error(ErrorCode::kInvalidArgument, record_.reference() + ": parameter " +
-                                                   std::to_string(i) + " is '" +
-                                                   record_.parameters[i].name + "', form '" +
-                                                   record_.form + "' expects '" + specs[i].name + "'");
+      throw Error(ErrorCode::kInvalidArgument,
+                  record_.reference() + ": parameter " + std::to_string(i) + " is '" +
+                      record_.parameters[i].name + "', form '" + record_.form + "' expects '" +
+                      specs[i].name + "'");
     }
     if (!std::isfinite(record_.parameters[i].value)) {
       throw Error(ErrorCode::kInvalidArgument,
@@ -126,8 +126,8 @@ void Law::prepare(double& phi, double& re, double* extra_out, const double* extr
         for (int k = 0; k < n_extra; ++k) {
           if (!box.extra[k].range.contains(extra_out[k])) {
             what = box.extra[k].name + " = " + fmt_double(extra_out[k]) +
-                   " is outside the validity range [" + fmt_double(box.extra[k].range.min) +
-                   ", " + fmt_double(box.extra[k].range.max) + "]";
+                   " is outside the validity range [" + fmt_double(box.extra[k].range.min) + ", " +
+                   fmt_double(box.extra[k].range.max) + "]";
           }
         }
       }
@@ -234,9 +234,9 @@ double Law::drag_coefficient_times_re_p(double phi, double re, const double* ext
 
 double Law::drag_coefficient(double phi, double re, const double* extra) const {
   if (!(re > 0.0)) {
-    throw Error(ErrorCode::kInvalidArgument,
-                reference() + ": C_d needs Re > 0 (use C_d Re_p at Re = 0), got Re = " +
-                    fmt_double(re));
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        reference() + ": C_d needs Re > 0 (use C_d Re_p at Re = 0), got Re = " + fmt_double(re));
   }
   return conventions::drag_coefficient(phi, re, F(phi, re, extra));
 }
@@ -273,6 +273,27 @@ double Law::beta(double eps_g, double mu_g, double rho_g, double slip, double d_
   const double re = checked_reynolds(reference(), eps_g, mu_g, rho_g, slip, d_p);
   const double phi = 1.0 - eps_g;
   return conventions::beta(phi, F(phi, re, extra), mu_g, d_p);
+}
+
+double Law::particle_drag(double eps_g, double mu_g, double rho_g, double slip, double d_i,
+                          double d_mean, double* re_out) const {
+  const int n_extra = form_->num_extra_inputs;
+  if (n_extra > 1) {
+    throw Error(ErrorCode::kInvalidArgument,
+                reference() + ": particle_drag supports forms with at most one extra input (y)");
+  }
+  const bool poly = n_extra == 1;
+  // The diameter of the Reynolds number: the mixture's for polydisperse forms.
+  const double d_ref = poly ? d_mean : d_i;
+  const double re = checked_reynolds(reference(), eps_g, mu_g, rho_g, slip, d_ref);
+  if (poly && (!std::isfinite(d_i) || !(d_i > 0.0))) {
+    throw Error(ErrorCode::kInvalidArgument,
+                reference() + ": d_i = " + fmt_double(d_i) + " must be finite and > 0");
+  }
+  const double y = poly ? d_i / d_mean : 1.0;
+  const double phi = 1.0 - eps_g;
+  if (re_out != nullptr) *re_out = re;
+  return conventions::particle_drag_coefficient(phi, F(phi, re, poly ? &y : nullptr), mu_g, d_i);
 }
 
 double Law::dga(double eps_g, double mu_g, double rho_g, double slip, double d_p,

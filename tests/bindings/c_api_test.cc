@@ -204,6 +204,52 @@ TEST_F(CApi, EvaluationsSurviveAHostThatTrapsFloatingPointExceptions) {
   EXPECT_EQ(WEXITSTATUS(status), 0) << "wrong values, or the caller's traps were not restored";
 }
 
+// CFD-DEM per-particle drag against the conversion identities (drag_db/conventions.h): for equal
+// spheres gamma = beta V_p / phi with beta from draglab_law_beta, and gamma / (3 pi mu d eps) is
+// the law's F at the returned Re = rho eps d slip / mu. Polydisperse bvk2007_poly: F_i is
+// normalised by 3 pi mu d_i eps u at Re based on the Sauter mean <d>, and equals
+// F_bvk2007(phi, Re) [(1 - phi) y + phi y^2 + 0.064 (1 - phi) y^3] with y = d_i/<d> (the law's
+// documented form), checked at y = 1 and y = 2 against bvk2007 itself. Tolerance: a few roundings.
+TEST_F(CApi, ParticleDragSatisfiesTheConversionIdentities) {
+  constexpr double kPi = 3.14159265358979323846;
+  const double eps = 0.65, mu = 1.8e-5, rho = 1.2, slip = 0.4, d = 4e-4, phi = 1.0 - eps;
+  double gamma = kUntouched, re = kUntouched, beta = 0.0;
+  ASSERT_EQ(draglab_law_particle_drag(law_, eps, mu, rho, slip, d, d, &gamma, &re), DRAGLAB_OK)
+      << draglab_last_error();
+  ASSERT_EQ(draglab_law_beta(law_, eps, mu, rho, slip, d, 2500.0, &beta), DRAGLAB_OK);
+  const double volume = kPi * d * d * d / 6.0;
+  EXPECT_NEAR(gamma * phi / volume / beta, 1.0, kRoundingTolerance);
+  EXPECT_NEAR(re / (rho * eps * d * slip / mu), 1.0, kRoundingTolerance);
+  EXPECT_NEAR(gamma / (3.0 * kPi * mu * d * eps) / F(phi, re), 1.0, kRoundingTolerance);
+  // d_mean is ignored by a monodisperse law.
+  double other = kUntouched;
+  ASSERT_EQ(draglab_law_particle_drag(law_, eps, mu, rho, slip, d, 3.0 * d, &other, nullptr),
+            DRAGLAB_OK);
+  EXPECT_EQ(other, gamma);
+
+  draglab_law* poly = nullptr;
+  ASSERT_EQ(draglab_law_load(db_, "bvk2007_poly@1", &poly), DRAGLAB_OK) << draglab_last_error();
+  for (const double y : {1.0, 2.0}) {
+    double g = kUntouched, r = kUntouched;
+    ASSERT_EQ(draglab_law_particle_drag(poly, eps, mu, rho, slip, y * d, d, &g, &r), DRAGLAB_OK)
+        << draglab_last_error();
+    EXPECT_NEAR(r / (rho * eps * d * slip / mu), 1.0, kRoundingTolerance);  // Re with <d>
+    const double factor = eps * y + phi * y * y + 0.064 * eps * y * y * y;
+    EXPECT_NEAR(g / (3.0 * kPi * mu * (y * d) * eps) / (F(phi, r) * factor), 1.0,
+                kRoundingTolerance)
+        << "y = " << y;
+  }
+  double untouched = kUntouched;
+  EXPECT_EQ(draglab_law_particle_drag(poly, eps, mu, rho, slip, -d, d, &untouched, nullptr),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(draglab_last_error()).find("d_i"), std::string::npos);
+  EXPECT_EQ(untouched, kUntouched);
+  EXPECT_EQ(draglab_law_particle_drag(law_, 1.5, mu, rho, slip, d, d, &untouched, nullptr),
+            DRAGLAB_INVALID_ARGUMENT);
+  EXPECT_EQ(untouched, kUntouched);
+  draglab_law_free(poly);
+}
+
 TEST_F(CApi, NullPointersAreInvalidArguments) {
   double value = kUntouched;
   EXPECT_EQ(draglab_law_F(nullptr, 0.3, 1.0, &value), DRAGLAB_INVALID_ARGUMENT);

@@ -17,7 +17,7 @@ program fortran_api_test
   character(len=4096) :: path
   type(draglab_db_t) :: db
   type(draglab_law_t) :: law, missing
-  real(c_double) :: F, beta, dga, K, nan, untouched, phi, re
+  real(c_double) :: F, beta, dga, K, nan, untouched, phi, re, gamma, re_p
   real(c_double) :: eps_g, mu_g, rho_g, slip, d_p, rho_s
   real(c_double) :: phis(4), res(4), Fs(4)
   integer(c_long_long) :: count
@@ -73,6 +73,12 @@ program fortran_api_test
   call expect_status(draglab_law_dga(law, eps_g, mu_g, rho_g, slip, d_p, rho_s, dga), &
                      DRAGLAB_OK, 'dga')
   call expect_close(dga, beta / phi, 1.0e-13_c_double, 'lDgA = beta / phi')
+  ! CFD-DEM per particle: gamma = beta V_p / phi for equal spheres, at the particle Re.
+  call expect_status(draglab_law_particle_drag(law, eps_g, mu_g, rho_g, slip, d_p, d_p, gamma, &
+                     re_p), DRAGLAB_OK, 'particle drag')
+  call expect_close(gamma, beta * (acos(-1.0_c_double) * d_p**3 / 6.0_c_double) / phi, &
+                    1.0e-13_c_double, 'gamma = beta V_p / phi')
+  call expect_close(re_p, re, 1.0e-13_c_double, 'particle Re = rho eps d slip / mu')
 
   ! Errors come back as statuses, the output untouched, never as NaN.
   F = untouched

@@ -125,6 +125,17 @@ DRAGLAB_EXPORT int draglab_law_beta_n(const draglab_law* law, size_t n, const do
                                       const double* mu_g, const double* rho_g,
                                       const double* slip, const double* d_p, double* beta);
 
+/* CFD-DEM per-particle drag (CFDEM/LIGGGHTS style): the coefficient gamma [kg/s] with which the
+ * fluid drags one particle, F_i = gamma (u_f - u_p), and the particle Reynolds number re used.
+ * eps_g: local voidage; mu_g [Pa s], rho_g [kg/m^3]: fluid; slip = |u_f - u_p| [m/s]; d_i [m]:
+ * the particle's diameter; d_mean [m]: the Sauter mean diameter of the particles around it, used
+ * by polydisperse laws (y = d_i/d_mean, Re with d_mean) and ignored by the others (Re with d_i).
+ * gamma = 3 pi mu_g d_i eps_g F(phi, Re), Re = rho_g eps_g d slip / mu_g; for equal spheres
+ * gamma = beta V_p / phi. re may be NULL. */
+DRAGLAB_EXPORT int draglab_law_particle_drag(const draglab_law* law, double eps_g, double mu_g,
+                                             double rho_g, double slip, double d_i, double d_mean,
+                                             double* gamma, double* re);
+
 /* Standalone source of the loaded law version, as `draglab law export`: format "c", "fortran" or
  * "json". Writes at most `size` bytes including the terminating NUL into `buffer` and the full
  * length (without NUL) into *length. Query the length with buffer = NULL, size = 0 (status 0);

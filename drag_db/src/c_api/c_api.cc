@@ -355,6 +355,18 @@ int draglab_law_dga(const draglab_law* law, double eps_g, double mu_g, double rh
   });
 }
 
+int draglab_law_particle_drag(const draglab_law* law, double eps_g, double mu_g, double rho_g,
+                              double slip, double d_i, double d_mean, double* gamma, double* re) {
+  return guarded([&] {
+    const draglab::Law& l = law_of(law, "draglab_law_particle_drag");
+    require(gamma != nullptr, "draglab_law_particle_drag: gamma is NULL");
+    double re_used = 0.0;
+    const double value = l.particle_drag(eps_g, mu_g, rho_g, slip, d_i, d_mean, &re_used);
+    *gamma = value;
+    if (re != nullptr) *re = re_used;
+  });
+}
+
 int draglab_law_beta_n(const draglab_law* law, size_t n, const double* eps_g, const double* mu_g,
                        const double* rho_g, const double* slip, const double* d_p, double* beta) {
   return guarded([&] {

@@ -27,9 +27,9 @@ enum class ForceKind {
 
 /// Which dimensionless quantity the native formula returns.
 enum class Normalisation {
-  kForce,           ///< F_x / (3 pi mu d U), U = eps u superficial (F or K family).
-  kBetaD2OverMuPhi, ///< beta d^2 / (mu phi), MFiX's DgA d^2/mu (beta per unit solids fraction).
-  kDragCoefficient, ///< C_d of an isolated sphere at the interstitial slip (single-sphere laws).
+  kForce,            ///< F_x / (3 pi mu d U), U = eps u superficial (F or K family).
+  kBetaD2OverMuPhi,  ///< beta d^2 / (mu phi), MFiX's DgA d^2/mu (beta per unit solids fraction).
+  kDragCoefficient,  ///< C_d of an isolated sphere at the interstitial slip (single-sphere laws).
 };
 
 /// Which Reynolds number the native formula takes.
@@ -115,6 +115,14 @@ T beta_d2_over_mu(const T& phi, const T& F) {
 template <typename T>
 T beta(const T& phi, const T& F, double mu, double d) {
   return beta_d2_over_mu(phi, F) * (mu / (d * d));
+}
+
+/// Per-particle drag coefficient gamma [kg/s] of CFD-DEM codes, the drag on one particle being
+/// gamma (u_f - u_p) with the interstitial slip: gamma = 3 pi mu d eps F, with d the particle's
+/// own diameter (F is normalised by 3 pi mu d_i eps u). Equals beta V_p / phi for equal spheres.
+template <typename T>
+T particle_drag_coefficient(const T& phi, const T& F, double mu, double d) {
+  return (T(1.0) - phi) * F * (3.0 * 3.14159265358979323846 * mu * d);
 }
 
 /// Total-force K = F / (1 - phi) (Zick-Homsy / Hill-Koch-Ladd normalisation).

@@ -85,9 +85,9 @@ RangePolicy range_policy_from_string(const std::string& s);
 /// One evaluation with the point the formula actually saw (differs from the request only under
 /// RangePolicy::kClamp).
 struct LawEvaluation {
-  double phi = 0.0;            ///< phi evaluated (clamped into the validity box if so asked).
-  double re = 0.0;             ///< Re evaluated.
-  double F = 0.0;              ///< Canonical drag-only F at (phi, re).
+  double phi = 0.0;              ///< phi evaluated (clamped into the validity box if so asked).
+  double re = 0.0;               ///< Re evaluated.
+  double F = 0.0;                ///< Canonical drag-only F at (phi, re).
   bool out_of_validity = false;  ///< The requested point lay outside the validity box.
 };
 
@@ -142,6 +142,15 @@ class Law {
   /// interstitial slip |u_g - u_s| [m/s], particle diameter d_p [m].
   double beta(double eps_g, double mu_g, double rho_g, double slip, double d_p,
               const double* extra = nullptr) const;
+  /// CFD-DEM per-particle drag coefficient gamma [kg/s] (drag on the particle = gamma times the
+  /// interstitial slip vector; conventions::particle_drag_coefficient) of a particle of diameter
+  /// d_i [m] at local voidage eps_g, fluid viscosity mu_g [Pa s] and density rho_g [kg/m^3],
+  /// slip |u_f - u_p| [m/s]. Polydisperse forms (one extra input, y = d_i/<d>) take d_mean [m],
+  /// the Sauter mean diameter of the particles around, and evaluate F at Re = rho_g eps_g d_mean
+  /// slip / mu_g and y = d_i/d_mean; monodisperse forms ignore d_mean (Re with d_i). *re_out, if
+  /// given, receives the Reynolds number used. Same checks as beta().
+  double particle_drag(double eps_g, double mu_g, double rho_g, double slip, double d_i,
+                       double d_mean, double* re_out = nullptr) const;
 
  private:
   /// Validates (phi, re, extra) and applies the range policy; returns the values to evaluate.
