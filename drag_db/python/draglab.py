@@ -13,14 +13,17 @@ K = F / (1 - phi) includes the mean pressure gradient.
 
 Every failing call raises DraglabError(code, message) with the status code of draglab.h.
 No compiler is needed: only the shared library. It is found from the environment variable
-DRAGLAB_LIBRARY (a path to libdraglab), else next to this file, else by
-ctypes.util.find_library("draglab").
+DRAGLAB_LIBRARY (a path to libdraglab), else next to this file, else in the libdir of the
+installed draglab's pkg-config file (`pkg-config --variable=libdir draglab`, so
+PKG_CONFIG_PATH finds an installation under any prefix), else by
+ctypes.util.find_library("draglab"). Installable with `pip install ./drag_db/python`.
 """
 
 import ctypes
 import ctypes.util
 import glob
 import os
+import subprocess
 import sys
 from array import array
 
@@ -66,11 +69,21 @@ def _candidate_paths():
     if env:
         yield env
         return
+    patterns = ("libdraglab.so", "libdraglab.so.*", "libdraglab.dylib", "libdraglab*.dylib",
+                "draglab.dll", "libdraglab.dll")
     here = os.path.dirname(os.path.abspath(__file__))
-    for pattern in ("libdraglab.so", "libdraglab.so.*", "libdraglab.dylib", "libdraglab*.dylib",
-                    "draglab.dll", "libdraglab.dll"):
+    for pattern in patterns:
         for path in sorted(glob.glob(os.path.join(here, pattern))):
             yield path
+    try:
+        libdir = subprocess.run(["pkg-config", "--variable=libdir", "draglab"],
+                                capture_output=True, text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        libdir = ""
+    if libdir:
+        for pattern in patterns:
+            for path in sorted(glob.glob(os.path.join(libdir, pattern))):
+                yield path
     found = ctypes.util.find_library("draglab")
     if found:
         yield found
