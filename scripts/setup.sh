@@ -50,6 +50,7 @@ packages=(
   python3-h5py                      # tests: packing files open in h5py
   gnuplot-nox                       # draglab lbm convergence --plot (PNG, no X11)
   python3                           # Python bindings test (Debian's /usr/bin/python3)
+  python3-pip python3-numpy         # pip install ./drag_db/python into a venv (install test)
   libopenmpi-dev openmpi-bin        # campaigns across ranks and nodes (mpirun, srun): mpi/
 )
 
