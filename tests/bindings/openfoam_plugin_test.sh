@@ -8,8 +8,8 @@
 #      plugin evaluates OpenFOAM's model on the same fields at every call and logs the largest
 #      relative difference of CdRe (K = alpha_d 0.75 CdRe rho nu / d^2 has the same factors for
 #      both, so this is K's difference);
-#   C. `law "bvk2007@1"` (rangePolicy clamp: its box starts at phi = 0.1, the freeboard is
-#      particle-free): the law changes the answer;
+#   C. `law bvk2007@1` (unquoted, as OpenFOAM users write words; rangePolicy clamp: its box
+#      starts at phi = 0.1, the freeboard is particle-free): the law changes the answer;
 #   D. bad input: bvk2007@1 with rangePolicy error, an unknown law, a missing database.
 # References and tolerances: gidaspow@1 and OpenFOAM's GidaspowErgunWenYu are the same formula
 # (Ergun below alpha_air = 0.8, Wen-Yu above, superficial Re = alpha_air |U_r| d / nu), so K
@@ -136,7 +136,7 @@ check "the pressure-drop history agrees with OpenFOAM's own model to 1e-6" \
 
 # --- C: another law changes the answer -----------------------------------------------------------
 make_case "$work/C" '        type            draglab;
-        law             "bvk2007@1";
+        law             bvk2007@1;
         database        "constant/draglab.db";
         rangePolicy     clamp;
         residualRe      1e-3;' || { echo "FAIL: case C"; exit 1; }

@@ -21,12 +21,27 @@ addToRunTimeSelectionTable(dragModel, draglab, dictionary);
 }  // namespace dragModels
 }  // namespace Foam
 
+namespace {
+
+// The law entry, quoted ("gidaspow@1") or not (gidaspow@1: a word to OpenFOAM's tokenizer).
+Foam::string lawReference(const Foam::dictionary& dict) {
+  Foam::ITstream& is = dict.lookup("law");
+  Foam::token t(is);
+  if (t.isWord()) return t.wordToken();
+  if (t.isString()) return t.stringToken();
+  FatalIOErrorInFunction(dict) << "draglab: law must be a law reference such as gidaspow@1"
+                               << Foam::exit(Foam::FatalIOError);
+  return Foam::string();
+}
+
+}  // namespace
+
 // * * * * * * * * * * * * * * * * Constructors  * * * * * * * * * * * * * * //
 
 Foam::dragModels::draglab::draglab(const dictionary& dict, const phasePair& pair,
                                    const bool registerObject)
     : dragModel(dict, pair, registerObject),
-      lawRef_(dict.get<string>("law")),
+      lawRef_(lawReference(dict)),
       database_(dict.get<fileName>("database")),
       rangePolicy_(dict.getOrDefault<word>("rangePolicy", "error")),
       db_(nullptr),
