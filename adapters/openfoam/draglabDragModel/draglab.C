@@ -77,12 +77,13 @@ Foam::dragModels::draglab::draglab(const dictionary& dict, const phasePair& pair
     const std::string why(draglab_last_error());
     draglab_db_close(db_);
     db_ = nullptr;
-    FatalIOErrorInFunction(dict) << "draglab: cannot load the law " << lawRef_ << " from "
+    FatalIOErrorInFunction(dict) << "draglab: cannot load the law " << lawRef_.c_str() << " from "
                                  << database_ << ": " << why.c_str() << exit(FatalIOError);
   }
   if (draglab_law_num_extra(law_) != 0) {
-    FatalIOErrorInFunction(dict) << "draglab: the law " << lawRef_ << " is polydisperse (it needs "
-                                 << draglab_law_num_extra(law_) << " extra inputs per cell); "
+    FatalIOErrorInFunction(dict) << "draglab: the law " << lawRef_.c_str()
+                                 << " is polydisperse (it needs " << draglab_law_num_extra(law_)
+                                 << " extra inputs per cell); "
                                  << "twoPhaseEulerFoam has one particle diameter per phase"
                                  << exit(FatalIOError);
   }
