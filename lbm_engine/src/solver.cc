@@ -520,19 +520,7 @@ class Solver final : public SolverBase {
     const std::uint32_t* masks = lattice_.solid_masks();
     const bool update = settings_.interpolated;
     const bool links = update || body_force != nullptr;
-    const std::size_t bodies = links_.num_bodies();
-    if (body_force != nullptr) {
-      for (auto& partial : partial_force_) partial.assign(3 * bodies + 1, 0.0);
-    }
-    for (auto& d : partial_defect_) d = 0.0;
-    // Net mass the interpolation added in the previous step, returned evenly through the rest
-    // populations of the boundary nodes (c_0 = 0: no momentum change). Only the net leak is
-    // corrected (local defects largely cancel, exactly so for a symmetric body in Stokes flow,
-    // and correcting them locally would perturb the second-order wall), so the total mass stays
-    // constant to within one step's leak.
-    const double correction = settings_.mass_correction && update
-                                  ? pending_defect_ / static_cast<double>(boundary_nodes())
-                                  : 0.0;
+    const double correction = begin_step(body_force);
 #pragma omp parallel num_threads(threads_)
     {
       for (int t = thread_id(); t < ranges; t += team_size()) {
@@ -550,15 +538,35 @@ class Solver final : public SolverBase {
       if (links) {
         // Every post-collision value of this step must be in place before any link reads it.
 #pragma omp barrier
-        for (int t = thread_id(); t < ranges; t += team_size()) {
-          const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
-          for (std::int64_t r = r0; r < r1; ++r) {
-            link_row(t, r, parity, update, body_force != nullptr, correction);
-          }
-        }
+        link_ranges(parity, update, body_force != nullptr, correction);
       }
     }
     finish_step(parity, update, body_force);
+  }
+
+  /// Clears the link pass's partial sums for a step and returns the mass correction it applies:
+  /// the net mass the interpolation added in the previous step, returned evenly through the
+  /// rest populations of the boundary nodes (c_0 = 0: no momentum change). Only the net leak is
+  /// corrected (local defects largely cancel, exactly so for a symmetric body in Stokes flow,
+  /// and correcting them locally would perturb the second-order wall), so the total mass stays
+  /// constant to within one step's leak.
+  double begin_step(std::vector<double>* body_force) {
+    if (body_force != nullptr) {
+      for (auto& partial : partial_force_) partial.assign(3 * links_.num_bodies() + 1, 0.0);
+    }
+    for (auto& d : partial_defect_) d = 0.0;
+    return settings_.mass_correction && settings_.interpolated
+               ? pending_defect_ / static_cast<double>(boundary_nodes())
+               : 0.0;
+  }
+
+  /// The link pass of this thread (inside a parallel region): the links of its work ranges.
+  void link_ranges(int parity, bool update, bool forces, double correction) {
+    const int ranges = lattice_.num_ranges();
+    for (int t = thread_id(); t < ranges; t += team_size()) {
+      const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
+      for (std::int64_t r = r0; r < r1; ++r) link_row(t, r, parity, update, forces, correction);
+    }
   }
 
   /// The sums of a step's link pass: the mass defect and the body forces, over the work ranges
@@ -593,19 +601,11 @@ class Solver final : public SolverBase {
     T* base = populations_.data();
     const std::int64_t stride = populations_.stride();
     const KernelParams<T> p = params_;
-    const int ranges = lattice_.num_ranges();
     const Segment* segments = lattice_.segments().data();
     const std::uint32_t* masks = lattice_.solid_masks();
     const bool update = settings_.interpolated;
     const bool links = update || body_force != nullptr;
-    const std::size_t bodies = links_.num_bodies();
-    if (body_force != nullptr) {
-      for (auto& partial : partial_force_) partial.assign(3 * bodies + 1, 0.0);
-    }
-    for (auto& d : partial_defect_) d = 0.0;
-    const double correction = settings_.mass_correction && update
-                                  ? pending_defect_ / static_cast<double>(boundary_nodes())
-                                  : 0.0;
+    const double correction = begin_step(body_force);
     const HaloPlan& plan = lattice_.halo();
     // Even step: the owned values go out, the halo's come in; odd step: the values this rank's
     // nodes wrote into the halo go back to their owners.
@@ -667,14 +667,7 @@ class Solver final : public SolverBase {
         }
       }
 #pragma omp barrier
-      if (links && !failure) {
-        for (int t = thread_id(); t < ranges; t += team_size()) {
-          const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
-          for (std::int64_t r = r0; r < r1; ++r) {
-            link_row(t, r, parity, update, body_force != nullptr, correction);
-          }
-        }
-      }
+      if (links && !failure) link_ranges(parity, update, body_force != nullptr, correction);
     }
     if (failure) std::rethrow_exception(failure);
     finish_step(parity, update, body_force);
