@@ -26,6 +26,7 @@
 #include "draglab/lbm/convergence.h"
 #include "draglab/lbm/fields_io.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/lbm/resolution.h"
 #include "draglab/mpi/communicator.h"
 #include "draglab/mpi/world.h"
 #include "draglab/workflows/bed_results.h"
@@ -52,9 +53,14 @@ struct SolverOptions {
   double re = kNaN;
   std::string collision = "trt";
   std::string boundary = "ibb";
+  std::string wall_interpolation = "auto";
   std::string precision = "double";
   double tau = 0.0;
   double magic = 3.0 / 16.0;
+  double mach = 0.1;
+  double average_time = 20.0;
+  bool average_time_given = false;
+  double average_tolerance = 5e-3;
   std::int64_t max_steps = 200000;
   double tolerance = 1e-6;
   int threads = 0;
@@ -142,10 +148,14 @@ lbm::RunOptions run_options(const SolverOptions& s) {
   }
   r.collision = lbm::collision_from_string(s.collision);
   r.boundary = lbm::boundary_from_string(s.boundary);
+  r.interpolation = lbm::wall_interpolation_from_string(s.wall_interpolation);
   r.precision = lbm::precision_from_string(s.precision);
   r.re = s.re;
   r.tau = s.tau;
   r.magic = s.magic;
+  r.mach_target = s.mach;
+  r.average_time = s.average_time;
+  r.average_tolerance = s.average_tolerance;
   r.max_steps = s.max_steps;
   r.tolerance = s.tolerance;
   r.threads = s.threads;
@@ -194,6 +204,27 @@ void on_every_rank(const mpi::Communicator& group, const std::function<void()>& 
   }
 }
 
+/// Before any work: the operator must hold the cell Reynolds number (resolution.h), and an
+/// averaging window the user set must fit in max_steps.
+void check_finite_re_plan(double phi, double d, const lbm::RunOptions& options,
+                          const SolverOptions& s) {
+  if (options.re == 0.0) return;
+  const lbm::VelocityPlan plan = lbm::plan_velocity(phi, options.re, d, options.collision,
+                                                    options.mach_target, 0.0, false, options.tau);
+  const std::string refusal = lbm::cell_reynolds_refusal(plan, options.re, d, options.collision);
+  if (!refusal.empty()) throw UsageError("--d / --re: " + refusal);
+  if (!s.average_time_given) return;
+  // Steps of the window at the plan's velocity (kappa estimated; the measured one is larger,
+  // so the run's window is longer still).
+  const double window = options.average_time * d / plan.velocity;
+  if (window > static_cast<double>(options.max_steps)) {
+    throw UsageError(fmt::format(
+        "--average-time = {} d/U is {:.0f} steps at this run's velocity (U = {:.4g}), more than "
+        "--max-steps = {}; raise --max-steps to at least {:.0f} or shorten --average-time",
+        options.average_time, window, plan.velocity, options.max_steps, 2.0 * window));
+  }
+}
+
 void run_lbm(const CliContext& ctx, const RunCommand& c) {
   // Launched with several ranks, the ranks share the box (slabs of z-planes): each reads the
   // input, rank 0 alone checks the outputs, prints and writes.
@@ -224,6 +255,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
           "calibration runs in Stokes flow");
     }
     if (c.calibrate && c.d > 128.0) throw UsageError("--calibrate works for --d up to 128");
+    check_finite_re_plan(the_case.packing.phi(), c.d, options, c.solver);
   });
 
   ProgressLine progress(!ctx.quiet && root);
@@ -344,10 +376,22 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
                              options.use_hydrodynamic_diameter
                                  ? fmt::format(" (d_h = {:.4g})", options.hydrodynamic_diameter)
                                  : "");
-    std::cout << fmt::format("scheme           {} + {}, {}, tau = {:.4g}{}\n",
-                             lbm::to_string(options.collision), lbm::to_string(options.boundary),
-                             lbm::to_string(options.precision), r.tau,
-                             options.re == 0.0 ? " (Stokes mode)" : "");
+    std::cout << fmt::format(
+        "scheme           {} + {}, {}, tau = {:.4g}{}\n", lbm::to_string(options.collision), r.wall,
+        lbm::to_string(options.precision), r.tau, options.re == 0.0 ? " (Stokes mode)" : "");
+    if (!r.wall_reason.empty()) {
+      std::cout << fmt::format("wall             {}: {}\n", r.wall, r.wall_reason);
+    }
+    if (r.pore_speed_ratio > 0.0) {
+      std::cout << fmt::format(
+          "velocity plan    kappa = u_max/U {:.3g} ({}), Mach target {:g}, U = {:.4g}; Re_cell "
+          "= kappa Re/d {:.3g} (limit {:g}){}\n",
+          r.pore_speed_ratio, r.pore_speed_ratio_measured ? "Stokes run" : "estimated",
+          r.mach_target, r.superficial_velocity, r.cell_reynolds, r.cell_reynolds_limit,
+          r.converged ? fmt::format("; at the end kappa {:.3g}, max|u|/nu {:.3g}",
+                                    r.final_pore_speed_ratio, r.final_cell_reynolds)
+                      : std::string());
+    }
     std::cout << fmt::format(
         "phi              {:.6f} exact, {:.6f} on the lattice{}\n", r.phi, r.phi_lattice,
         j.contains("phi_hydrodynamic")
@@ -614,6 +658,11 @@ void add_solver_options(CLI::App* cmd, SolverOptions* s, bool with_re) {
                   "Wall: bb (halfway bounce-back) or ibb (interpolated bounce-back with q)")
       ->capture_default_str()
       ->check(CLI::IsMember({"bb", "ibb"}));
+  cmd->add_option("--wall-interpolation", s->wall_interpolation,
+                  "Interpolated wall: auto (CLI where stable, BFL near tau = 1/2), cli (central "
+                  "linear) or bfl (Bouzidi linear)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "cli", "bfl"}));
   cmd->add_option("--precision", s->precision, "double, or float (shifted populations)")
       ->capture_default_str()
       ->check(CLI::IsMember({"double", "float"}));
@@ -622,6 +671,19 @@ void add_solver_options(CLI::App* cmd, SolverOptions* s, bool with_re) {
                   "budget")
       ->capture_default_str();
   cmd->add_option("--magic", s->magic, "TRT magic parameter Lambda")->capture_default_str();
+  cmd->add_option("--mach", s->mach,
+                  "Finite Re: Mach target max|u| sqrt(3), (0, 0.3]; U = Mach c_s / kappa with "
+                  "kappa = u_max/U measured by a short Stokes run")
+      ->capture_default_str();
+  cmd->add_option("--average-time", s->average_time,
+                  "Unsteady flow: average F over at least this many d/U after the start-up, "
+                  "[1, 10000]")
+      ->capture_default_str()
+      ->each([s](const std::string&) { s->average_time_given = true; });
+  cmd->add_option("--average-tolerance", s->average_tolerance,
+                  "Unsteady flow: converged when the standard error of the time-averaged F is "
+                  "below this (relative), [1e-4, 0.1]")
+      ->capture_default_str();
   cmd->add_option("--max-steps", s->max_steps, "Step limit (reaching it = not converged)")
       ->capture_default_str();
   cmd->add_option("--tolerance", s->tolerance,

@@ -54,7 +54,9 @@ double median(std::vector<double> v) {
 /// Fluid-node updates per second (millions) of `steps` steps (rounded up to pairs).
 double time_solver(const arrays::VoxelGrid& grid, Boundary boundary, int threads, int steps) {
   const SparseLattice lattice(grid, threads, sizeof(double));
-  const LinkTable links = lattice.build_links(grid, boundary == Boundary::kInterpolated);
+  const LinkTable links =
+      lattice.build_links(grid, boundary == Boundary::kInterpolated ? WallScheme::kCentralLinear
+                                                                    : WallScheme::kBounceBack);
   SolverSettings settings;
   settings.kernel = CollisionKernel::kTrt;
   settings.stokes = false;

@@ -3,11 +3,10 @@
 // the error estimate.
 //
 // Choices (all in lattice units, dx = dt = 1, rho0 = 1):
-//  - Velocity scale. Pore velocities reach about 2.5 U/(1 - phi) (lbm.md 4.5), so the superficial
-//    velocity is budgeted as U = 0.1 (1 - phi)/2.5 (max |u| about 0.1, Mach about 0.17) for
-//    finite Re, and 10x less for Re = 0: in Stokes mode the scale is immaterial (the scheme is
-//    linear) and only has to stay far above round-off; with the full equilibrium at Re = 0 it
-//    keeps the lattice Re (about 0.01 d / nu) and the u.u terms small.
+//  - Velocity scale. Finite Re: the velocity plan (draglab/lbm/resolution.h; run_planned). Re =
+//    0: U = 0.01 (1 - phi)/2.5: in Stokes mode the scale is immaterial (the scheme is linear)
+//    and only has to stay far above round-off; with the full equilibrium at Re = 0 it keeps the
+//    lattice Re (about 0.01 d / nu) and the u.u terms small.
 //  - Relaxation time (RunOptions::tau == 0). Stokes (re == 0): tau = 1 (BGK, regularized) or
 //    tau+ = 1.5 for TRT: with Lambda fixed the TRT steady state does not depend on tau+ at all,
 //    and a larger viscosity reaches it in fewer steps. Finite Re: nu = U d / Re from the budget,
@@ -28,8 +27,13 @@
 //    slowest viscous mode of a periodic cell of edge L decays in L^2/(4 pi^2 nu), 0.17 d^2/nu for
 //    the dilute simple-cubic case), so the change per T bounds the remaining error.
 //  - Stability watch at every check (10 per T): non-finite populations, density <= 0, Mach number
-//    max|u| sqrt(3) above mach_limit (a warning above 0.1), and tau - 1/2 < 1e-3 refused up front
-//    for BGK and TRT. Each stops the run with the limit, the step, the node and a remedy.
+//    max|u| sqrt(3) above mach_limit (a warning above 1.5x the Mach target), and tau - 1/2 < 1e-3
+//    refused up front for BGK and TRT. A blow-up (non-finite values, density <= 0, or a speed
+//    that grows past the limit within one check) is diagnosed as an instability with the cell
+//    Reynolds number at the last healthy check and the d that would hold; a Mach stop after
+//    steady growth as such. No blind retry: halving the velocity at the same Re does not change
+//    the cell Reynolds number, which decides stability.
+//  - Unsteady flow: see lbm.h (Convergence) and averaging.h.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -40,9 +44,11 @@
 #include <string>
 #include <vector>
 
+#include "averaging.h"
 #include "collision.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/lbm/resolution.h"
 #include "draglab/mpi/world.h"
 #include "error_model.h"
 #include "lattice.h"
@@ -61,10 +67,20 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMachWarning = 0.1;
 constexpr double kMinTauGap = 1e-3;  ///< Refuse tau - 1/2 below this for BGK and TRT.
 constexpr double kMinTauGapRegularized = 1e-5;
-constexpr double kBudgetMaxSpeed = 0.1;   ///< Target max |u| at finite Re.
 constexpr double kStokesMaxSpeed = 0.01;  ///< Target max |u| in Stokes mode.
-constexpr double kPoreSpeedFactor = 2.5;  ///< max |u| ~ 2.5 U / (1 - phi).
+constexpr double kPoreSpeedFactor = 2.5;  ///< Stokes mode: max |u| ~ 2.5 U / (1 - phi).
+/// A speed that grows by more than this factor within one check interval is a blow-up, not a
+/// flow that is merely too fast.
+constexpr double kBlowUpGrowth = 1.5;
+/// Tolerance of the Stokes run that measures the pore-speed ratio.
+constexpr double kPoreSpeedTolerance = 1e-3;
+/// Corrections of the force an averaging run may make before it gives up.
+constexpr int kMaxAveragingRestarts = 3;
+/// Its steps, as a share of a Stokes run to the default tolerance (for predicted_steps).
+constexpr double kPoreSpeedRunShare = 0.5;
 constexpr int kChecksPerTime = 10;
+/// Checks (five characteristic times) over which unsteadiness is judged.
+constexpr std::size_t kUnsteadyWindowChecks = 5 * kChecksPerTime;
 constexpr double kAdjustBelowChange = 1e-2;  ///< Full mode: adjust G once F changes less per T.
 constexpr int kMaxAdjustments = 30;
 constexpr double kProgressInterval = 0.2;  ///< Seconds between progress reports.
@@ -140,15 +156,109 @@ double machine_memory_bytes() {
 #endif
 }
 
+/// The wall scheme of a run, recorded in result->wall with the reason for an automatic choice.
+/// CLI's negative weight amplifies the short-wave modes that a relaxation time near 1/2 leaves
+/// undamped; BFL's weights are all non-negative.
+WallScheme choose_wall(const RunOptions& options, double tau, bool stokes, RunResult* result) {
+  if (options.boundary == Boundary::kHalfwayBounceBack) {
+    result->wall = "bb";
+    return WallScheme::kBounceBack;
+  }
+  WallInterpolation choice = options.interpolation;
+  if (choice == WallInterpolation::kAuto) {
+    if (stokes || tau >= kCentralWallMinTau) {
+      choice = WallInterpolation::kCentral;
+      result->wall_reason = stokes ? "Stokes flow: CLI is stable and the more accurate"
+                                   : "tau = " + fmt("%.4g", tau) +
+                                         " >= " + fmt("%g", kCentralWallMinTau) +
+                                         ": CLI is stable there and the more accurate";
+    } else {
+      choice = WallInterpolation::kBouzidi;
+      result->wall_reason = "tau = " + fmt("%.4g", tau) + " < " + fmt("%g", kCentralWallMinTau) +
+                            ": CLI's negative weight goes unstable near tau = 1/2, BFL's "
+                            "non-negative weights do not";
+    }
+  }
+  result->wall = to_string(choice);
+  return choice == WallInterpolation::kCentral ? WallScheme::kCentralLinear
+                                               : WallScheme::kBouzidiLinear;
+}
+
+/// The diagnosis of a run that blew up at `step` (`what` at `node`): where the flow was fastest
+/// at the last healthy check, the cell Reynolds number there, the operator's limit and the d
+/// that would hold.
+std::string diverged_diagnosis(const SparseLattice& lattice, const RunOptions& options, double d,
+                               double nu, double target_re, double result_phi, std::int64_t step,
+                               const std::string& what, std::int64_t node, double last_max_speed,
+                               std::int64_t last_max_node, std::int64_t last_check_step) {
+  std::string text = "diverged (numerical instability of " +
+                     std::string(to_string(options.collision)) + "): " + what + " at step " +
+                     std::to_string(step) + ", " + node_text(lattice, node);
+  const double limit = max_cell_reynolds(options.collision);
+  const double stable = stable_cell_reynolds(options.collision);
+  // The central interpolation's negative weight is a cause of its own near tau = 1/2.
+  const double tau = 0.5 + 3.0 * nu;
+  const std::string wall_remedy =
+      options.boundary == Boundary::kInterpolated &&
+              options.interpolation == WallInterpolation::kCentral && tau < kCentralWallMinTau
+          ? "the BFL wall (--wall-interpolation auto or bfl: CLI is unstable at tau = " +
+                fmt("%.4g", tau) + " < " + fmt("%g", kCentralWallMinTau) + "), or "
+          : std::string();
+  if (last_max_speed > 0.0 && nu > 0.0) {
+    const double cell_re = last_max_speed / nu;
+    text += "; at step " + std::to_string(last_check_step) + " the fastest node was " +
+            node_text(lattice, last_max_node) + " (|u| = " + fmt("%.3g", last_max_speed) +
+            "), a cell Reynolds number |u| dx / nu = " + fmt("%.3g", cell_re);
+    if (std::isfinite(limit)) {
+      text += " (" + std::string(to_string(options.collision)) + " has held up to " +
+              fmt("%g", stable) + " in every measured packing and diverged in all beyond " +
+              fmt("%g", limit) + ")";
+      if (target_re > 0.0) {
+        const double d_hold =
+            std::ceil(estimated_pore_speed_ratio(result_phi) * target_re / stable);
+        text += "; remedy: " + wall_remedy + "--d " +
+                fmt("%g", std::max(d_hold, std::ceil(d) + 1.0)) +
+                " or more (kappa Re / d = " + fmt("%g", stable) + "), or a lower Re";
+        return text;
+      }
+    }
+  }
+  return text + "; remedy: " + wall_remedy + "raise the resolution d" +
+         (target_re > 0.0 ? std::string(" or lower Re") : std::string()) +
+         (options.tau != 0.0 ? std::string(", or leave tau to the engine") : std::string());
+}
+
+/// The force that brings Re to target_re: a secant step in log G against log Re through the last
+/// adjustment (*last_log_force, *last_log_re, updated), or with the BVK estimate's slope at the
+/// first one.
+double adjusted_force(double force, double re, double target_re, double phi, double* last_log_force,
+                      double* last_log_re) {
+  double slope;
+  const double log_force = std::log(force), log_re = std::log(re);
+  if (std::isfinite(*last_log_force) && std::abs(log_force - *last_log_force) > 1e-12) {
+    slope = (log_re - *last_log_re) / (log_force - *last_log_force);
+  } else {
+    const double h = 1e-3;
+    const double dlnf =
+        (std::log(bvk2007_estimate(phi, re * (1 + h))) - std::log(bvk2007_estimate(phi, re))) /
+        std::log1p(h);
+    slope = 1.0 / (1.0 + dlnf);
+  }
+  slope = std::clamp(slope, 0.3, 1.0);
+  *last_log_force = log_force;
+  *last_log_re = log_re;
+  return force * std::exp(std::log(target_re / re) / slope);
+}
+
 /// Initial body force for a superficial velocity U (force balance with the BVK estimate).
 double force_for_velocity(double u, double nu, double d, double phi, double re) {
   const double f = bvk2007_estimate(phi, re);
   return 18.0 * nu * u * f * phi / ((1.0 - phi) * d * d);
 }
 
-/// One run. `velocity_scale` (<= 1) scales the Mach budget of the velocity (see run_checked).
+/// One run. `plan`: the velocity plan of a finite-Re run (null at Re = 0).
 RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
-                   Fields* fields, const ProgressCallback& progress, double velocity_scale) {
+                   Fields* fields, const ProgressCallback& progress, const VelocityPlan* plan) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   auto seconds_since = [](Clock::time_point t) {
@@ -180,16 +290,24 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   result.stokes_mode = stokes;
   const double target_re = options.re;
 
-  // Relaxation times and the velocity scale.
-  // Re = 0 asks for creeping flow: a small velocity also with the full equilibrium (so that its
-  // u.u terms are negligible, not merely its Re undefined).
-  const double budget_u = velocity_scale * (target_re == 0.0 ? kStokesMaxSpeed : kBudgetMaxSpeed) *
-                          (1.0 - phi) / kPoreSpeedFactor;
+  // Relaxation times and the velocity scale. Finite Re: the plan (resolution.h). Re = 0 asks for
+  // creeping flow: a small velocity also with the full equilibrium (so that its u.u terms are
+  // negligible, not merely its Re undefined).
+  if (target_re > 0.0 && plan == nullptr) {
+    throw Error(ErrorCode::kInternal, "lbm run: a finite-Re run needs its velocity plan");
+  }
+  const double budget_u = kStokesMaxSpeed * (1.0 - phi) / kPoreSpeedFactor;
   const double stokes_tau = options.collision == Collision::kTrt ? 1.5 : 1.0;
   double tau = options.tau;
-  if (tau == 0.0) {
-    tau =
-        target_re == 0.0 ? stokes_tau : std::min(stokes_tau, 0.5 + 3.0 * budget_u * d / target_re);
+  if (target_re > 0.0) {
+    tau = plan->tau;
+    result.pore_speed_ratio = plan->kappa;
+    result.pore_speed_ratio_measured = plan->kappa_measured;
+    result.mach_target = plan->mach_target;
+    result.cell_reynolds = plan->cell_reynolds;
+    result.cell_reynolds_limit = plan->cell_reynolds_limit;
+  } else if (tau == 0.0) {
+    tau = stokes_tau;
   }
   const double nu = (tau - 0.5) / 3.0;
   double tau_minus = tau;
@@ -240,6 +358,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   const int threads = resolve_threads(options.threads, group);
   const std::size_t element = options.precision == Precision::kFloat ? 4 : 8;
   const bool interpolated = options.boundary == Boundary::kInterpolated;
+  const WallScheme wall = choose_wall(options, tau, stokes, &result);
   SolverSettings settings;
   settings.kernel = options.collision == Collision::kRegularized ? CollisionKernel::kRegularized
                                                                  : CollisionKernel::kTrt;
@@ -282,7 +401,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
                       " GiB; lower the resolution or use --precision float" +
                       (group.size() > 1 ? ", or spread the ranks over more nodes" : ""));
     }
-    links_storage = std::make_unique<LinkTable>(lattice.build_links(grid, interpolated));
+    links_storage = std::make_unique<LinkTable>(lattice.build_links(grid, wall));
     solver = make_solver(options.precision, lattice, *links_storage, settings, threads, group);
   });
   const SparseLattice& lattice = *lattice_storage;
@@ -334,12 +453,27 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   std::int64_t step = 0;
   double stepping_s = 0.0;
   int adjustments = 0;
+  // Unsteady flow (averaging.h): once detected, the force is held and F averaged.
+  bool averaging = false;
+  int averaging_restarts = 0;
+  std::int64_t averaging_start = 0;
+  std::vector<double> series_F, series_re;
+  std::vector<std::vector<double>> series_body;  // per body, the averaging samples
+  TimeAverage average_F, average_re;
   double last_log_force = std::numeric_limits<double>::quiet_NaN(), last_log_re = last_log_force;
   double relative_change = std::numeric_limits<double>::infinity();
   bool mach_warned = false;
   auto last_progress = Clock::now();
   double F_mean = 0.0, U = 0.0, re_lattice = 0.0, mach = 0.0;
   MomentSummary m;
+  // The largest speed at the last healthy check: where and how fast the flow was before a
+  // blow-up, for the diagnosis.
+  double last_max_speed = 0.0;
+  std::int64_t last_max_node = -1, last_check_step = 0;
+  auto instability = [&](const std::string& what, std::int64_t node) {
+    return diverged_diagnosis(lattice, options, d, nu, target_re, phi, step, what, node,
+                              last_max_speed, last_max_node, last_check_step);
+  };
 
   while (true) {
     if (step >= options.max_steps) {
@@ -371,35 +505,45 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     m = solver->moments();
     if (m.nonfinite_node >= 0) {
       if (fields != nullptr) solver->fill_fields(fields);
-      return fail("diverged: non-finite population at step " + std::to_string(step) + ", " +
-                  node_text(lattice, m.nonfinite_node) +
-                  "; remedy: raise the resolution, lower Re or use the regularized collision "
-                  "(rr)");
+      return fail(instability("a non-finite population", m.nonfinite_node));
     }
     if (m.min_rho <= 0.0) {
       if (fields != nullptr) solver->fill_fields(fields);
-      return fail("diverged: density " + fmt("%.3g", m.min_rho) + " <= 0 at step " +
-                  std::to_string(step) + ", " + node_text(lattice, m.min_rho_node) +
-                  "; remedy: raise the resolution, lower Re or use the regularized collision (rr)");
+      return fail(instability("density " + fmt("%.3g", m.min_rho) + " <= 0", m.min_rho_node));
     }
     mach = std::sqrt(3.0 * m.max_speed2);
     result.mach_max = std::max(result.mach_max, mach);
     if (mach > options.mach_limit) {
       if (fields != nullptr) solver->fill_fields(fields);
+      if (last_max_speed > 0.0 && std::sqrt(m.max_speed2) > kBlowUpGrowth * last_max_speed) {
+        return fail(instability("max |u| grew from " + fmt("%.3g", last_max_speed) + " to " +
+                                    fmt("%.3g", std::sqrt(m.max_speed2)) + " (Mach " +
+                                    fmt("%.3g", mach) + ") within " + std::to_string(interval) +
+                                    " steps",
+                                m.max_speed_node));
+      }
       return fail("Mach number " + fmt("%.3g", mach) + " above the limit " +
                   fmt("%g", options.mach_limit) + " at step " + std::to_string(step) + ", " +
                   node_text(lattice, m.max_speed_node) +
-                  " (max |u| = " + fmt("%.3g", std::sqrt(m.max_speed2)) +
-                  "); remedy: raise the resolution d or lower tau (the velocity is U = Re nu / d "
-                  "at the target Re), or lower Re");
+                  " (max |u| = " + fmt("%.3g", std::sqrt(m.max_speed2)) + ", grown steadily" +
+                  (target_re > 0.0 && options.tau == 0.0
+                       ? std::string("); remedy: lower the Mach target (--mach)")
+                       : std::string("); remedy: lower tau (the velocity is U = Re nu / d at the "
+                                     "target Re), or leave tau to the engine")));
     }
-    if (mach > kMachWarning && !mach_warned) {
+    const double mach_warning = target_re > 0.0 && options.tau == 0.0
+                                    ? std::max(kMachWarning, 1.5 * options.mach_target)
+                                    : kMachWarning;
+    if (mach > mach_warning && !mach_warned) {
       mach_warned = true;
       result.warnings.push_back(
-          "Mach number " + fmt("%.3g", mach) + " above 0.1 at step " + std::to_string(step) + " (" +
-          node_text(lattice, m.max_speed_node) +
+          "Mach number " + fmt("%.3g", mach) + " above " + fmt("%.3g", mach_warning) + " at step " +
+          std::to_string(step) + " (" + node_text(lattice, m.max_speed_node) +
           "): compressibility error of order Ma^2 = " + fmt("%.2g", mach * mach));
     }
+    last_max_speed = std::sqrt(m.max_speed2);
+    last_max_node = m.max_speed_node;
+    last_check_step = step;
 
     U = m.sum_u[0] / total_nodes;
     re_lattice = U * d / nu;
@@ -408,9 +552,8 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     F_mean = sum_fx / static_cast<double>(bodies) / (3.0 * kPi * nu * d * U);
     if (!std::isfinite(F_mean)) {
       if (fields != nullptr) solver->fill_fields(fields);
-      return fail("diverged: non-finite drag at step " + std::to_string(step) +
-                  " (superficial velocity " + fmt("%.3g", U) +
-                  "); remedy: raise the resolution or use the regularized collision (rr)");
+      return fail(instability("a non-finite drag (superficial velocity " + fmt("%.3g", U) + ")",
+                              m.max_speed_node));
     }
     window.push_back({F_mean, U});
     relative_change = std::numeric_limits<double>::infinity();
@@ -457,6 +600,93 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
       if (factor != 1.0) solver->scale_deviations(factor);
     }
 
+    // Unsteady flow. A flow that fluctuates around a stationary mean at the target Re never
+    // meets the steady test: detect it, bring Re to its band on the filtered (window mean)
+    // velocity, then hold the force and average F (averaging.h).
+    if (!averaging && target_re > 0.0 && !stokes && relative_change > options.tolerance &&
+        window.size() >= kUnsteadyWindowChecks) {
+      std::vector<double> window_F(window.size());
+      double mean_U = 0.0;
+      for (std::size_t k = 0; k < window.size(); ++k) window_F[k] = window[k].first;
+      for (std::size_t k = window.size() - kUnsteadyWindowChecks; k < window.size(); ++k) {
+        mean_U += window[k].second / static_cast<double>(kUnsteadyWindowChecks);
+      }
+      if (stationary_fluctuating(window_F, kUnsteadyWindowChecks, options.tolerance)) {
+        const double mean_re = mean_U * d / nu;
+        if (std::abs(mean_re / target_re - 1.0) > options.re_tolerance / 3.0 &&
+            adjustments < kMaxAdjustments) {
+          force = adjusted_force(force, mean_re, target_re, phi, &last_log_force, &last_log_re);
+          solver->set_force(force);
+          window.clear();
+          ++adjustments;
+          continue;
+        }
+        const std::int64_t needed =
+            static_cast<std::int64_t>(std::ceil(options.average_time * d / (target_re * nu / d)));
+        if (step + needed > options.max_steps) {
+          if (fields != nullptr) solver->fill_fields(fields);
+          return fail("unsteady flow at Re = " + fmt("%.4g", mean_re) + " (F fluctuates by " +
+                      fmt("%.2g", relative_change) +
+                      " per characteristic time around a "
+                      "stationary mean): averaging over average_time = " +
+                      fmt("%g", options.average_time) + " d/U needs " + std::to_string(needed) +
+                      " more steps, beyond max_steps = " + std::to_string(options.max_steps) +
+                      "; remedy: --max-steps " + std::to_string(step + 2 * needed) + " or more");
+        }
+        averaging = true;
+        averaging_start = step;
+        result.warnings.push_back("unsteady flow from step " + std::to_string(step) +
+                                  ": the force is held and F time-averaged");
+      }
+    }
+    if (averaging) {
+      series_F.push_back(F_mean);
+      series_re.push_back(re_lattice);
+      series_body.resize(bodies);
+      for (std::size_t s = 0; s < bodies; ++s) {
+        series_body[s].push_back(body_force[3 * s] / (3.0 * kPi * nu * d * U));
+      }
+      average_F = time_average(series_F);
+      average_re = time_average(series_re, average_F.truncated);
+      const double averaged_time =
+          static_cast<double>(average_F.used * interval) * (target_re * nu / d) / d;
+      if (averaged_time >= options.average_time && average_F.used >= 2 * kMinBlocks) {
+        if (std::abs(average_re.mean / target_re - 1.0) > options.re_tolerance) {
+          if (averaging_restarts >= kMaxAveragingRestarts) {
+            if (fields != nullptr) solver->fill_fields(fields);
+            return fail("unsteady flow: the time-averaged Re " + fmt("%.4g", average_re.mean) +
+                        " stays outside the band of the target " + fmt("%g", target_re) +
+                        " after " + std::to_string(averaging_restarts) +
+                        " corrections of the force; remedy: a wider re_tolerance");
+          }
+          force =
+              adjusted_force(force, average_re.mean, target_re, phi, &last_log_force, &last_log_re);
+          solver->set_force(force);
+          series_F.clear();
+          series_re.clear();
+          series_body.clear();
+          averaging_start = step;
+          ++averaging_restarts;
+          continue;
+        }
+        if (average_F.standard_error <= options.average_tolerance * std::abs(average_F.mean)) {
+          break;
+        }
+      }
+      if (progress && seconds_since(last_progress) >= kProgressInterval) {
+        last_progress = Clock::now();
+        const double se = average_F.mean != 0.0
+                              ? average_F.standard_error / std::abs(average_F.mean)
+                              : std::numeric_limits<double>::infinity();
+        progress(std::min(1.0, static_cast<double>(step) / static_cast<double>(options.max_steps)),
+                 "step " + std::to_string(step) + ": averaging, F = " +
+                     fmt("%.6g", average_F.mean) + " +- " + fmt("%.2g", 100.0 * se) + " % over " +
+                     fmt("%.3g", averaged_time) + " d/U, Re = " + fmt("%.4g", average_re.mean) +
+                     ", " + fmt("%.4g", result.mflups) + " MFLUPS");
+      }
+      continue;
+    }
+
     // Target Re.
     const double re_ratio = target_re > 0.0 ? re_lattice / target_re : 1.0;
     if (target_re > 0.0 && std::abs(re_ratio - 1.0) > options.re_tolerance / 3.0 &&
@@ -467,22 +697,8 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
       if (stokes) {
         new_force = force * velocity_factor;  // exact: the Stokes-mode scheme is linear in G
       } else {
-        // Secant in log G vs log Re; the first step uses the BVK estimate's slope.
-        double slope;
-        const double log_force = std::log(force), log_re = std::log(re_lattice);
-        if (std::isfinite(last_log_force) && std::abs(log_force - last_log_force) > 1e-12) {
-          slope = (log_re - last_log_re) / (log_force - last_log_force);
-        } else {
-          const double h = 1e-3;
-          const double dlnf = (std::log(bvk2007_estimate(phi, re_lattice * (1 + h))) -
-                               std::log(bvk2007_estimate(phi, re_lattice))) /
-                              std::log1p(h);
-          slope = 1.0 / (1.0 + dlnf);
-        }
-        slope = std::clamp(slope, 0.3, 1.0);
-        last_log_force = log_force;
-        last_log_re = log_re;
-        new_force = force * std::exp(std::log(target_re / re_lattice) / slope);
+        new_force =
+            adjusted_force(force, re_lattice, target_re, phi, &last_log_force, &last_log_re);
         window.clear();
       }
       solver->scale_deviations(velocity_factor);
@@ -522,10 +738,29 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     result.body_F[s] = body_force[3 * s] / (3.0 * kPi * nu * d * U);
   }
   result.momentum_balance_rel = balance;
+  result.final_pore_speed_ratio = U > 0.0 ? std::sqrt(m.max_speed2) / U : 0.0;
+  result.final_cell_reynolds = std::sqrt(m.max_speed2) / nu;
   result.mass_change_rel = m.sum_drho / static_cast<double>(fluid);
   result.F = F_mean;
+  if (averaging) {
+    // The time means from the end of the start-up on (the same samples for every quantity).
+    result.unsteady = true;
+    result.F = average_F.mean;
+    result.F_time_error = average_F.standard_error;
+    result.re = average_re.mean;
+    result.re_standard_error = average_re.standard_error;
+    result.averaging_steps = static_cast<std::int64_t>(average_F.used) * interval;
+    result.averaging_time = static_cast<double>(result.averaging_steps) * (target_re * nu / d) / d;
+    result.startup_steps =
+        averaging_start + static_cast<std::int64_t>(average_F.truncated) * interval;
+    result.averaging_restarts = averaging_restarts;
+    for (std::size_t s = 0; s < bodies; ++s) {
+      result.body_F[s] = time_average(series_body[s], average_F.truncated).mean;
+    }
+    relative_change = average_F.standard_error / std::abs(average_F.mean);
+  }
   double var = 0.0;
-  for (double f : result.body_F) var += (f - F_mean) * (f - F_mean);
+  for (double f : result.body_F) var += (f - result.F) * (f - result.F);
   result.F_standard_error =
       bodies > 1 ? std::sqrt(var / static_cast<double>(bodies - 1) / static_cast<double>(bodies))
                  : 0.0;
@@ -551,73 +786,106 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   return result;
 }
 
-/// run_impl with one remedy applied automatically: a finite-Re run whose relaxation time the
-/// engine chose (tau == 0) and that stops at the Mach limit is repeated with half the velocity
-/// (hence a smaller tau at the same Re), at most twice. The velocity budget assumes pore speeds
-/// of about 2.5 U/(1 - phi); narrow throats of dense random packings exceed that (phi = 0.4,
-/// d = 10: Mach 0.32 in the start-up). The retries are reported in the warnings, and their time
-/// is included in wall_s; any other failure, or a Mach stop with a user-given tau, is returned
-/// (or thrown) as it is.
-RunResult run_checked(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
+/// The Stokes run that measures kappa = max|u|/U on the run's own lattice: TRT with the central
+/// wall (stable and second order there), its automatic tau, a loose tolerance (kappa to about
+/// a per cent is all the plan needs).
+RunOptions pore_speed_options(const RunOptions& options) {
+  RunOptions s = options;
+  s.re = 0.0;
+  s.tau = 0.0;
+  s.collision = Collision::kTrt;
+  s.magic = 3.0 / 16.0;
+  s.boundary = Boundary::kInterpolated;
+  s.interpolation = WallInterpolation::kCentral;
+  s.stokes_mode = RunOptions::StokesMode::kOn;
+  s.tolerance = kPoreSpeedTolerance;
+  s.throw_on_failure = false;
+  return s;
+}
+
+/// run_impl behind the velocity plan of a finite-Re run: refused before any stepping when the
+/// operator cannot hold the estimated cell Reynolds number (Error(kInvalidArgument)); when the
+/// engine chooses tau, the velocity is planned with kappa measured by a Stokes run on the same
+/// lattice (resolution.h).
+RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
                       Fields* fields, const ProgressCallback& progress) {
-  RunOptions attempt_options = options;
-  attempt_options.throw_on_failure = false;
-  const bool may_retry = options.tau == 0.0 && options.re > 0.0;
-  double scale = 1.0, earlier_wall_s = 0.0;
-  std::vector<std::string> notes;
-  RunResult previous;
   auto finish = [&](RunResult r) {
-    r.wall_s += earlier_wall_s;
-    r.warnings.insert(r.warnings.begin(), notes.begin(), notes.end());
     if (!r.converged && options.throw_on_failure) {
       throw Error(ErrorCode::kOutOfValidity, "lbm run: " + r.diagnosis);
     }
     return r;
   };
-  for (int attempt = 0;; ++attempt) {
-    RunResult r = run_impl(grid, phi_exact, attempt_options, fields, progress, scale);
-    if (attempt > 0 && !r.converged && r.steps == 0) {
-      // The slower run is refused up front (tau too close to 1/2): the Mach stop stands.
-      notes.pop_back();
-      earlier_wall_s -= previous.wall_s;
-      return finish(previous);
+  RunOptions quiet = options;
+  quiet.throw_on_failure = false;
+  if (options.re == 0.0) return finish(run_impl(grid, phi_exact, quiet, fields, progress, nullptr));
+  const double phi = phi_exact > 0.0 ? phi_exact : grid.phi_lattice();
+  const double d =
+      options.use_hydrodynamic_diameter ? options.hydrodynamic_diameter : grid.resolution();
+  VelocityPlan plan = plan_velocity(phi, options.re, d, options.collision, options.mach_target, 0.0,
+                                    false, options.tau);
+  std::string refusal = cell_reynolds_refusal(plan, options.re, d, options.collision);
+  if (!refusal.empty()) throw Error(ErrorCode::kInvalidArgument, "lbm run: " + refusal);
+  RunResult stokes;
+  if (options.tau == 0.0) {
+    ProgressCallback stokes_progress;
+    if (progress) {
+      stokes_progress = [&progress](double fraction, const std::string& status) {
+        (void)fraction;
+        progress(0.0, "pore-speed ratio (Stokes run): " + status);
+      };
     }
-    const bool mach_stop = !r.converged && r.diagnosis.rfind("Mach number", 0) == 0;
-    if (mach_stop && may_retry && attempt < 2) {
-      notes.push_back("attempt " + std::to_string(attempt + 1) + " (tau = " + fmt("%.4g", r.tau) +
-                      ") stopped at the Mach limit after " + std::to_string(r.steps) +
-                      " steps; repeated with half the velocity");
-      earlier_wall_s += r.wall_s;
-      scale *= 0.5;
-      previous = r;
-      continue;
+    stokes =
+        run_impl(grid, phi_exact, pore_speed_options(options), nullptr, stokes_progress, nullptr);
+    if (stokes.converged && stokes.final_pore_speed_ratio > 0.0) {
+      plan = plan_velocity(phi, options.re, d, options.collision, options.mach_target,
+                           stokes.final_pore_speed_ratio, true);
     }
-    return finish(r);
   }
+  RunResult r = run_impl(grid, phi_exact, quiet, fields, progress, &plan);
+  if (options.tau == 0.0) {
+    r.wall_s += stokes.wall_s;
+    if (!stokes.converged) {
+      r.warnings.insert(r.warnings.begin(),
+                        "the Stokes run for the pore-speed ratio did not converge (" +
+                            stokes.diagnosis + "); the velocity was planned with kappa " +
+                            "estimated from phi");
+    }
+  }
+  if (plan.cell_reynolds > stable_cell_reynolds(options.collision)) {
+    r.warnings.push_back("cell Reynolds number kappa Re / d = " + fmt("%.3g", plan.cell_reynolds) +
+                         " is beyond " + fmt("%g", stable_cell_reynolds(options.collision)) +
+                         ", where " + to_string(options.collision) +
+                         " has held in every measured packing; it may diverge (at --d " +
+                         fmt("%g", plan.d_stable) + " it would not)");
+  }
+  return finish(r);
 }
 
 }  // namespace
 
 double predicted_steps(double phi, double re, double d, Collision collision) {
   const double stokes_tau = collision == Collision::kTrt ? 1.5 : 1.0;
-  const double budget_u =
-      (re == 0.0 ? kStokesMaxSpeed : kBudgetMaxSpeed) * (1.0 - phi) / kPoreSpeedFactor;
-  const double tau = re == 0.0 ? stokes_tau : std::min(stokes_tau, 0.5 + 3.0 * budget_u * d / re);
-  const double nu = (tau - 0.5) / 3.0;
-  const double characteristic = d * d / (nu * (1.0 + re));
-  const double darcy = d * d / (nu * phi * bvk2007_estimate(phi, re));
-  return std::max(2.5 * characteristic, 0.9 * darcy);
+  auto steps_at = [phi, d](double tau, double re) {
+    const double nu = (tau - 0.5) / 3.0;
+    const double characteristic = d * d / (nu * (1.0 + re));
+    const double darcy = d * d / (nu * phi * bvk2007_estimate(phi, re));
+    return std::max(2.5 * characteristic, 0.9 * darcy);
+  };
+  if (re == 0.0) return steps_at(stokes_tau, 0.0);
+  // The Stokes run that measures kappa (TRT, tau 1.5, a loose tolerance), then the run itself.
+  const VelocityPlan plan = plan_velocity(phi, re, d, collision, kDefaultMachTarget, 0.0, false);
+  return kPoreSpeedRunShare * steps_at(1.5, 0.0) + steps_at(plan.tau, re);
 }
 
 RunResult run(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
               const ProgressCallback& progress) {
-  return run_checked(grid, phi_exact, options, nullptr, progress);
+  return run_planned(grid, phi_exact, options, nullptr, progress);
 }
 
 RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
                           const RunOptions& options, Fields* fields,
                           const ProgressCallback& progress) {
-  return run_checked(grid, phi_exact, options, fields, progress);
+  return run_planned(grid, phi_exact, options, fields, progress);
 }
 
 double physical_memory_bytes() { return machine_memory_bytes(); }
@@ -695,7 +963,7 @@ RunResult run(const arrays::Packing& packing, double resolution, const RunOption
   arrays::VoxelizationOptions vox;
   vox.resolution = resolution;
   const arrays::VoxelGrid grid = arrays::voxelize(packing, vox);
-  return run_checked(grid, packing.phi(), options, nullptr, progress);
+  return run_planned(grid, packing.phi(), options, nullptr, progress);
 }
 
 }  // namespace lbm

@@ -324,7 +324,39 @@ std::vector<std::int64_t> LinkTable::chunks(int parts) const {
   return begin;
 }
 
-LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, bool interpolated) const {
+void wall_weights(WallScheme wall, double q, bool second_node_fluid, double* weight_a,
+                  double* weight_b, bool* fallback) {
+  *weight_a = *weight_b = 0.0;
+  *fallback = false;
+  switch (wall) {
+    case WallScheme::kBounceBack:
+      return;
+    case WallScheme::kCentralLinear:
+      if (!second_node_fluid) {
+        *fallback = true;
+        return;
+      }
+      *weight_a = (1.0 - 2.0 * q) / (1.0 + 2.0 * q);
+      *weight_b = -*weight_a;
+      return;
+    case WallScheme::kBouzidiLinear:
+      // q >= 1/2 needs no second node, but with r - c_i solid the opposite link of the same
+      // node writes the value it would read (f*_ib(r)'s slot): fall back there too, so that no
+      // link reads what another writes and the pass runs in any order.
+      if (!second_node_fluid) {
+        *fallback = true;
+        return;
+      }
+      if (q >= 0.5) {
+        *weight_b = (2.0 * q - 1.0) / (2.0 * q);
+      } else {
+        *weight_a = 1.0 - 2.0 * q;
+      }
+      return;
+  }
+}
+
+LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, WallScheme wall) const {
   struct Raw {
     std::int32_t node;
     std::int32_t body;
@@ -358,7 +390,8 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, bool interpo
   table.self.reserve(total);
   table.a.reserve(total);
   table.b.reserve(total);
-  table.kappa.reserve(total);
+  table.weight_a.reserve(total);
+  table.weight_b.reserve(total);
   table.node.reserve(total);
   table.body.reserve(total);
   table.direction.reserve(total);
@@ -374,22 +407,19 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, bool interpo
     const std::int64_t d2 =
         wrap(i - kC[q][0], nx) + nx * (wrap(j - kC[q][1], ny) + ny * wrap(k - kC[q][2], nz));
     const std::int32_t r2 = grid.solid[static_cast<std::size_t>(d2)] ? -1 : stored_index(d2);
-    double kappa = 0.0;
-    std::int64_t a = self, b = self;
-    if (interpolated) {
-      if (r2 >= 0) {
-        // Ginzburg's central linear interpolation (CLI): kappa = (1 - 2q)/(1 + 2q).
-        kappa = (1.0 - 2.0 * link.q) / (1.0 + 2.0 * link.q);
-        a = qb * stride_ + r2;
-        b = q * stride_ + r;
-      } else {
-        ++table.fallback_links;
-      }
-    }
+    double weight_a = 0.0, weight_b = 0.0;
+    bool fallback = false;
+    wall_weights(wall, link.q, r2 >= 0, &weight_a, &weight_b, &fallback);
+    if (fallback) ++table.fallback_links;
+    // Unused positions point at the link's own value (read with a zero weight, or not at all).
+    const bool interpolates = weight_a != 0.0 || weight_b != 0.0;
+    const std::int64_t a = interpolates && r2 >= 0 ? qb * stride_ + r2 : self;
+    const std::int64_t b = interpolates ? q * stride_ + r : self;
     table.self.push_back(self);
     table.a.push_back(a);
     table.b.push_back(b);
-    table.kappa.push_back(kappa);
+    table.weight_a.push_back(weight_a);
+    table.weight_b.push_back(weight_b);
     table.node.push_back(link.node);
     table.body.push_back(link.body);
     table.direction.push_back(static_cast<std::uint8_t>(q));

@@ -64,6 +64,23 @@ struct Segment {
   bool wall = false;  ///< Some node of the run has a solid neighbour (use the masked kernel).
 };
 
+/// How a boundary link places its wall (solver.h): halfway bounce-back, or a linear
+/// interpolation in the wall fraction q.
+enum class WallScheme {
+  kBounceBack,     ///< Wall at q = 1/2 whatever the geometry.
+  kCentralLinear,  ///< Ginzburg's central linear interpolation (CLI).
+  kBouzidiLinear,  ///< Bouzidi, Firdaouss & Lallemand's linear interpolation (BFL).
+};
+
+/// The weights of a link with wall fraction q in (0, 1] (LinkTable::weight_a, weight_b).
+/// `second_node_fluid`: whether r - c_i is fluid; the interpolations fall back to halfway
+/// bounce-back (both weights 0) when it is not (a one-node gap), and *fallback is set.
+///   CLI: a = kappa, b = -kappa, kappa = (1 - 2q)/(1 + 2q) (b < 0 for q < 1/2, a < 0 above).
+///   BFL: q < 1/2: a = 1 - 2q, b = 0 (2q f + (1 - 2q) f_a);
+///        q >= 1/2: a = 0, b = (2q - 1)/(2q) (f/(2q) + (2q - 1)/(2q) f_b): no negative weight.
+void wall_weights(WallScheme wall, double q, bool second_node_fluid, double* weight_a,
+                  double* weight_b, bool* fallback);
+
 /// Boundary links in the form the link pass needs (see solver.h), sorted by fluid node so that
 /// a node's links are contiguous (its mass correction is then race-free and deterministic) and
 /// the pass sweeps memory in order.
@@ -71,7 +88,10 @@ struct LinkTable {
   std::vector<std::int64_t> self;  ///< Row opp(i), node r: f*_i(r); receives the reflected value.
   std::vector<std::int64_t> a;     ///< Row opp(i), node r - c_i.
   std::vector<std::int64_t> b;     ///< Row i, node r.
-  std::vector<double> kappa;       ///< Interpolation weight; 0 = plain halfway bounce-back.
+  /// Interpolation weights: the reflected value is f + weight_a (f_a - f) + weight_b (f_b - f)
+  /// with f = f*_i(r), f_a = f*_i(r - c_i), f_b = f*_ib(r) (both 0: halfway bounce-back).
+  std::vector<double> weight_a;
+  std::vector<double> weight_b;
   std::vector<std::int32_t> node;  ///< Fluid index r (row 0 at r holds its rest population).
   std::vector<std::int32_t> body;  ///< Body (sphere) the link belongs to.
   std::vector<std::uint8_t> direction;
@@ -85,7 +105,7 @@ struct LinkTable {
   /// links of one node: chunk p is [result[p], result[p+1]).
   std::vector<std::int64_t> chunks(int parts) const;
   std::size_t memory_bytes() const {
-    return size() * (3 * sizeof(std::int64_t) + sizeof(double) + 2 * sizeof(std::int32_t) + 1);
+    return size() * (3 * sizeof(std::int64_t) + 2 * sizeof(double) + 2 * sizeof(std::int32_t) + 1);
   }
 };
 
@@ -180,8 +200,8 @@ class SparseLattice {
   /// Mean segment length (fluid nodes per run of the neighbour table).
   double mean_segment_length() const;
 
-  /// Link table for this lattice's offsets; kappa from q when `interpolated`, else all 0.
-  LinkTable build_links(const arrays::VoxelGrid& grid, bool interpolated) const;
+  /// Link table for this lattice's offsets with the weights of `wall` (WallScheme).
+  LinkTable build_links(const arrays::VoxelGrid& grid, WallScheme wall) const;
 
   /// Bytes held by the topology (node maps, masks, segments); the populations are extra.
   std::size_t memory_bytes() const;

@@ -58,6 +58,26 @@ Boundary boundary_from_string(const std::string& s) {
               "unknown boundary scheme '" + s + "' (allowed: bb, ibb)");
 }
 
+const char* to_string(WallInterpolation w) {
+  switch (w) {
+    case WallInterpolation::kAuto:
+      return "auto";
+    case WallInterpolation::kCentral:
+      return "cli";
+    case WallInterpolation::kBouzidi:
+      return "bfl";
+  }
+  return "?";
+}
+
+WallInterpolation wall_interpolation_from_string(const std::string& s) {
+  if (s == "auto") return WallInterpolation::kAuto;
+  if (s == "cli") return WallInterpolation::kCentral;
+  if (s == "bfl") return WallInterpolation::kBouzidi;
+  throw Error(ErrorCode::kInvalidArgument,
+              "unknown wall interpolation '" + s + "' (allowed: auto, cli, bfl)");
+}
+
 const char* to_string(Precision p) {
   switch (p) {
     case Precision::kDouble:
@@ -87,6 +107,10 @@ bool RunOptions::IsValid(std::string* error) const {
   if (boundary != Boundary::kHalfwayBounceBack && boundary != Boundary::kInterpolated) {
     return fail("boundary: unknown scheme (allowed: bb, ibb)");
   }
+  if (interpolation != WallInterpolation::kAuto && interpolation != WallInterpolation::kCentral &&
+      interpolation != WallInterpolation::kBouzidi) {
+    return fail("interpolation: unknown wall interpolation (allowed: auto, cli, bfl)");
+  }
   if (precision != Precision::kDouble && precision != Precision::kFloat) {
     return fail("precision: unknown (allowed: double, float)");
   }
@@ -112,6 +136,17 @@ bool RunOptions::IsValid(std::string* error) const {
   if (max_steps < 2) return fail("max_steps: must be >= 2");
   if (!(std::isfinite(mach_limit) && mach_limit > 0.0 && mach_limit <= 1.0)) {
     return fail("mach_limit: must be in (0, 1], got " + format("%g", mach_limit));
+  }
+  if (!(std::isfinite(mach_target) && mach_target > 0.0 && mach_target <= 0.3)) {
+    return fail("mach_target: must be in (0, 0.3], got " + format("%g", mach_target));
+  }
+  if (!(std::isfinite(average_tolerance) && average_tolerance >= 1e-4 &&
+        average_tolerance <= 0.1)) {
+    return fail("average_tolerance: must be in [1e-4, 0.1], got " +
+                format("%g", average_tolerance));
+  }
+  if (!(std::isfinite(average_time) && average_time >= 1.0 && average_time <= 1e4)) {
+    return fail("average_time: must be in [1, 10000] d/U, got " + format("%g", average_time));
   }
   if (!(std::isfinite(min_gap_nodes) && min_gap_nodes >= 0.0 && min_gap_nodes <= 100.0)) {
     return fail("min_gap_nodes: must be in [0, 100], got " + format("%g", min_gap_nodes));
@@ -145,8 +180,14 @@ std::string RunResult::FullReport() const {
   out << "converged            " << (converged ? "yes" : "no") << "\n";
   if (!diagnosis.empty()) out << "diagnosis            " << diagnosis << "\n";
   out << "F (drag only)        " << format("%.8g", F) << " +- " << format("%.3g", F_standard_error)
-      << " (spread over " << body_F.size() << " bodies)\n"
-      << "K = F/(1-phi)        " << format("%.8g", K) << "\n"
+      << " (spread over " << body_F.size() << " bodies)\n";
+  if (unsteady) {
+    out << "unsteady             F +- " << format("%.3g", F_time_error) << ", Re "
+        << format("%.6g", re) << " +- " << format("%.3g", re_standard_error) << " (time means over "
+        << averaging_steps << " steps = " << format("%.3g", averaging_time) << " d/U after "
+        << startup_steps << " steps; " << averaging_restarts << " restarts)\n";
+  }
+  out << "K = F/(1-phi)        " << format("%.8g", K) << "\n"
       << "beta d^2/mu          " << format("%.8g", beta_d2_over_mu) << "\n"
       << "error estimate       " << format("%.3g", error_estimate) << " (convergence "
       << format("%.3g", convergence_residual) << ", discretisation "
@@ -158,6 +199,16 @@ std::string RunResult::FullReport() const {
       << "d (lattice units)    " << format("%.6g", d) << "\n"
       << "tau+ / tau-          " << format("%.6g", tau) << " / " << format("%.6g", tau_minus)
       << "  (nu = " << format("%.6g", nu) << ")\n"
+      << (pore_speed_ratio > 0.0
+              ? "velocity plan        kappa = u_max/U = " + format("%.4g", pore_speed_ratio) +
+                    (pore_speed_ratio_measured ? " (measured)" : " (estimated)") +
+                    ", Mach target " + format("%g", mach_target) + ", Re_cell = kappa Re/d = " +
+                    format("%.3g", cell_reynolds) + " (limit " + format("%g", cell_reynolds_limit) +
+                    "; at the end max|u|/nu = " + format("%.3g", final_cell_reynolds) + ", kappa " +
+                    format("%.3g", final_pore_speed_ratio) + ")\n"
+              : std::string())
+      << "wall                 " << wall
+      << (wall_reason.empty() ? std::string() : " (" + wall_reason + ")") << "\n"
       << "body force           " << format("%.6g", body_force) << "\n"
       << "superficial U        " << format("%.6g", superficial_velocity) << "\n"
       << "Mach (max)           " << format("%.4g", mach_max) << "\n"
@@ -214,6 +265,21 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"fluid_nodes", fluid_nodes},
                       {"collision", to_string(o.collision)},
                       {"boundary", to_string(o.boundary)},
+                      {"wall", wall},
+                      {"pore_speed_ratio", pore_speed_ratio},
+                      {"pore_speed_ratio_measured", pore_speed_ratio_measured},
+                      {"mach_target", mach_target},
+                      {"cell_reynolds", cell_reynolds},
+                      {"cell_reynolds_limit", cell_reynolds_limit},
+                      {"final_pore_speed_ratio", final_pore_speed_ratio},
+                      {"final_cell_reynolds", final_cell_reynolds},
+                      {"unsteady", unsteady},
+                      {"F_time_error", F_time_error},
+                      {"re_standard_error", re_standard_error},
+                      {"averaging_steps", averaging_steps},
+                      {"averaging_time", averaging_time},
+                      {"startup_steps", startup_steps},
+                      {"averaging_restarts", averaging_restarts},
                       {"precision", to_string(o.precision)},
                       {"narrow_gap_pairs", narrow_gap_pairs},
                       {"smallest_gap_nodes", smallest_gap_nodes},

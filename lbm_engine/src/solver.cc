@@ -729,12 +729,14 @@ class Solver final : public SolverBase {
     const std::int64_t end = L.row_begin[static_cast<std::size_t>(row) + 1];
     if (begin == end) return;
     const bool interpolate = settings_.interpolated;
-    // Even parity: f*_i(r - c_i) at a, f*_ib(r) at b; odd parity: the other way round.
+    // Even parity: f*_i(r - c_i) at a, f*_ib(r) at b; odd parity: the other way round (the
+    // weights follow the values, not the positions).
     const std::int64_t* first = parity == 0 ? L.a.data() : L.b.data();
     const std::int64_t* second = parity == 0 ? L.b.data() : L.a.data();
     const std::int64_t* self = L.self.data();
     const std::int32_t* node = L.node.data();
-    const double* kappa = L.kappa.data();
+    const double* weight_a = L.weight_a.data();
+    const double* weight_b = L.weight_b.data();
     double* force = forces ? partial_force_[static_cast<std::size_t>(t)].data() : nullptr;
     double defect = 0.0;
     for (std::int64_t l = begin; l < end; ++l) {
@@ -749,7 +751,8 @@ class Solver final : public SolverBase {
       double back = f;
       if (interpolate) {
         // In float, rounded as the fluid receives it.
-        back = static_cast<T>(f + kappa[l] * (double(base[first[l]]) - double(base[second[l]])));
+        back = static_cast<T>(f + weight_a[l] * (double(base[first[l]]) - f) +
+                              weight_b[l] * (double(base[second[l]]) - f));
       }
       if (update) {
         base[self[l]] = static_cast<T>(back);

@@ -5,12 +5,17 @@
 // bounce-back, which the AA offsets already do), after the sweep of each step. For a link from
 // fluid node r along c_i into a solid node, with wall fraction q, the value that comes back into r
 // along c_ib (ib = opp(i)) at the next step is, with post-collision values f* of this step,
-//   f_ib(r, t+1) = f*_i(r) + kappa (f*_i(r - c_i) - f*_ib(r)),   kappa = (1 - 2q)/(1 + 2q),
+//   f_ib(r, t+1) = f + a (f*_i(r - c_i) - f) + b (f*_ib(r) - f),   f = f*_i(r),
+// with the weights a, b of the wall scheme (lattice.h, wall_weights). The central one, a = kappa,
+// b = -kappa, kappa = (1 - 2q)/(1 + 2q), is
 // Ginzburg's central linear interpolation (CLI; Ginzburg & d'Humieres 2003, Ginzburg et al. 2008,
 // Khirevich et al. 2015). It is exact for a linear profile at the wall, reduces to halfway
 // bounce-back at q = 1/2, keeps |kappa| <= 1 for all q in (0, 1] (no division by q as in
 // Bouzidi's q < 1/2 branch) and, being built from the post-collision values along one link line
-// only, keeps the TRT steady state a function of Lambda alone (viscosity independent). Fallback:
+// only, keeps the TRT steady state a function of Lambda alone (viscosity independent); but its
+// negative weight amplifies the short waves that a tau near 1/2 leaves undamped. Linear Bouzidi
+// (BFL: a = 1 - 2q, b = 0 for q < 1/2; a = 0, b = (2q - 1)/(2q) above) has no negative weight and
+// stays stable there; its wall moves with tau, by little near tau = 1/2. Fallback:
 // when r - c_i is solid (a gap of one node along the link) the link uses plain halfway
 // bounce-back; this also makes every link update independent of the others (no link reads a
 // value another link writes), so the pass runs in any order and in parallel.

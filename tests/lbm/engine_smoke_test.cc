@@ -85,7 +85,7 @@ std::vector<double> reference_stream(const arrays::VoxelGrid& grid, const std::v
 TEST(LbmEngineSmoke, AaSweepsReproduceStreamingWithBounceBack) {
   const arrays::VoxelGrid grid = random_solid_box({7, 6, 5}, 0.25, 3);
   const SparseLattice lattice(grid, 2, sizeof(double));
-  const LinkTable links = lattice.build_links(grid, false);
+  const LinkTable links = lattice.build_links(grid, WallScheme::kBounceBack);
   SolverSettings settings;
   settings.omega_plus = 0.0;
   settings.omega_minus = 0.0;
@@ -137,8 +137,8 @@ TEST(LbmEngineSmoke, TwoThreadsMatchOneThread) {
   const SparseLattice two_ranges(grid, 2, sizeof(double));
   ASSERT_EQ(two_ranges.num_ranges(), 2);
   ASSERT_GT(two_ranges.num_fluid(), 2 * 32768);
-  const LinkTable links_one = one_range.build_links(grid, true);
-  const LinkTable links_two = two_ranges.build_links(grid, true);
+  const LinkTable links_one = one_range.build_links(grid, WallScheme::kCentralLinear);
+  const LinkTable links_two = two_ranges.build_links(grid, WallScheme::kCentralLinear);
   ASSERT_GT(links_one.fallback_links, 0);
   for (bool stokes : {true, false}) {
     SolverSettings settings;

@@ -35,28 +35,41 @@
 // nodes only (plus a one-node ghost layer of solid boundary nodes), AA-pattern in-place
 // streaming, SIMD collision. Guo forcing with the second-order velocity u = (sum f c + G/2)/rho.
 // TRT: tau+ from nu, tau- = 1/2 + Lambda/(tau+ - 1/2). Stokes mode: linear equilibrium (no u.u
-// terms; u = j). Interpolated bounce-back: Ginzburg's central linear interpolation (CLI),
+// terms; u = j). Interpolated bounce-back, linear in the wall fraction q: Ginzburg's central
+// linear interpolation (CLI, the more accurate: its wall does not move with tau at fixed Lambda)
 //   f_ib(x, t+1) = f*_i(x) + kappa (f*_i(x - c_i) - f*_ib(x)),  kappa = (1 - 2q)/(1 + 2q),
-// falling back to halfway bounce-back on links whose node x - c_i is solid; its net mass leak is
-// fed back through the rest populations of the wall nodes (no momentum change). Momentum
-// exchange per link (f*_i + f_ib(t+1)) c_i (Ladd; Mei et al. 2002 with the interpolated value),
-// averaged over the two steps of an AA pair. Precision::kFloat stores the shifted populations
-// in float and collides in float (16 SIMD lanes instead of 8); moments, forces and the link pass
-// arithmetic are accumulated in double. Shifting keeps the O(Ma) deviations at float's 7 digits
-// (F agrees with double to ~1e-6 on the simple-cubic cases); the momentum balance then has a
-// noise floor of ~1e-5, so the float convergence test accepts a balance up to max(tolerance,
-// 1e-4).
+// or Bouzidi-Firdaouss-Lallemand's (BFL, all weights non-negative: stable near tau = 1/2, where
+// CLI's negative weight blows up), 2q f*_i(x) + (1 - 2q) f*_i(x - c_i) for q < 1/2 and
+// f*_i(x)/(2q) + (2q - 1)/(2q) f*_ib(x) above; WallInterpolation::kAuto takes CLI in Stokes flow
+// and for tau >= kCentralWallMinTau, BFL below. Both fall back to halfway bounce-back on links
+// whose node x - c_i is solid; the net mass leak is fed back through the rest populations of the
+// wall nodes (no momentum change). Momentum exchange per link (f*_i + f_ib(t+1)) c_i (Ladd; Mei et
+// al. 2002 with the interpolated value), averaged over the two steps of an AA pair.
+// Precision::kFloat stores the shifted populations in float and collides in float (16 SIMD lanes
+// instead of 8); moments, forces and the link pass arithmetic are accumulated in double. Shifting
+// keeps the O(Ma) deviations at float's 7 digits (F agrees with double to ~1e-6 on the simple-cubic
+// cases); the momentum balance then has a noise floor of ~1e-5, so the float convergence test
+// accepts a balance up to max(tolerance, 1e-4).
 //
 // Automatic choices (RunOptions::tau == 0): Re = 0 -> tau = 1.5 for TRT (its steady state does
 // not depend on tau at fixed Lambda, and a larger viscosity converges faster), 1 otherwise;
-// Re > 0 -> U from the Mach budget U = 0.1 (1 - phi)/2.5 (pore speeds reach ~2.5 U/(1 - phi)),
-// tau = min(tau_Stokes, 1/2 + 3 U d / Re). The body force starts from the force balance with the
-// BVK 2007 drag and is rescaled until Re is within re_tolerance of the target.
+// Re > 0 -> the velocity plan of draglab/lbm/resolution.h: a short Stokes run on the same
+// lattice measures kappa = max|u|/U, U = mach_target c_s / kappa, tau = min(tau_Stokes,
+// 1/2 + 3 U d / Re). A run whose cell Reynolds number kappa Re / d is beyond what the operator
+// holds is refused before any stepping (Error(kInvalidArgument), naming the d that would hold);
+// a run that blows up is diagnosed as an instability (where, when, the cell Reynolds number
+// there, the d that would hold). The body force starts from the force balance with the BVK 2007
+// drag and is rescaled until Re is within re_tolerance of the target.
 //
 // Convergence: characteristic time T = d^2 / (nu (1 + Re)) steps (momentum crossing a diameter by
 // diffusion, or by advection at higher Re); checks every T/10; converged when the relative
 // change of F over the last T (and of U, with the full equilibrium) is below `tolerance`, the
 // momentum balance is below `tolerance` too (1e-4 in float), and Re is within its band.
+// Unsteady flow (F fluctuating around a stationary mean over five T, src/averaging.h): Re is
+// brought to its band on the window mean, then the force is held and F time-averaged from the
+// end of the start-up (MSER); converged when the blocking standard error of the mean is below
+// average_tolerance after at least average_time d/U. F and Re are then time means with their
+// standard errors (RunResult::unsteady).
 // error_estimate = convergence_residual (the last relative change per T) +
 // discretisation_error: the hydrodynamic-radius model S 2 delta / d, S = 1 + 3 phi d ln F/d phi
 // (van der Hoef 2005), with the wall offset delta = 0.15 (bounce-back) or 0.2/d (interpolated)
@@ -98,6 +111,22 @@ enum class Boundary {
 const char* to_string(Boundary b);
 Boundary boundary_from_string(const std::string& s);  ///< "bb", "ibb"
 
+/// Which linear interpolation an interpolated wall (Boundary::kInterpolated) uses.
+enum class WallInterpolation {
+  kAuto,     ///< CLI where it is stable (tau >= kCentralWallMinTau, and Stokes), BFL below.
+  kCentral,  ///< Ginzburg's central linear interpolation (CLI): the more accurate in Stokes
+             ///< flow, but one weight is negative and it blows up near tau = 1/2.
+  kBouzidi,  ///< Bouzidi-Firdaouss-Lallemand linear (BFL): non-negative weights, stable near
+             ///< tau = 1/2, its wall moving with tau more than CLI's at large tau.
+};
+const char* to_string(WallInterpolation w);
+WallInterpolation wall_interpolation_from_string(const std::string& s);  ///< "auto", "cli", "bfl"
+
+/// The smallest tau at which `auto` keeps the central interpolation. Below it BFL is stable where
+/// CLI is not, and their drags differ by little (SC Stokes: 0.05 % at tau 0.52; dense packings
+/// at Re 10 - 20: 0.2 - 0.4 %; docs/validation.md, "Finite Re in dense packings").
+constexpr double kCentralWallMinTau = 0.52;
+
 enum class Precision { kDouble, kFloat };
 const char* to_string(Precision p);
 Precision precision_from_string(const std::string& s);  ///< "double", "float"
@@ -112,6 +141,7 @@ struct RunOptions {
   Collision collision = Collision::kTrt;
   double magic = 3.0 / 16.0;  ///< TRT Lambda = (tau+ - 1/2)(tau- - 1/2).
   Boundary boundary = Boundary::kInterpolated;
+  WallInterpolation interpolation = WallInterpolation::kAuto;  ///< With kInterpolated.
   Precision precision = Precision::kDouble;
   double re = 0.0;   ///< Target Reynolds number U d / nu, >= 0; 0 = Stokes flow.
   double tau = 0.0;  ///< Relaxation time; 0 = choose from Re and the Mach budget.
@@ -121,6 +151,14 @@ struct RunOptions {
   double tolerance = 1e-6;     ///< Relative drag change per characteristic time at convergence.
   std::int64_t max_steps = 200000;
   double mach_limit = 0.3;  ///< max |u| sqrt(3) above this stops the run.
+  /// Finite Re with tau == 0: the Mach number max|u| sqrt(3) the velocity is planned for, in
+  /// (0, 0.3] (draglab/lbm/resolution.h: U = Ma c_s / kappa).
+  double mach_target = 0.1;
+  /// Unsteady flow (F fluctuating around a stationary mean at the target Re): the force is held
+  /// and F time-averaged until its standard error is below average_tolerance (relative, in
+  /// [1e-4, 0.1]) over at least average_time d/U (in [1, 1e4]) after the start-up.
+  double average_tolerance = 5e-3;
+  double average_time = 20.0;
   /// Opt-in check: refuse a packing whose smallest sphere gap spans fewer lattice units (0 = off,
   /// the default: sub-node gaps are run and reported).
   double min_gap_nodes = 0.0;
@@ -165,6 +203,15 @@ struct RunResult {
   double mach_max = 0.0;
   double error_estimate = 0.0;  ///< Estimated relative discretisation + convergence error of F.
   std::vector<HistoryPoint> history;
+  /// Unsteady flow: F and Re are time means, with their standard errors (blocking), over
+  /// averaging_steps (averaging_time d/U) after startup_steps.
+  bool unsteady = false;
+  double F_time_error = 0.0;
+  double re_standard_error = 0.0;
+  std::int64_t averaging_steps = 0;
+  double averaging_time = 0.0;
+  std::int64_t startup_steps = 0;
+  int averaging_restarts = 0;  ///< Force corrections after averaging began (restarting it).
   // Additions (engine diagnostics).
   std::vector<std::string> warnings;  ///< Non-fatal findings (Mach above 0.1, boundary fallbacks).
   std::int64_t fluid_nodes = 0;       ///< Fluid nodes updated per step.
@@ -178,11 +225,25 @@ struct RunResult {
   double smallest_gap_nodes = 0.0;  ///< Smallest gap of pairs closer than one link (lattice units).
   /// Fraction of fluid nodes with solid nodes on both sides along a lattice direction.
   double narrow_gap_fluid_fraction = 0.0;
-  double tau_minus = 0.0;             ///< TRT odd relaxation time (= tau for BGK / regularized).
-  bool stokes_mode = false;           ///< Linear equilibrium used.
-  double mass_change_rel = 0.0;       ///< (fluid mass at end - at start) / start.
-  double convergence_residual = 0.0;  ///< Last relative change of F per characteristic time.
-  double discretisation_error = 0.0;  ///< The discretisation part of error_estimate.
+  double tau_minus = 0.0;  ///< TRT odd relaxation time (= tau for BGK / regularized).
+  /// Finite Re: the velocity plan (draglab/lbm/resolution.h). kappa = max|u|/U used to set U
+  /// (measured by a Stokes run on the same lattice when tau is automatic, else estimated), the
+  /// cell Reynolds number kappa Re / d and the operator's limit.
+  double pore_speed_ratio = 0.0;
+  bool pore_speed_ratio_measured = false;
+  double mach_target = 0.0;
+  double cell_reynolds = 0.0;
+  double cell_reynolds_limit = 0.0;
+  /// max|u|/U at the end of this run (what a Stokes run measures for the plan).
+  double final_pore_speed_ratio = 0.0;
+  double final_cell_reynolds = 0.0;  ///< max|u| / nu at the end of this run.
+  /// The wall scheme used: "bb", "cli" or "bfl", and why (the automatic choice).
+  std::string wall;
+  std::string wall_reason;
+  bool stokes_mode = false;               ///< Linear equilibrium used.
+  double mass_change_rel = 0.0;           ///< (fluid mass at end - at start) / start.
+  double convergence_residual = 0.0;      ///< Last relative change of F per characteristic time.
+  double discretisation_error = 0.0;      ///< The discretisation part of error_estimate.
   std::int64_t characteristic_steps = 0;  ///< Steps per characteristic time (see run()).
   std::size_t memory_bytes = 0;           ///< Populations plus lattice tables.
   std::string BriefReport() const;

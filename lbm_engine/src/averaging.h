@@ -1,0 +1,50 @@
+// averaging.h: time averages of an unsteady drag signal and their standard errors.
+//
+// A run whose flow stays unsteady at its target Re (vortex shedding in the pores above Re of
+// order 100) has no steady drag: F is the time mean of the samples taken at the checks, after
+// the start-up is discarded, with a standard error that accounts for their correlation.
+//  - Start-up: MSER (White 1997; the marginal standard error rule): the truncation point k
+//    minimises sum_{i >= k} (x_i - mean_k)^2 / (n - k)^2 over k <= n/2.
+//  - Standard error: Flyvbjerg & Petersen (1989) blocking. The series is averaged in pairs again
+//    and again; the naive standard error of each level grows while the blocks are shorter than
+//    the correlation time and levels off once they are longer. The estimate is the largest over
+//    the levels that keep at least kMinBlocks blocks (conservative: it never reports the
+//    small, correlated levels' value).
+//  - Unsteadiness: a window of samples whose fluctuation (standard deviation) exceeds the
+//    tolerance while its two halves have nearly the same mean (no trend): the flow is stationary
+//    but not steady, and waiting for it to settle would never end.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace draglab {
+namespace lbm {
+
+/// Fewest blocks a blocking level may have to count.
+constexpr std::size_t kMinBlocks = 16;
+
+/// MSER truncation index of x (0 for fewer than 4 samples).
+std::size_t mser_truncation(const std::vector<double>& x);
+
+/// Blocking standard error of the mean of x[first, end); 0 for fewer than 2 samples.
+double blocking_standard_error(const std::vector<double>& x, std::size_t first = 0);
+
+struct TimeAverage {
+  double mean = 0.0;
+  double standard_error = 0.0;
+  std::size_t truncated = 0;  ///< Leading samples discarded (start-up).
+  std::size_t used = 0;       ///< Samples averaged.
+};
+/// The mean of x after the MSER truncation, with its blocking standard error.
+TimeAverage time_average(const std::vector<double>& x);
+/// The same with a given truncation (for a second series sampled with the first).
+TimeAverage time_average(const std::vector<double>& x, std::size_t truncated);
+
+/// True if the last `window` samples of x fluctuate by more than `tolerance` (relative standard
+/// deviation) with no trend: the difference of the means of the window's halves below half
+/// the standard deviation.
+bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, double tolerance);
+
+}  // namespace lbm
+}  // namespace draglab

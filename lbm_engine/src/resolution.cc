@@ -1,0 +1,117 @@
+// resolution.cc: see draglab/lbm/resolution.h.
+#include "draglab/lbm/resolution.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace draglab {
+namespace lbm {
+namespace {
+
+constexpr double kCs = 0.57735026918962576;  // 1/sqrt(3)
+/// TRT (Lambda = 3/16) with BFL or bounce-back, kappa estimated (docs/validation.md): phi 0.6
+/// stable at 24 and diverged at 28 and 32; phi 0.3 stable at 31. Refused beyond the largest,
+/// suggested at the smallest stable value.
+constexpr double kTrtMaxCellReynolds = 35.0;
+constexpr double kTrtStableCellReynolds = 23.0;
+
+std::string fmt(const char* format, double x) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, x);
+  return buffer;
+}
+
+}  // namespace
+
+double estimated_pore_speed_ratio(double phi) {
+  const double p = std::clamp(phi, 0.0, 0.7);
+  return 2.7 / std::pow(1.0 - p, 1.7);
+}
+
+double max_cell_reynolds(Collision collision) {
+  switch (collision) {
+    case Collision::kBgk:
+    case Collision::kTrt:
+      return kTrtMaxCellReynolds;
+    case Collision::kRegularized:
+      return std::numeric_limits<double>::infinity();
+  }
+  return kTrtMaxCellReynolds;
+}
+
+double stable_cell_reynolds(Collision collision) {
+  return std::isfinite(max_cell_reynolds(collision)) ? kTrtStableCellReynolds
+                                                     : std::numeric_limits<double>::infinity();
+}
+
+std::string VelocityPlan::Summary() const {
+  std::string s = "kappa = u_max/U = " + fmt("%.3g", kappa) +
+                  (kappa_measured ? " (measured)" : " (estimated from phi)") + ", Ma target " +
+                  fmt("%g", mach_target) + " -> U = " + fmt("%.4g", velocity) +
+                  ", tau = " + fmt("%.5g", tau) +
+                  ", Re_cell = kappa Re/d = " + fmt("%.3g", cell_reynolds);
+  if (std::isfinite(cell_reynolds_limit)) s += " (limit " + fmt("%g", cell_reynolds_limit) + ")";
+  return s;
+}
+
+VelocityPlan plan_velocity(double phi, double re, double d, Collision collision, double mach_target,
+                           double kappa, bool kappa_measured, double tau) {
+  VelocityPlan plan;
+  plan.kappa = kappa > 0.0 ? kappa : estimated_pore_speed_ratio(phi);
+  plan.kappa_measured = kappa > 0.0 && kappa_measured;
+  plan.mach_target = mach_target;
+  const double stokes_tau = collision == Collision::kTrt ? 1.5 : 1.0;
+  if (tau > 0.0) {
+    plan.tau = tau;
+    plan.nu = (tau - 0.5) / 3.0;
+    plan.velocity = re * plan.nu / d;
+  } else {
+    plan.velocity = mach_target * kCs / plan.kappa;
+    plan.tau = std::min(stokes_tau, 0.5 + 3.0 * plan.velocity * d / re);
+    plan.nu = (plan.tau - 0.5) / 3.0;
+    plan.velocity = re * plan.nu / d;  // below the budget where tau is capped
+  }
+  plan.kappa_stability = estimated_pore_speed_ratio(phi);
+  plan.cell_reynolds = plan.kappa_stability * re / d;
+  plan.cell_reynolds_limit = max_cell_reynolds(collision);
+  const double stable = stable_cell_reynolds(collision);
+  plan.d_stable = std::isfinite(stable) ? std::ceil(plan.kappa_stability * re / stable) : 0.0;
+  return plan;
+}
+
+std::string cell_reynolds_refusal(const VelocityPlan& plan, double re, double d,
+                                  Collision collision) {
+  if (plan.within_limit()) return std::string();
+  return "the cell Reynolds number kappa Re / d = " + fmt("%.3g", plan.kappa_stability) + " x " +
+         fmt("%g", re) + " / " + fmt("%.4g", d) + " = " + fmt("%.3g", plan.cell_reynolds) +
+         " (kappa = u_max/U at finite Re, estimated from phi) is beyond what " +
+         to_string(collision) + " holds (" + fmt("%g", plan.cell_reynolds_limit) +
+         ": it diverges there whatever the velocity); " + "remedy: --d " +
+         fmt("%g", plan.d_stable) + " or more, or a lower Re";
+}
+
+std::string ResolutionNeed::Summary() const {
+  return "d >= " + fmt("%.3g", d) + " (gaps " + fmt("%.3g", gaps) + ", boundary layer " +
+         fmt("%.3g", boundary_layer) + ", stability " + fmt("%.3g", stability) + ")";
+}
+
+ResolutionNeed resolution_needed(double phi, double re, Collision collision, double kappa) {
+  ResolutionNeed need;
+  // D_h = h d with h = (2/3)(1 - phi)/phi.
+  const double h = (2.0 / 3.0) * (1.0 - phi) / phi;
+  need.gaps = kGapNodes / h;
+  if (re > 0.0) {
+    const double re_h = re * (2.0 / 3.0) / phi;
+    need.boundary_layer = kLayerNodes * std::sqrt(re_h) / h;
+    const double stable = stable_cell_reynolds(collision);
+    const double k = kappa > 0.0 ? kappa : estimated_pore_speed_ratio(phi);
+    need.stability = std::isfinite(stable) ? k * re / stable : 0.0;
+  }
+  need.d = std::max({need.gaps, need.boundary_layer, need.stability});
+  return need;
+}
+
+}  // namespace lbm
+}  // namespace draglab

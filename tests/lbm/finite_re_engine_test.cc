@@ -1,0 +1,100 @@
+// Fast checks of the finite-Re engine paths (the long ones: finite_re_stability_validation.cc).
+//
+// 1. Wall interpolation in Stokes flow. Set-up: simple-cubic array, phi = 0.125, d = 16 (one
+//    sphere centred on a cell corner), Re = 0. Reference: Sangani & Acrivos 1982 (the 31-term
+//    series, data/sangani_acrivos_sc_series.csv), F = (1 - phi) K. The automatic wall takes CLI in
+//    Stokes flow: within 0.2 % at tau = 0.52 and 1.5 (measured -0.07 % at both; its steady state
+//    does not depend on tau). BFL, the wall automatic runs take below tau = 0.52, is checked at
+//    tau = 0.52, where it runs: within 0.2 % (measured -0.12 %; its wall moves with tau, by
+//    -2.2 % at tau = 1.5, which is why it is not used there).
+// 2. Refusal before any stepping: the case, a random packing at phi = 0.6 (27 spheres),
+//    d = 10, Re = 30 with TRT: kappa Re / d = 12.9 x 30 / 10 = 39 is beyond the 35 every measured
+//    TRT run diverged at; Error(kInvalidArgument) naming the cell Reynolds number and the d that
+//    holds, thrown within a second (the run would take minutes).
+// 3. The velocity plan of a run: kappa measured by the Stokes run is the run's own (Stokes)
+//    max|u|/U, the Mach number the run reaches stays near the target (at most 1.5x: the start-up
+//    overshoots, and kappa falls with Re), and the achieved Re hits the target.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "draglab/drag_db/error.h"
+#include "draglab/lbm/resolution.h"
+#include "validation_support.h"
+
+namespace draglab {
+namespace lbm {
+namespace validation {
+namespace {
+
+RunResult sc_stokes(double tau, WallInterpolation wall) {
+  const ScArray sc = make_sc_array(0.125, 16.0);
+  RunOptions o = stokes_options(Collision::kTrt, Boundary::kInterpolated, tau);
+  o.interpolation = wall;
+  o.tolerance = 1e-6;  // F to well below the 0.2 % checked
+  o.threads = 1;
+  return run(sc.grid, sc.packing.phi(), o);
+}
+
+TEST(FiniteReEngine, AutomaticWallIsCentralInStokesFlowAndBouzidiHoldsNearOneHalf) {
+  const double reference = sangani_acrivos_F(0.125);
+  for (double tau : {0.52, 1.5}) {
+    const RunResult r = sc_stokes(tau, WallInterpolation::kAuto);
+    ASSERT_TRUE(r.converged) << r.diagnosis;
+    EXPECT_EQ(r.wall, "cli");
+    EXPECT_NEAR(r.F / reference - 1.0, 0.0, 2e-3) << "tau " << tau << ": " << format_run(r);
+  }
+  const RunResult bfl = sc_stokes(0.52, WallInterpolation::kBouzidi);
+  ASSERT_TRUE(bfl.converged) << bfl.diagnosis;
+  EXPECT_EQ(bfl.wall, "bfl");
+  EXPECT_NEAR(bfl.F / reference - 1.0, 0.0, 2e-3) << format_run(bfl);
+}
+
+TEST(FiniteReEngine, DensePackingBeyondTheCellReynoldsLimitIsRefusedBeforeStepping) {
+  const arrays::Packing packing = make_random_packing(0.6, 27, 1);
+  RunOptions o;
+  o.collision = Collision::kTrt;
+  o.re = 30.0;
+  o.threads = 1;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    run(packing, 10.0, o);
+    FAIL() << "phi 0.6, d 10, Re 30 with TRT must be refused";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cell Reynolds number"), std::string::npos) << what;
+    const VelocityPlan plan = plan_velocity(0.6, 30.0, 10.0, Collision::kTrt, 0.1, 0.0, false);
+    EXPECT_NE(what.find("--d " + std::to_string(static_cast<int>(plan.d_stable))),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+}
+
+TEST(FiniteReEngine, VelocityIsPlannedFromTheMeasuredPoreSpeedRatio) {
+  const arrays::Packing packing = make_random_packing(0.4, 8, 3);
+  RunOptions o;
+  o.re = 10.0;
+  o.tolerance = 1e-5;
+  o.threads = 1;
+  o.throw_on_failure = false;
+  const RunResult r = run(packing, 12.0, o);
+  ASSERT_TRUE(r.converged) << r.diagnosis;
+  EXPECT_TRUE(r.pore_speed_ratio_measured);
+  EXPECT_GT(r.pore_speed_ratio, 2.0);
+  EXPECT_NEAR(r.re / 10.0, 1.0, o.re_tolerance);
+  EXPECT_LT(r.mach_max, 1.5 * o.mach_target) << format_run(r);
+  EXPECT_GT(r.mach_max, 0.5 * o.mach_target) << format_run(r);
+  // The run's own max|u|/U at Re 10 is below the Stokes value it was planned with.
+  EXPECT_LT(r.final_pore_speed_ratio, r.pore_speed_ratio * 1.02);
+  EXPECT_NEAR(r.superficial_velocity, o.mach_target / std::sqrt(3.0) / r.pore_speed_ratio,
+              0.02 * r.superficial_velocity);
+}
+
+}  // namespace
+}  // namespace validation
+}  // namespace lbm
+}  // namespace draglab

@@ -1,0 +1,207 @@
+// The pieces of a finite-Re run that are not the flow itself: the wall weights (CLI and BFL),
+// the velocity plan and the resolution rule (resolution.h), and the time averaging of an
+// unsteady drag (averaging.h).
+//
+// References:
+//  - Wall weights: Ginzburg & d'Humieres 2003 (CLI: kappa = (1 - 2q)/(1 + 2q) on the
+//    difference f_a - f_b) and Bouzidi, Firdaouss & Lallemand 2001 (BFL, linear: 2q, 1 - 2q for
+//    q < 1/2; 1/(2q), (2q - 1)/(2q) above), checked weight by weight. BFL's weights are never
+//    negative; CLI's are for every q != 1/2.
+//  - Averaging: an AR(1) series x_k = a x_{k-1} + e_k with unit-variance noise has the exact
+//    standard error of the mean sqrt(sum of its autocovariances / n) =
+//    sqrt((1 + a)/(1 - a) / (1 - a^2) / n); blocking must find it within its own sampling error
+//    (about 10 % at these lengths: tolerance 25 %), where the naive estimate is sqrt((1 + a)/
+//    (1 - a)) = 4.4x too small at a = 0.9. MSER must cut a decaying start-up and keep a
+//    stationary series whole.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "averaging.h"
+#include "draglab/lbm/resolution.h"
+#include "lattice.h"
+
+namespace draglab {
+namespace lbm {
+namespace {
+
+// The reflected value for populations f = f*_i(r), f_a = f*_i(r - c_i), f_b = f*_ib(r).
+double reflected(WallScheme wall, double q, double f, double fa, double fb) {
+  double wa = 0.0, wb = 0.0;
+  bool fallback = false;
+  wall_weights(wall, q, true, &wa, &wb, &fallback);
+  EXPECT_FALSE(fallback);
+  return f + wa * (fa - f) + wb * (fb - f);
+}
+
+TEST(WallWeights, HalfwayAtOneHalfAndUniformFieldsUnchanged) {
+  // At q = 1/2 both closures are halfway bounce-back; their weights sum to one, so a uniform
+  // population field comes back unchanged (no mass made at the wall).
+  for (double q : {0.05, 0.2, 0.35, 0.5, 0.65, 0.8, 0.95, 1.0}) {
+    EXPECT_NEAR(reflected(WallScheme::kCentralLinear, 0.5, 3.0, 7.0, 5.0), 3.0, 1e-15);
+    EXPECT_NEAR(reflected(WallScheme::kBouzidiLinear, 0.5, 3.0, 7.0, 5.0), 3.0, 1e-15);
+    // Constant fields pass through every closure (the weights sum to one).
+    EXPECT_NEAR(reflected(WallScheme::kCentralLinear, q, 2.0, 2.0, 2.0), 2.0, 1e-15);
+    EXPECT_NEAR(reflected(WallScheme::kBouzidiLinear, q, 2.0, 2.0, 2.0), 2.0, 1e-15);
+  }
+}
+
+TEST(WallWeights, BouzidiWeightsAreTheTextbookOnesAndNeverNegative) {
+  for (double q = 0.01; q <= 1.0; q += 0.01) {
+    double wa = 0.0, wb = 0.0;
+    bool fallback = true;
+    wall_weights(WallScheme::kBouzidiLinear, q, true, &wa, &wb, &fallback);
+    EXPECT_FALSE(fallback);
+    const double w_self = 1.0 - wa - wb;
+    EXPECT_GE(wa, 0.0) << q;
+    EXPECT_GE(wb, 0.0) << q;
+    EXPECT_GE(w_self, 0.0) << q;
+    if (q < 0.5) {
+      EXPECT_NEAR(w_self, 2.0 * q, 1e-14);
+      EXPECT_NEAR(wa, 1.0 - 2.0 * q, 1e-14);
+      EXPECT_EQ(wb, 0.0);
+    } else {
+      EXPECT_NEAR(w_self, 1.0 / (2.0 * q), 1e-14);
+      EXPECT_NEAR(wb, (2.0 * q - 1.0) / (2.0 * q), 1e-14);
+      EXPECT_EQ(wa, 0.0);
+    }
+    double ca = 0.0, cb = 0.0;
+    wall_weights(WallScheme::kCentralLinear, q, true, &ca, &cb, &fallback);
+    EXPECT_NEAR(ca, (1.0 - 2.0 * q) / (1.0 + 2.0 * q), 1e-14);
+    EXPECT_EQ(cb, -ca);
+    if (std::abs(q - 0.5) > 1e-9) {
+      EXPECT_LT(std::min(ca, cb), 0.0) << q;
+    }
+  }
+}
+
+TEST(WallWeights, OneNodeGapsFallBackToBounceBack) {
+  for (WallScheme wall : {WallScheme::kCentralLinear, WallScheme::kBouzidiLinear}) {
+    for (double q : {0.2, 0.7}) {
+      double wa = 1.0, wb = 1.0;
+      bool fallback = false;
+      wall_weights(wall, q, false, &wa, &wb, &fallback);
+      EXPECT_TRUE(fallback);
+      EXPECT_EQ(wa, 0.0);
+      EXPECT_EQ(wb, 0.0);
+    }
+  }
+  double wa = 1.0, wb = 1.0;
+  bool fallback = true;
+  wall_weights(WallScheme::kBounceBack, 0.3, true, &wa, &wb, &fallback);
+  EXPECT_FALSE(fallback);
+  EXPECT_EQ(wa + wb, 0.0);
+}
+
+TEST(VelocityPlan, MachTargetSetsTheVelocityAndReCellTheStability) {
+  // phi 0.6, Re 30, d 16, kappa 17.1 measured: U = 0.1 / sqrt(3) / 17.1, tau = 1/2 + 3 U d / Re.
+  const VelocityPlan p = plan_velocity(0.6, 30.0, 16.0, Collision::kTrt, 0.1, 17.1, true);
+  const double u = 0.1 / std::sqrt(3.0) / 17.1;
+  EXPECT_NEAR(p.velocity, u, 1e-15);
+  EXPECT_NEAR(p.tau, 0.5 + 3.0 * u * 16.0 / 30.0, 1e-15);
+  EXPECT_NEAR(p.nu, (p.tau - 0.5) / 3.0, 1e-15);
+  EXPECT_NEAR(p.velocity * 16.0 / p.nu, 30.0, 1e-9);  // the plan realises the target Re
+  // Stability is judged with the finite-Re kappa: 2.7 / 0.4^1.7 = 12.93.
+  EXPECT_NEAR(p.kappa_stability, 2.7 / std::pow(0.4, 1.7), 1e-12);
+  EXPECT_NEAR(p.cell_reynolds, p.kappa_stability * 30.0 / 16.0, 1e-12);
+  EXPECT_TRUE(p.within_limit());
+  EXPECT_TRUE(cell_reynolds_refusal(p, 30.0, 16.0, Collision::kTrt).empty());
+  // Halving the Mach target halves U and tau - 1/2 but leaves Re_cell alone.
+  const VelocityPlan h = plan_velocity(0.6, 30.0, 16.0, Collision::kTrt, 0.05, 17.1, true);
+  EXPECT_NEAR(h.velocity, 0.5 * p.velocity, 1e-15);
+  EXPECT_NEAR(h.cell_reynolds, p.cell_reynolds, 1e-15);
+  // A user tau fixes U from Re.
+  const VelocityPlan t = plan_velocity(0.6, 30.0, 16.0, Collision::kTrt, 0.1, 0.0, false, 0.6);
+  EXPECT_NEAR(t.velocity, 30.0 * (0.1 / 3.0) / 16.0, 1e-15);
+}
+
+TEST(VelocityPlan, RefusalNamesTheLimitAndTheResolutionThatHolds) {
+  // The example: phi 0.6, d 10, Re 30 with TRT.
+  const VelocityPlan p = plan_velocity(0.6, 30.0, 10.0, Collision::kTrt, 0.1, 0.0, false);
+  EXPECT_FALSE(p.within_limit());
+  const std::string why = cell_reynolds_refusal(p, 30.0, 10.0, Collision::kTrt);
+  EXPECT_NE(why.find("cell Reynolds number"), std::string::npos) << why;
+  EXPECT_NE(why.find("--d " + std::to_string(static_cast<int>(p.d_stable))), std::string::npos)
+      << why;
+  EXPECT_LE(p.kappa_stability * 30.0 / p.d_stable, stable_cell_reynolds(Collision::kTrt));
+  // The regularized operator has no limit.
+  const VelocityPlan r = plan_velocity(0.6, 30.0, 10.0, Collision::kRegularized, 0.1, 0.0, false);
+  EXPECT_TRUE(r.within_limit());
+}
+
+TEST(ResolutionRule, BoundsFollowTheirFormulas) {
+  // phi 0.5, Re 300: D_h = (2/3) d, Re_h = 400, delta = D_h / 20.
+  const ResolutionNeed n = resolution_needed(0.5, 300.0, Collision::kTrt);
+  EXPECT_NEAR(n.gaps, kGapNodes * 1.5, 1e-12);
+  EXPECT_NEAR(n.boundary_layer, kLayerNodes * 20.0 * 1.5, 1e-12);
+  EXPECT_NEAR(n.stability,
+              estimated_pore_speed_ratio(0.5) * 300.0 / stable_cell_reynolds(Collision::kTrt),
+              1e-12);
+  EXPECT_DOUBLE_EQ(n.d, std::max({n.gaps, n.boundary_layer, n.stability}));
+  const ResolutionNeed s = resolution_needed(0.3, 0.0, Collision::kTrt);
+  EXPECT_EQ(s.boundary_layer, 0.0);
+  EXPECT_EQ(s.stability, 0.0);
+  EXPECT_DOUBLE_EQ(s.d, s.gaps);
+}
+
+std::vector<double> ar1(double a, std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::vector<double> x(n);
+  double v = noise(rng) / std::sqrt(1.0 - a * a);  // stationary start
+  for (std::size_t k = 0; k < n; ++k) {
+    v = a * v + noise(rng);
+    x[k] = v;
+  }
+  return x;
+}
+
+TEST(TimeAveraging, BlockingFindsTheCorrelatedStandardError) {
+  const double a = 0.9;
+  const std::size_t n = 1 << 14;
+  const double exact = std::sqrt((1.0 + a) / (1.0 - a) / (1.0 - a * a) / static_cast<double>(n));
+  double sum = 0.0;
+  const int repeats = 8;
+  for (int r = 0; r < repeats; ++r) sum += blocking_standard_error(ar1(a, n, 11 + r));
+  EXPECT_NEAR(sum / repeats, exact, 0.25 * exact);
+  // The naive (uncorrelated) estimate is far smaller: blocking must not return it.
+  const std::vector<double> x = ar1(a, n, 3);
+  double mean = 0.0, ss = 0.0;
+  for (double v : x) mean += v / static_cast<double>(n);
+  for (double v : x) ss += (v - mean) * (v - mean);
+  const double naive = std::sqrt(ss / (n - 1.0) / n);
+  EXPECT_GT(blocking_standard_error(x), 2.5 * naive);
+}
+
+TEST(TimeAveraging, MserCutsTheStartUpAndKeepsAStationarySeries) {
+  std::vector<double> x = ar1(0.5, 2000, 5);
+  for (double& v : x) v = 20.0 + 0.1 * v;
+  EXPECT_LT(mser_truncation(x), 100u);  // stationary: little or nothing cut
+  std::vector<double> y = x;
+  for (std::size_t k = 0; k < y.size(); ++k)
+    y[k] += 5.0 * std::exp(-static_cast<double>(k) / 100.0);
+  const std::size_t cut = mser_truncation(y);
+  EXPECT_GT(cut, 200u);  // the transient is 5 / 0.1 = 50 noise amplitudes at k = 0
+  EXPECT_LT(cut, 1000u);
+  const TimeAverage avg = time_average(y);
+  EXPECT_NEAR(avg.mean, 20.0, 4.0 * avg.standard_error + 0.01);
+}
+
+TEST(TimeAveraging, UnsteadinessIsFluctuationWithoutTrend) {
+  std::vector<double> oscillating(60), decaying(60);
+  for (std::size_t k = 0; k < 60; ++k) {
+    oscillating[k] = 19.6 + 0.25 * std::sin(0.7 * static_cast<double>(k));
+    decaying[k] = 19.6 + 2.0 * std::exp(-static_cast<double>(k) / 20.0);
+  }
+  EXPECT_TRUE(stationary_fluctuating(oscillating, 50, 1e-4));
+  EXPECT_FALSE(stationary_fluctuating(decaying, 50, 1e-4));
+  // Fluctuations below the tolerance are steady enough.
+  EXPECT_FALSE(stationary_fluctuating(oscillating, 50, 0.1));
+}
+
+}  // namespace
+}  // namespace lbm
+}  // namespace draglab
