@@ -154,7 +154,10 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                         {"fluid_nodes", p.fluid_nodes},
                         {"steps", p.steps},
                         {"unit_seconds", p.unit_seconds},
-                        {"memory_bytes", p.memory_bytes}});
+                        {"memory_bytes", p.memory_bytes},
+                        {"d_needed", p.d_needed},
+                        {"resolution_verdict", p.resolution_verdict},
+                        {"resolution_detail", p.resolution_detail}});
     }
     ctx.print_json({{"campaign", spec.name},
                     {"units", plan.units},
@@ -165,6 +168,8 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                     {"largest_unit_memory_bytes", plan.largest_unit_memory_bytes},
                     {"machine_memory_bytes", plan.machine_memory_bytes},
                     {"fits_in_memory", plan.fits_in_memory},
+                    {"refused_units", plan.refused_units},
+                    {"under_resolved_units", plan.under_resolved_units},
                     {"points", points}});
   } else {
     std::cout << fmt::format("campaign {}\n", spec.name) << plan.FullReport();

@@ -57,7 +57,7 @@ struct SolverOptions {
   std::string precision = "double";
   double tau = 0.0;
   double magic = 3.0 / 16.0;
-  double mach = 0.1;
+  double mach = 0.15;
   double average_time = 20.0;
   bool average_time_given = false;
   double average_tolerance = 5e-3;

@@ -16,6 +16,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/lbm/resolution.h"
 
 namespace draglab {
 namespace campaign {
@@ -92,6 +93,22 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
         p.steps = lbm::predicted_steps(phi, re, d, collision);
         p.unit_seconds = p.fluid_nodes * p.steps * plan.node_update_seconds;
         p.memory_bytes = lbm::estimated_run_bytes(nodes, lbm::Precision::kDouble);
+        const lbm::ResolutionNeed need = lbm::resolution_needed(phi, re, collision);
+        p.d_needed = need.d;
+        p.resolution_detail = need.Summary();
+        const lbm::VelocityPlan velocity =
+            re > 0.0
+                ? lbm::plan_velocity(phi, re, d, collision, lbm::kDefaultMachTarget, 0.0, false)
+                : lbm::VelocityPlan();
+        if (re > 0.0 && !velocity.within_limit()) {
+          p.resolution_verdict = "refused";
+          plan.refused_units += p.units;
+        } else if (d < std::max(need.gaps, need.boundary_layer)) {
+          p.resolution_verdict = "under-resolved";
+          plan.under_resolved_units += p.units;
+        } else {
+          p.resolution_verdict = "ok";
+        }
         plan.units += p.units;
         plan.core_seconds += p.units * p.unit_seconds;
         plan.largest_unit_memory_bytes = std::max(plan.largest_unit_memory_bytes, p.memory_bytes);
@@ -125,19 +142,30 @@ std::string CampaignPlan::BriefReport() const {
          std::to_string(jobs) + " worker" + (jobs == 1 ? "" : "s") + " (" +
          format("%.3g", core_seconds) + " core-seconds), largest unit " +
          format("%.2g", largest_unit_memory_bytes / 1073741824.0) + " GiB" +
-         (fits_in_memory ? "" : ": DOES NOT FIT in memory");
+         (fits_in_memory ? "" : ": DOES NOT FIT in memory") +
+         (refused_units > 0 ? "; " + std::to_string(refused_units) +
+                                  " units WILL BE REFUSED (cell Reynolds number: raise d)"
+                            : std::string()) +
+         (under_resolved_units > 0
+              ? "; " + std::to_string(under_resolved_units) + " units under-resolved"
+              : std::string());
 }
 
 std::string CampaignPlan::FullReport() const {
   std::ostringstream out;
-  out << "phi     Re      d      units  fluid nodes  steps     unit time   memory/unit\n";
+  out << "phi     Re      d      units  fluid nodes  steps     unit time   memory/unit  d needed  "
+         "resolution\n";
   for (const PlannedPoint& p : points) {
-    char line[160];
-    std::snprintf(line, sizeof line, "%-7.3g %-7.4g %-6.4g %-6d %-12.3g %-9.3g %-11s %.2g GiB\n",
-                  p.phi, p.re, p.resolution, p.units, p.fluid_nodes, p.steps,
-                  duration(p.unit_seconds).c_str(), p.memory_bytes / 1073741824.0);
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "%-7.3g %-7.4g %-6.4g %-6d %-12.3g %-9.3g %-11s %-12s %-9.3g %s\n", p.phi, p.re,
+                  p.resolution, p.units, p.fluid_nodes, p.steps, duration(p.unit_seconds).c_str(),
+                  format("%.2g GiB", p.memory_bytes / 1073741824.0).c_str(), p.d_needed,
+                  p.resolution_verdict.c_str());
     out << line;
   }
+  out << "d needed: the largest of the bounds from the pores' hydraulic diameter, the boundary "
+         "layer and the cell Reynolds number the collision holds (lbm/resolution.h)\n";
   out << "time per fluid-node update (one core, measured): "
       << format("%.3g", node_update_seconds * 1e9) << " ns\n";
   out << BriefReport() << "\n";

@@ -69,18 +69,25 @@ TimeAverage time_average(const std::vector<double>& x) {
 }
 
 bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, double tolerance) {
-  if (window < 4 || x.size() < window) return false;
+  if (window < 8 || x.size() < window) return false;
   const std::size_t first = x.size() - window, half = window / 2;
-  double sum_a = 0.0, sum_b = 0.0;
-  for (std::size_t i = first; i < first + half; ++i) sum_a += x[i];
-  for (std::size_t i = first + half; i < x.size(); ++i) sum_b += x[i];
-  const double mean_a = sum_a / static_cast<double>(half);
-  const double mean_b = sum_b / static_cast<double>(window - half);
-  const double mean = (sum_a + sum_b) / static_cast<double>(window);
-  double ss = 0.0;
-  for (std::size_t i = first; i < x.size(); ++i) ss += (x[i] - mean) * (x[i] - mean);
-  const double sd = std::sqrt(ss / static_cast<double>(window - 1));
-  return sd > tolerance * std::abs(mean) && std::abs(mean_b - mean_a) < 0.5 * sd;
+  auto mean_sd = [&x](std::size_t begin, std::size_t end, double* mean, double* sd) {
+    const double n = static_cast<double>(end - begin);
+    double sum = 0.0;
+    for (std::size_t i = begin; i < end; ++i) sum += x[i];
+    *mean = sum / n;
+    double ss = 0.0;
+    for (std::size_t i = begin; i < end; ++i) ss += (x[i] - *mean) * (x[i] - *mean);
+    *sd = std::sqrt(ss / (n - 1.0));
+  };
+  double mean = 0.0, sd = 0.0, mean_a = 0.0, sd_a = 0.0, mean_b = 0.0, sd_b = 0.0;
+  mean_sd(first, x.size(), &mean, &sd);
+  mean_sd(first, first + half, &mean_a, &sd_a);
+  mean_sd(first + half, x.size(), &mean_b, &sd_b);
+  // Large enough to matter, no drift of the mean, and no decay of the fluctuation: a transient
+  // that still settles (however slowly, or with a damped oscillation) fails the last two.
+  return sd > tolerance * std::abs(mean) && std::abs(mean_b - mean_a) < 0.5 * sd &&
+         sd_b > kUndampedFraction * sd_a;
 }
 
 }  // namespace lbm

@@ -11,8 +11,9 @@
 //    the levels that keep at least kMinBlocks blocks (conservative: it never reports the
 //    small, correlated levels' value).
 //  - Unsteadiness: a window of samples whose fluctuation (standard deviation) exceeds the
-//    tolerance while its two halves have nearly the same mean (no trend): the flow is stationary
-//    but not steady, and waiting for it to settle would never end.
+//    tolerance while its two halves have nearly the same mean (no trend) and nearly the same
+//    fluctuation (no decay): the flow is stationary but not steady, and waiting for it to settle
+//    would never end. A transient that settles, even slowly or oscillating, decays.
 #pragma once
 
 #include <cstddef>
@@ -23,6 +24,9 @@ namespace lbm {
 
 /// Fewest blocks a blocking level may have to count.
 constexpr std::size_t kMinBlocks = 16;
+/// A fluctuation whose second half keeps more than this fraction of the first half's standard
+/// deviation is not decaying.
+constexpr double kUndampedFraction = 0.5;
 
 /// MSER truncation index of x (0 for fewer than 4 samples).
 std::size_t mser_truncation(const std::vector<double>& x);
@@ -41,9 +45,10 @@ TimeAverage time_average(const std::vector<double>& x);
 /// The same with a given truncation (for a second series sampled with the first).
 TimeAverage time_average(const std::vector<double>& x, std::size_t truncated);
 
-/// True if the last `window` samples of x fluctuate by more than `tolerance` (relative standard
-/// deviation) with no trend: the difference of the means of the window's halves below half
-/// the standard deviation.
+/// True if the last `window` (>= 8) samples of x fluctuate by more than `tolerance` (relative
+/// standard deviation) with no trend (the means of the window's halves differ by less than half
+/// the standard deviation) and no decay (the second half's standard deviation above
+/// kUndampedFraction of the first's).
 bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, double tolerance);
 
 }  // namespace lbm

@@ -74,6 +74,9 @@ constexpr double kPoreSpeedFactor = 2.5;  ///< Stokes mode: max |u| ~ 2.5 U / (1
 constexpr double kBlowUpGrowth = 1.5;
 /// Tolerance of the Stokes run that measures the pore-speed ratio.
 constexpr double kPoreSpeedTolerance = 1e-3;
+/// Relative fluctuation of F below which a flow is not called unsteady whatever the tolerance:
+/// round-off and the last digits of a converging run, not vortex shedding.
+constexpr double kUnsteadyMinAmplitude = 1e-4;
 /// Corrections of the force an averaging run may make before it gives up.
 constexpr int kMaxAveragingRestarts = 3;
 /// Its steps, as a share of a Stokes run to the default tolerance (for predicted_steps).
@@ -226,6 +229,26 @@ std::string diverged_diagnosis(const SparseLattice& lattice, const RunOptions& o
   return text + "; remedy: " + wall_remedy + "raise the resolution d" +
          (target_re > 0.0 ? std::string(" or lower Re") : std::string()) +
          (options.tau != 0.0 ? std::string(", or leave tau to the engine") : std::string());
+}
+
+/// The accuracy rules of resolution.h at the run's phi and Re: d below the gap or boundary-layer
+/// bound widens the discretisation estimate by (bound / d)^order (1 for halfway bounce-back, 2
+/// for an interpolated wall: the error's scaling with the nodes across the thinnest layer), and
+/// the run says so.
+void widen_for_resolution(const RunOptions& options, double d, RunResult* result) {
+  const ResolutionNeed need =
+      resolution_needed(result->phi, result->re, options.collision, result->final_pore_speed_ratio);
+  result->resolution_needed = need.d;
+  const double accuracy = std::max(need.gaps, need.boundary_layer);
+  if (d >= accuracy) return;
+  const double order = options.boundary == Boundary::kHalfwayBounceBack ? 1.0 : 2.0;
+  const double factor = std::pow(accuracy / d, order);
+  result->discretisation_error *= factor;
+  result->warnings.push_back(
+      "under-resolved: d = " + fmt("%.4g", d) + " is below " + fmt("%.3g", accuracy) + " (" +
+      (need.boundary_layer > need.gaps ? "the boundary layer" : "the pores") +
+      " span too few nodes; " + need.Summary() + "): the discretisation estimate is widened x" +
+      fmt("%.3g", factor) + "; extrapolate in d");
 }
 
 /// The force that brings Re to target_re: a secant step in log G against log Re through the last
@@ -611,7 +634,8 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
       for (std::size_t k = window.size() - kUnsteadyWindowChecks; k < window.size(); ++k) {
         mean_U += window[k].second / static_cast<double>(kUnsteadyWindowChecks);
       }
-      if (stationary_fluctuating(window_F, kUnsteadyWindowChecks, options.tolerance)) {
+      if (stationary_fluctuating(window_F, kUnsteadyWindowChecks,
+                                 std::max(options.tolerance, kUnsteadyMinAmplitude))) {
         const double mean_re = mean_U * d / nu;
         if (std::abs(mean_re / target_re - 1.0) > options.re_tolerance / 3.0 &&
             adjustments < kMaxAdjustments) {
@@ -779,6 +803,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   em.re = result.re;
   em.precision = options.precision;
   result.discretisation_error = discretisation_error_estimate(em);
+  widen_for_resolution(options, grid.resolution(), &result);
   result.error_estimate = result.discretisation_error + result.convergence_residual;
   if (fields != nullptr) solver->fill_fields(fields);
   result.wall_s = seconds_since(start);

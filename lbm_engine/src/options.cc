@@ -273,6 +273,7 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"cell_reynolds_limit", cell_reynolds_limit},
                       {"final_pore_speed_ratio", final_pore_speed_ratio},
                       {"final_cell_reynolds", final_cell_reynolds},
+                      {"resolution_needed", resolution_needed},
                       {"unsteady", unsteady},
                       {"F_time_error", F_time_error},
                       {"re_standard_error", re_standard_error},

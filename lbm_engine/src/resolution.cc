@@ -104,7 +104,8 @@ ResolutionNeed resolution_needed(double phi, double re, Collision collision, dou
   need.gaps = kGapNodes / h;
   if (re > 0.0) {
     const double re_h = re * (2.0 / 3.0) / phi;
-    need.boundary_layer = kLayerNodes * std::sqrt(re_h) / h;
+    const double re_p = re / (1.0 - phi);
+    need.boundary_layer = kLayerNodes * std::max(std::sqrt(re_p), std::sqrt(re_h) / h);
     const double stable = stable_cell_reynolds(collision);
     const double k = kappa > 0.0 ? kappa : estimated_pore_speed_ratio(phi);
     need.stability = std::isfinite(stable) ? k * re / stable : 0.0;

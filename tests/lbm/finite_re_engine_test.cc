@@ -8,7 +8,7 @@
 //    tau = 0.52, where it runs: within 0.2 % (measured -0.12 %; its wall moves with tau, by
 //    -2.2 % at tau = 1.5, which is why it is not used there).
 // 2. Refusal before any stepping: the case, a random packing at phi = 0.6 (27 spheres),
-//    d = 10, Re = 30 with TRT: kappa Re / d = 12.9 x 30 / 10 = 39 is beyond the 35 every measured
+//    d = 10, Re = 30 with TRT: kappa Re / d = 12.8 x 30 / 10 = 38.5 is beyond the 35 every measured
 //    TRT run diverged at; Error(kInvalidArgument) naming the cell Reynolds number and the d that
 //    holds, thrown within a second (the run would take minutes).
 // 3. The velocity plan of a run: kappa measured by the Stokes run is the run's own (Stokes)

@@ -133,10 +133,14 @@ TEST(VelocityPlan, RefusalNamesTheLimitAndTheResolutionThatHolds) {
 }
 
 TEST(ResolutionRule, BoundsFollowTheirFormulas) {
-  // phi 0.5, Re 300: D_h = (2/3) d, Re_h = 400, delta = D_h / 20.
+  // phi 0.5, Re 300: D_h = (2/3) d, Re_h = 400, pore layer D_h / 20 = d / 30; sphere layer
+  // d / sqrt(600) = d / 24.5: the pores' is the thinner.
   const ResolutionNeed n = resolution_needed(0.5, 300.0, Collision::kTrt);
   EXPECT_NEAR(n.gaps, kGapNodes * 1.5, 1e-12);
   EXPECT_NEAR(n.boundary_layer, kLayerNodes * 20.0 * 1.5, 1e-12);
+  // phi 0.125, Re 100: the sphere's layer, d / sqrt(114.3), is the thinner (pores: d / 4.9).
+  const ResolutionNeed dilute = resolution_needed(0.125, 100.0, Collision::kTrt);
+  EXPECT_NEAR(dilute.boundary_layer, kLayerNodes * std::sqrt(100.0 / 0.875), 1e-12);
   EXPECT_NEAR(n.stability,
               estimated_pore_speed_ratio(0.5) * 300.0 / stable_cell_reynolds(Collision::kTrt),
               1e-12);
@@ -191,13 +195,17 @@ TEST(TimeAveraging, MserCutsTheStartUpAndKeepsAStationarySeries) {
 }
 
 TEST(TimeAveraging, UnsteadinessIsFluctuationWithoutTrend) {
-  std::vector<double> oscillating(60), decaying(60);
+  std::vector<double> oscillating(60), decaying(60), ringing(60);
   for (std::size_t k = 0; k < 60; ++k) {
-    oscillating[k] = 19.6 + 0.25 * std::sin(0.7 * static_cast<double>(k));
-    decaying[k] = 19.6 + 2.0 * std::exp(-static_cast<double>(k) / 20.0);
+    const double t = static_cast<double>(k);
+    oscillating[k] = 19.6 + 0.25 * std::sin(0.7 * t);
+    decaying[k] = 19.6 + 2.0 * std::exp(-t / 20.0);
+    // A damped oscillation (a steady flow settling): no trend in the mean, but it decays.
+    ringing[k] = 19.6 + 0.25 * std::exp(-t / 15.0) * std::sin(0.7 * t);
   }
   EXPECT_TRUE(stationary_fluctuating(oscillating, 50, 1e-4));
   EXPECT_FALSE(stationary_fluctuating(decaying, 50, 1e-4));
+  EXPECT_FALSE(stationary_fluctuating(ringing, 50, 1e-4));
   // Fluctuations below the tolerance are steady enough.
   EXPECT_FALSE(stationary_fluctuating(oscillating, 50, 0.1));
 }

@@ -165,6 +165,13 @@ struct PlannedPoint {
   double steps = 0.0;         ///< Per unit: lbm::predicted_steps.
   double unit_seconds = 0.0;  ///< Predicted run time of one unit on one core.
   double memory_bytes = 0.0;  ///< Per unit (populations, flags, links: generous).
+  /// The resolution rule at (phi, Re) for the spec's collision (lbm/resolution.h) and what it
+  /// says of this d: "ok", "under-resolved" (below the gap or boundary-layer bound: the error
+  /// grows; extrapolate in d) or "refused" (the engine will refuse the unit: beyond the
+  /// operator's cell Reynolds number).
+  double d_needed = 0.0;
+  std::string resolution_verdict;
+  std::string resolution_detail;  ///< lbm::ResolutionNeed::Summary().
 };
 
 /// What `draglab campaign plan` predicts before any work: units, memory and run time, from the
@@ -183,6 +190,8 @@ struct CampaignPlan {
   double largest_unit_memory_bytes = 0.0;
   double machine_memory_bytes = 0.0;  ///< 0 if unknown.
   bool fits_in_memory = true;         ///< largest_unit_memory_bytes x jobs <= 80 % of the machine.
+  std::int64_t refused_units = 0;     ///< Units the engine will refuse (cell Reynolds number).
+  std::int64_t under_resolved_units = 0;  ///< Units below the accuracy rules.
   std::string BriefReport() const;
   std::string FullReport() const;
 };

@@ -153,7 +153,7 @@ struct RunOptions {
   double mach_limit = 0.3;  ///< max |u| sqrt(3) above this stops the run.
   /// Finite Re with tau == 0: the Mach number max|u| sqrt(3) the velocity is planned for, in
   /// (0, 0.3] (draglab/lbm/resolution.h: U = Ma c_s / kappa).
-  double mach_target = 0.1;
+  double mach_target = 0.15;  // = kDefaultMachTarget (resolution.h)
   /// Unsteady flow (F fluctuating around a stationary mean at the target Re): the force is held
   /// and F time-averaged until its standard error is below average_tolerance (relative, in
   /// [1e-4, 0.1]) over at least average_time d/U (in [1, 1e4]) after the start-up.
@@ -237,6 +237,9 @@ struct RunResult {
   /// max|u|/U at the end of this run (what a Stokes run measures for the plan).
   double final_pore_speed_ratio = 0.0;
   double final_cell_reynolds = 0.0;  ///< max|u| / nu at the end of this run.
+  /// The resolution rule's d at this phi and Re (draglab/lbm/resolution.h); below its accuracy
+  /// bounds the estimate is widened and a warning says so.
+  double resolution_needed = 0.0;
   /// The wall scheme used: "bb", "cli" or "bfl", and why (the automatic choice).
   std::string wall;
   std::string wall_reason;
