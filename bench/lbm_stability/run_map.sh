@@ -101,7 +101,7 @@ EOF
 header="# Stability map of the finite-Re engine (bench/lbm_stability/run_map.sh).
 # Command: bench/lbm_stability/run_map.sh --phi \"$phis\" --re \"$res\" --d \"$ds\" --collision \"$collisions\" --max-steps $max_steps
 # Input: draglab pack --phi P --n N --seed 1 (N = 27 at phi >= 0.5, else 16); lbm run defaults, tolerance 1e-5, 1 thread per run, $jobs at once.
-# Code: $("$draglab" --version 2>/dev/null | head -1) (git $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)). Machine: $(nproc) cores, $(uname -m).
+# Code: git $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown) ($("$draglab" --version 2>/dev/null | head -1)). Machine: $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores.
 # Measured $(date -u +%Y-%m-%d).
 # F +-: the time-averaging standard error (averaged) or the engine's error estimate (converged)."
 if [ -n "$out" ]; then

@@ -20,7 +20,9 @@
 // bounce-back; this also makes every link update independent of the others (no link reads a
 // value another link writes), so the pass runs in any order and in parallel.
 // Momentum exchange (Ladd 1994; Mei et al. 2002 for interpolated walls): the force on the body is
-//   F = sum over its links of (f*_i(r) + f_ib(r, t+1)) c_i,
+//   F = sum over its links of (f*_i(r) + f_ib(r, t+1) - 2 w_i) c_i
+// (the reference pressure's part 2 w_i c_i left out: it cancels over the interface, but not over a
+// body that lost links in a sub-node gap to its neighbour),
 // the momentum the fluid loses through the link in one step, so the steady sum over all bodies
 // equals G times the fluid node count to round-off.
 #pragma once
