@@ -251,6 +251,7 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"wall_s", wall_s},
                       {"mflups", mflups},
                       {"momentum_balance_rel", momentum_balance_rel},
+                      {"mass_change_rel", mass_change_rel},
                       {"mach_max", mach_max},
                       {"error_estimate", error_estimate},
                       {"convergence_residual", convergence_residual},
