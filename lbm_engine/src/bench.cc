@@ -13,6 +13,9 @@
 //    (max(200, 4 LLC / (5362 nodes x 152 B)) spheres: about 5362 nodes per sphere, 60 % fluid),
 //    double, TRT with the default interpolated bounce-back (its link pass included), 100 steps
 //    per run; mflups_fluid_packing_bb: the same with halfway bounce-back (no link pass).
+//  - mflups_blocks, mflups_blocks_bb: the same two on RRZE lbm-benchmark-kernels' `blocks-8`
+//    geometry (100^3, 849 808 fluid nodes; blocks_geometry), to compare with that peer's
+//    list-based kernels on one geometry (bench/lbm_peer).
 //  - bandwidth_gbs: b = s * b over max(1 GiB, 4 LLC) of doubles, counted as 16 bytes per element
 //    (read + write back, no write-allocate), best of 5 passes per run (STREAM's convention),
 //    median over runs.
@@ -74,6 +77,52 @@ double time_solver(const arrays::VoxelGrid& grid, Boundary boundary, int threads
   return static_cast<double>(lattice.num_fluid()) * 2.0 * pairs / s / 1e6;
 }
 
+/// RRZE lbm-benchmark-kernels' `blocks-<block>` geometry on an edge^3 box (their Geometry.c):
+/// walls on the y and z boundary planes, periodic in x, and solid cubes of edge `block` where
+/// x, y and z all lie in the upper half of a 2 block period. Every fluid-to-solid link gets
+/// q = 1/2 (flat walls half-way between nodes), so that the interpolated path (its link pass
+/// included) runs on the peer's geometry.
+arrays::VoxelGrid blocks_geometry(std::int64_t edge, std::int64_t block) {
+  arrays::VoxelGrid grid;
+  grid.dims = {edge, edge, edge};
+  grid.dx = 1.0 / 16.0;
+  grid.solid.assign(static_cast<std::size_t>(grid.num_nodes()), 0);
+  auto upper = [block](std::int64_t v) { return v % (2 * block) >= block; };
+  for (std::int64_t k = 0; k < edge; ++k) {
+    for (std::int64_t j = 0; j < edge; ++j) {
+      for (std::int64_t i = 0; i < edge; ++i) {
+        const bool wall = j == 0 || j == edge - 1 || k == 0 || k == edge - 1;
+        if (wall || (upper(i) && upper(j) && upper(k))) {
+          grid.solid[static_cast<std::size_t>(grid.index(i, j, k))] = 1;
+        }
+      }
+    }
+  }
+  grid.links.resize(1);
+  for (std::int64_t k = 0; k < edge; ++k) {
+    for (std::int64_t j = 0; j < edge; ++j) {
+      for (std::int64_t i = 0; i < edge; ++i) {
+        const std::int64_t n = grid.index(i, j, k);
+        if (grid.solid[static_cast<std::size_t>(n)]) continue;
+        for (int q = 1; q < arrays::kD3Q19; ++q) {
+          const auto& c = arrays::kD3Q19Velocities[static_cast<std::size_t>(q)];
+          const std::int64_t m = grid.index((i + c[0] + edge) % edge, (j + c[1] + edge) % edge,
+                                            (k + c[2] + edge) % edge);
+          if (grid.solid[static_cast<std::size_t>(m)]) {
+            grid.links[0].push_back(
+                {static_cast<std::uint64_t>(n), 0.5, static_cast<std::uint8_t>(q)});
+          }
+        }
+      }
+    }
+  }
+  return grid;
+}
+
+std::int64_t fluid_nodes(const arrays::VoxelGrid& grid) {
+  return static_cast<std::int64_t>(std::count(grid.solid.begin(), grid.solid.end(), 0));
+}
+
 /// Largest cache size the system reports (sysconf, else sysfs), or 32 MiB if none is known.
 double last_level_cache_bytes() {
   double bytes = 0.0;
@@ -93,6 +142,9 @@ double last_level_cache_bytes() {
 }
 
 constexpr double kCacheMultiple = 4.0;
+// The peer's porous benchmark geometry: 100^3, blocks of 8 (849 808 fluid nodes).
+constexpr std::int64_t kBlocksEdge = 100;
+constexpr std::int64_t kBlocksSize = 8;
 constexpr double kBytesPerNode = 19.0 * 8.0;  // double populations
 
 double update_bandwidth_gbs(int threads, std::int64_t n) {
@@ -153,14 +205,22 @@ BenchResult benchmark(int threads, int repeat) {
   vox.resolution = 16.0;
   const arrays::VoxelGrid grid = arrays::voxelize(packing, vox);
 
-  std::vector<double> box_rate, packing_rate, packing_bb_rate, bandwidth;
+  const arrays::VoxelGrid blocks = blocks_geometry(kBlocksEdge, kBlocksSize);
+  result.blocks_fluid_nodes = fluid_nodes(blocks);
+
+  std::vector<double> box_rate, packing_rate, packing_bb_rate, blocks_rate, blocks_bb_rate,
+      bandwidth;
   for (int r = 0; r < repeat; ++r) {
     // Interleaved, so that a slow phase of the machine hits all of them alike.
     box_rate.push_back(time_solver(box, Boundary::kHalfwayBounceBack, threads, 100));
     packing_rate.push_back(time_solver(grid, Boundary::kInterpolated, threads, 100));
     packing_bb_rate.push_back(time_solver(grid, Boundary::kHalfwayBounceBack, threads, 100));
+    blocks_rate.push_back(time_solver(blocks, Boundary::kInterpolated, threads, 100));
+    blocks_bb_rate.push_back(time_solver(blocks, Boundary::kHalfwayBounceBack, threads, 100));
     bandwidth.push_back(update_bandwidth_gbs(threads, bandwidth_doubles));
   }
+  result.mflups_blocks = median(blocks_rate);
+  result.mflups_blocks_bb = median(blocks_bb_rate);
   result.mflups = median(box_rate);
   result.mflups_fluid_packing = median(packing_rate);
   result.mflups_fluid_packing_bb = median(packing_bb_rate);

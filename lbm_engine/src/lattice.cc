@@ -390,6 +390,7 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, WallScheme w
   table.self.reserve(total);
   table.a.reserve(total);
   table.b.reserve(total);
+  table.ghost.reserve(total);
   table.weight_a.reserve(total);
   table.weight_b.reserve(total);
   table.node.reserve(total);
@@ -407,6 +408,12 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, WallScheme w
     const std::int64_t d2 =
         wrap(i - kC[q][0], nx) + nx * (wrap(j - kC[q][1], ny) + ny * wrap(k - kC[q][2], nz));
     const std::int32_t r2 = grid.solid[static_cast<std::size_t>(d2)] ? -1 : stored_index(d2);
+    const std::int64_t dg =
+        wrap(i + kC[q][0], nx) + nx * (wrap(j + kC[q][1], ny) + ny * wrap(k + kC[q][2], nz));
+    const std::int32_t g = stored_index(dg);
+    if (g < 0 || !grid.solid[static_cast<std::size_t>(dg)]) {
+      throw Error(ErrorCode::kInternal, "lbm: a boundary link does not end at a stored solid node");
+    }
     double weight_a = 0.0, weight_b = 0.0;
     bool fallback = false;
     wall_weights(wall, link.q, r2 >= 0, &weight_a, &weight_b, &fallback);
@@ -418,6 +425,7 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, WallScheme w
     table.self.push_back(self);
     table.a.push_back(a);
     table.b.push_back(b);
+    table.ghost.push_back(q * stride_ + g);
     table.weight_a.push_back(weight_a);
     table.weight_b.push_back(weight_b);
     table.node.push_back(link.node);

@@ -33,8 +33,11 @@
 //    row opp(i) at x as well (the copy written to the ghost is never read). The kernel selects
 //    these with the node's 18-bit solid-neighbour mask, only in segments that touch a wall.
 // After either step the post-collision population leaving x along a boundary link i (x + c_i
-// solid) sits at row opp(i), node x: that is where the momentum exchange reads it and where
-// interpolated bounce-back overwrites the value coming back.
+// solid) sits at row opp(i), node x: that is where the momentum exchange reads it.
+// Interpolated walls do without the masks: every wall value goes through the link pass, which
+// reads the leaving value and writes the one coming back where the plain sweeps put and take
+// them (after an even step: row opp(i) at x and row i at the ghost x + c_i; after an odd step
+// the other way round; solver.h).
 //
 // Segments (run-length coded neighbour table): a Segment is a run of consecutive fluid nodes of
 // one x-row (split at x = 0 and x = nx - 1, where the periodic wrap breaks the contiguity). Its
@@ -85,9 +88,10 @@ void wall_weights(WallScheme wall, double q, bool second_node_fluid, double* wei
 /// a node's links are contiguous (its mass correction is then race-free and deterministic) and
 /// the pass sweeps memory in order.
 struct LinkTable {
-  std::vector<std::int64_t> self;  ///< Row opp(i), node r: f*_i(r); receives the reflected value.
-  std::vector<std::int64_t> a;     ///< Row opp(i), node r - c_i.
-  std::vector<std::int64_t> b;     ///< Row i, node r.
+  std::vector<std::int64_t> self;   ///< Row opp(i), node r: f*_i(r); receives the reflected value.
+  std::vector<std::int64_t> a;      ///< Row opp(i), node r - c_i.
+  std::vector<std::int64_t> b;      ///< Row i, node r.
+  std::vector<std::int64_t> ghost;  ///< Row i, solid node r + c_i (a ghost: see solver.h).
   /// Interpolation weights: the reflected value is f + weight_a (f_a - f) + weight_b (f_b - f)
   /// with f = f*_i(r), f_a = f*_i(r - c_i), f_b = f*_ib(r) (both 0: halfway bounce-back).
   std::vector<double> weight_a;
@@ -105,7 +109,7 @@ struct LinkTable {
   /// links of one node: chunk p is [result[p], result[p+1]).
   std::vector<std::int64_t> chunks(int parts) const;
   std::size_t memory_bytes() const {
-    return size() * (3 * sizeof(std::int64_t) + 2 * sizeof(double) + 2 * sizeof(std::int32_t) + 1);
+    return size() * (4 * sizeof(std::int64_t) + 2 * sizeof(double) + 2 * sizeof(std::int32_t) + 1);
   }
 };
 

@@ -115,10 +115,11 @@ void even_sweep(T* base, std::int64_t stride, const Segment* first, const Segmen
 /// Odd step over the segments [first, last): read row opp(i) at x - c_i (= the write location
 /// of opp(i)), write row i at x + c_i. Segments touching a wall take the masked variant: a solid
 /// x - c_i makes the read come from row i at x, and a solid x + c_i adds a write of f*_i to row
-/// opp(i) at x (halfway bounce-back; the write to the ghost is harmless).
+/// opp(i) at x (halfway bounce-back; the write to the ghost is harmless). With `masked` false
+/// (interpolated walls) every segment takes the plain loop: the link pass handles the walls.
 template <typename T, CollisionKernel K, bool kStokes>
 void odd_sweep(T* base, std::int64_t stride, const std::uint32_t* masks, const Segment* first,
-               const Segment* last, const KernelParams<T>& p) {
+               const Segment* last, const KernelParams<T>& p, bool masked) {
   const KernelParams<T> params = p;
   for (const Segment* s = first; s != last; ++s) {
     T* const w0 = base + s->write[0];
@@ -141,7 +142,7 @@ void odd_sweep(T* base, std::int64_t stride, const std::uint32_t* masks, const S
     T* const w17 = base + s->write[17];
     T* const w18 = base + s->write[18];
     const std::int64_t length = s->length;
-    if (!s->wall) {
+    if (!s->wall || !masked) {
 #pragma GCC ivdep
       for (std::int64_t k = 0; k < length; ++k) {
         T g[kQ], o[kQ];
@@ -488,11 +489,11 @@ class Solver final : public SolverBase {
   }
 
  private:
-  /// One time step in one parallel region: the collision sweep of the given parity, a barrier,
-  /// and, when interpolating or when body_force != nullptr, the link pass, each thread over the
-  /// links of its own x-rows. (Interleaving the link pass with the sweep, a few planes behind
-  /// it so that its values are still cached, measured no faster on this machine: the pass is
-  /// bound by the latency of its scattered accesses, not by bandwidth.)
+  /// One time step in one parallel region: the collision sweep of the given parity and, when
+  /// interpolating or when body_force != nullptr, the link pass, each thread over the links of
+  /// its own x-rows, two planes behind its sweep (the rows at the ends of its range after a
+  /// barrier). With interpolated walls the sweeps run without the solid-neighbour masks.
+  /// (docs/scaling.md has what each part costs.)
   void step(int parity, std::vector<double>* body_force) {
     switch (settings_.kernel) {
       case CollisionKernel::kTrt:
@@ -519,8 +520,15 @@ class Solver final : public SolverBase {
     const Segment* segments = lattice_.segments().data();
     const std::uint32_t* masks = lattice_.solid_masks();
     const bool update = settings_.interpolated;
+    const bool masked = !settings_.interpolated;
     const bool links = update || body_force != nullptr;
     const double correction = begin_step(body_force);
+    const bool forces = body_force != nullptr;
+    // A link of row R reads and writes only nodes of rows R - lag .. R + lag (row j + ny k; a
+    // neighbour across the periodic y boundary in the next plane is 2 ny - 1 rows on): its pass
+    // runs right behind the sweep, while those rows are still cached, except for the rows within
+    // lag of either end of a work range, whose neighbours another range sweeps (after the barrier).
+    const std::int64_t lag = 2 * lattice_.dims()[1];
 #pragma omp parallel num_threads(threads_)
     {
       for (int t = thread_id(); t < ranges; t += team_size()) {
@@ -531,14 +539,26 @@ class Solver final : public SolverBase {
           if (parity == 0) {
             even_sweep<T, K, kStokes>(base, stride, first, last, p);
           } else {
-            odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p);
+            odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p, masked);
+          }
+          const std::int64_t behind = r - lag;
+          if (links && behind >= r0 + lag && behind < r1 - lag) {
+            link_row(t, behind, parity, update, forces, correction);
           }
         }
       }
       if (links) {
-        // Every post-collision value of this step must be in place before any link reads it.
+        // Every post-collision value of this step must be in place before the remaining links
+        // read it.
 #pragma omp barrier
-        link_ranges(parity, update, body_force != nullptr, correction);
+        for (int t = thread_id(); t < ranges; t += team_size()) {
+          const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
+          const std::int64_t head = std::min(r1, r0 + lag), tail = std::max(head, r1 - lag);
+          for (std::int64_t r = r0; r < head; ++r)
+            link_row(t, r, parity, update, forces, correction);
+          for (std::int64_t r = tail; r < r1; ++r)
+            link_row(t, r, parity, update, forces, correction);
+        }
       }
     }
     finish_step(parity, update, body_force);
@@ -604,6 +624,7 @@ class Solver final : public SolverBase {
     const Segment* segments = lattice_.segments().data();
     const std::uint32_t* masks = lattice_.solid_masks();
     const bool update = settings_.interpolated;
+    const bool masked = !settings_.interpolated;
     const bool links = update || body_force != nullptr;
     const double correction = begin_step(body_force);
     const HaloPlan& plan = lattice_.halo();
@@ -619,7 +640,7 @@ class Solver final : public SolverBase {
       if (parity == 0) {
         even_sweep<T, K, kStokes>(base, stride, first, last, p);
       } else {
-        odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p);
+        odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p, masked);
       }
     };
     const std::int64_t boundary_rows = static_cast<std::int64_t>(plan.boundary_rows.size());
@@ -733,7 +754,13 @@ class Solver final : public SolverBase {
     // weights follow the values, not the positions).
     const std::int64_t* first = parity == 0 ? L.a.data() : L.b.data();
     const std::int64_t* second = parity == 0 ? L.b.data() : L.a.data();
-    const std::int64_t* self = L.self.data();
+    // Halfway bounce-back in the kernels (masked sweeps): the value leaving r and the one coming
+    // back share the slot row opp(i) at r. Interpolated walls (plain sweeps): the odd sweep
+    // writes the leaving value into the solid neighbour's slot, row i at r + c_i, and reads the
+    // one coming back from there; the pass moves each value to where the next step reads it.
+    const bool plain = settings_.interpolated;
+    const std::int64_t* out = plain && parity == 1 ? L.ghost.data() : L.self.data();
+    const std::int64_t* in = plain && parity == 0 ? L.ghost.data() : L.self.data();
     const std::int32_t* node = L.node.data();
     const double* weight_a = L.weight_a.data();
     const double* weight_b = L.weight_b.data();
@@ -743,11 +770,12 @@ class Solver final : public SolverBase {
       if (l + kLinkPrefetch < end) {
         // The pass is bound by the latency of its scattered loads (last-level-cache hits on
         // this machine); prefetching a few links ahead keeps more of them in flight.
-        __builtin_prefetch(base + self[l + kLinkPrefetch], 1);
+        __builtin_prefetch(base + out[l + kLinkPrefetch], 0);
+        __builtin_prefetch(base + in[l + kLinkPrefetch], 1);
         __builtin_prefetch(base + first[l + kLinkPrefetch], 0);
         __builtin_prefetch(base + second[l + kLinkPrefetch], 0);
       }
-      const double f = base[self[l]];
+      const double f = base[out[l]];
       double back = f;
       if (interpolate) {
         // In float, rounded as the fluid receives it.
@@ -755,7 +783,7 @@ class Solver final : public SolverBase {
                               weight_b[l] * (double(base[second[l]]) - f));
       }
       if (update) {
-        base[self[l]] = static_cast<T>(back);
+        base[in[l]] = static_cast<T>(back);
         defect += back - f;
         if (l + 1 == end || node[l + 1] != node[l]) {
           base[node[l]] = static_cast<T>(base[node[l]] - correction);

@@ -2,7 +2,12 @@
 // pass (interpolated bounce-back and momentum exchange) and the diagnostic moment sweep.
 //
 // Boundary-link pass (every step when interpolating; at checked steps only for halfway
-// bounce-back, which the AA offsets already do), after the sweep of each step. For a link from
+// bounce-back, which the masked AA sweeps already do), right behind the sweep of each step
+// (solver.cc: a link touches only rows near its own, so it runs while they are cached). With
+// interpolated walls the sweeps are plain (no solid-neighbour masks): the odd sweep writes the
+// value leaving r along c_i into the solid neighbour's slot (row i at r + c_i, a ghost) and reads
+// the value coming back from there, and the pass moves each value where the next step reads it
+// (lattice.h, LinkTable::ghost). For a link from
 // fluid node r along c_i into a solid node, with wall fraction q, the value that comes back into r
 // along c_ib (ib = opp(i)) at the next step is, with post-collision values f* of this step,
 //   f_ib(r, t+1) = f + a (f*_i(r - c_i) - f) + b (f*_ib(r) - f),   f = f*_i(r),

@@ -113,10 +113,16 @@ setsid timeout -s KILL 300 "$mpirun" -np 3 \
 job=$!
 pids_to_kill+=("$job")
 caught=0
+job_pids=""
 for _ in $(seq 1 600); do
   done_now=$(units "$work/whole.db" done 2>/dev/null || echo 0)
   running=$(units "$work/whole.db" running 2>/dev/null || echo 0)
-  if [ "${done_now:-0}" -ge 1 ] && [ "${running:-0}" -ge 1 ]; then
+  # The job's processes, found once its ranks work (scanning /proc takes a while on a loaded
+  # machine: done at the moment of the kill, it let the units in flight finish first).
+  if [ -z "$job_pids" ] && [ "${running:-0}" -ge 1 ]; then
+    job_pids="$(pids_of "draglab --db $work/whole.db")"
+  fi
+  if [ -n "$job_pids" ] && [ "${done_now:-0}" -ge 1 ] && [ "${running:-0}" -ge 1 ]; then
     caught=1
     break
   fi
@@ -125,6 +131,7 @@ done
 check "the whole job was caught with units done and in flight" test "$caught" -eq 1
 # mpirun puts each rank in a process group of its own: every process of the job is killed by
 # name, at once, as a batch system ends a job (mpirun's command line names the database too).
+kill -9 $job_pids 2>/dev/null
 kill -9 $(pids_of "draglab --db $work/whole.db") 2>/dev/null
 wait "$job" 2>/dev/null
 for _ in $(seq 1 50); do

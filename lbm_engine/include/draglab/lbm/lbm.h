@@ -313,8 +313,13 @@ struct BenchResult {
   double mflups_fluid_packing = 0.0;     ///< Fluid-node updates/s on a phi = 0.4 random packing
                                          ///< (TRT, interpolated bounce-back: the default scheme).
   double mflups_fluid_packing_bb = 0.0;  ///< Same packing, halfway bounce-back (no link pass).
-  double bandwidth_gbs = 0.0;            ///< STREAM-like in-place update kernel.
-  double roofline_fraction = 0.0;        ///< mflups / (bandwidth / 304 bytes).
+  /// Fluid-node updates/s on RRZE lbm-benchmark-kernels' `blocks-8` geometry (100^3), with the
+  /// interpolated path (q = 1/2 links) and with halfway bounce-back.
+  double mflups_blocks = 0.0;
+  double mflups_blocks_bb = 0.0;
+  std::int64_t blocks_fluid_nodes = 0;
+  double bandwidth_gbs = 0.0;      ///< STREAM-like in-place update kernel.
+  double roofline_fraction = 0.0;  ///< mflups / (bandwidth / 304 bytes).
   int threads = 0;
   /// Working sets are >= 4x this: the all-fluid box edge and the packing's sphere count.
   double last_level_cache_bytes = 0.0;

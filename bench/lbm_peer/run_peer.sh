@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# The engine's packing path against a peer list-based kernel, side by side in one run: RRZE
+# lbm-benchmark-kernels (github.com/RRZE-HPC/lbm-benchmark-kernels, GPLv3; build it outside this
+# repository, e.g. `make CONFIG=linux-gcc ISA=avx` in its src/) runs `list-aa-pv-soa` (fluid-only
+# list, AA pattern, partial vectorization, TRT, double) on its `blocks-8` geometry (100^3), and
+# `draglab lbm bench` measures, on the same geometry and in the same repetition, the engine's
+# interpolated-wall path (link pass included) and halfway bounce-back, besides its phi = 0.4
+# sphere packing and all-fluid box. Repetitions are interleaved (peer, engine, peer, ...) so
+# that a slow phase of this shared machine hits both alike; medians are reported.
+# Usage: bench/lbm_peer/run_peer.sh --peer PATH/lbmbenchk-linux-gcc-release-dp [--threads T]
+#        [--repeat N] [--iterations I] [--draglab BIN] [--out FILE]
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+peer=""
+threads=2
+repeat=5
+iterations=200
+draglab="$root/build/cli/draglab"
+out=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --peer) peer="$2"; shift 2 ;;
+    --threads) threads="$2"; shift 2 ;;
+    --repeat) repeat="$2"; shift 2 ;;
+    --iterations) iterations="$2"; shift 2 ;;
+    --draglab) draglab="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    *) echo "usage: $0 --peer BIN [--threads T] [--repeat N] [--iterations I] [--draglab BIN] [--out FILE]" >&2; exit 2 ;;
+  esac
+done
+[ -x "$peer" ] || { echo "error: --peer must name the built RRZE lbmbenchk binary" >&2; exit 2; }
+[ -x "$draglab" ] || { echo "error: no draglab at $draglab (build first)" >&2; exit 2; }
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+for r in $(seq 1 "$repeat"); do
+  echo "repetition $r of $repeat" >&2
+  OMP_NUM_THREADS="$threads" "$peer" -dims 100x100x100 -geometry blocks-8 -kernel list-aa-pv-soa \
+    -iterations "$iterations" -t "$threads" 2>&1 | awk '/^P:/ {print $2}' >>"$work/peer.txt"
+  "$draglab" lbm bench --threads "$threads" --repeat 1 --json 2>/dev/null >"$work/engine_$r.json"
+done
+table="$(python3 - "$work" "$repeat" <<'PY'
+import json, statistics, sys
+work, repeat = sys.argv[1], int(sys.argv[2])
+peer = [float(x) for x in open(f"{work}/peer.txt").read().split()]
+runs = [json.load(open(f"{work}/engine_{r}.json")) for r in range(1, repeat + 1)]
+def med(key): return statistics.median(r[key] for r in runs)
+p = statistics.median(peer)
+rows = [
+    ("peer list-aa-pv-soa, blocks-8", p, max(peer)),
+    ("engine, blocks-8, interpolated path", med("mflups_blocks"), max(r["mflups_blocks"] for r in runs)),
+    ("engine, blocks-8, halfway bounce-back", med("mflups_blocks_bb"), max(r["mflups_blocks_bb"] for r in runs)),
+    ("engine, phi 0.4 packing d 16, interpolated path", med("mflups_fluid_packing"), max(r["mflups_fluid_packing"] for r in runs)),
+    ("engine, phi 0.4 packing d 16, halfway bounce-back", med("mflups_fluid_packing_bb"), max(r["mflups_fluid_packing_bb"] for r in runs)),
+    ("engine, all-fluid box", med("mflups"), max(r["mflups"] for r in runs)),
+]
+print(f"# {len(peer)} interleaved repetitions, {runs[0]['threads']} threads; bandwidth (in-place update) median {med('bandwidth_gbs'):.1f} GB/s")
+print("# kernel / geometry                                   MFLUPS median  best  ratio to peer (medians)")
+for name, m, b in rows:
+    print(f"{name:<52} {m:8.1f} {b:8.1f}  {m / p:6.2f}")
+PY
+)"
+echo "$table"
+if [ -n "$out" ]; then
+  {
+    echo "# bench/lbm_peer/run_peer.sh --threads $threads --repeat $repeat --iterations $iterations"
+    echo "# code: $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet || echo '+modified'); peer: RRZE lbm-benchmark-kernels $(git -C "$(dirname "$peer")/.." rev-parse --short HEAD 2>/dev/null || echo '?'), list-aa-pv-soa, double"
+    echo "# machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(date -u +%Y-%m-%d)"
+    echo "$table"
+  } >"$out"
+fi
