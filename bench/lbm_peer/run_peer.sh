@@ -35,8 +35,9 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 for r in $(seq 1 "$repeat"); do
   echo "repetition $r of $repeat" >&2
-  OMP_NUM_THREADS="$threads" "$peer" -dims 100x100x100 -geometry blocks-8 -kernel list-aa-pv-soa \
-    -iterations "$iterations" -t "$threads" 2>&1 | awk '/^P:/ {print $2}' >>"$work/peer.txt"
+  # (in the scratch folder: the peer writes its own output files where it runs)
+  (cd "$work" && OMP_NUM_THREADS="$threads" "$peer" -dims 100x100x100 -geometry blocks-8 -kernel list-aa-pv-soa \
+    -iterations "$iterations" -t "$threads" 2>&1) | awk '/^P:/ {print $2}' >>"$work/peer.txt"
   "$draglab" lbm bench --threads "$threads" --repeat 1 --json 2>/dev/null >"$work/engine_$r.json"
 done
 table="$(python3 - "$work" "$repeat" <<'PY'
