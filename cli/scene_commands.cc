@@ -34,7 +34,8 @@ struct SceneArgs {
   std::string laws;       // --law a,b,c
   double duration_s = 0;  // scene run --duration (not given: the scene's)
   bool duration_given = false;
-  bool no_store = false;  // scene run --no-store
+  bool laws_given = false;  // scene run --law (given empty: refused, not the scene's)
+  bool no_store = false;    // scene run --no-store
 };
 
 /// The laws to evaluate: --law, else the scene's plus the five reference laws' version 1 that
@@ -173,6 +174,8 @@ void run_run(const CliContext& ctx, const SceneArgs& args) {
         fmt::format("--duration = {} must be a time > 0 s (leave it out for the "
                     "scene's [time] duration_s)",
                     format_number(args.duration_s)));
+  if (args.laws_given && args.laws.empty())
+    throw UsageError("--law: empty (give NAME@V, or leave --law out for the scene's first law)");
   const Scene scene = consumers::load_scene(args.scene_path);
   const std::string ref = args.laws.empty() ? scene.laws.front() : args.laws;
   if (ref.find(',') != std::string::npos)
@@ -267,7 +270,8 @@ void add_scene_commands(CLI::App& app, CliContext& ctx) {
       "bubble; prints U_mf, the background velocity used, the bubble diameter at t_ref and the "
       "time series (progress with ETA on stderr)");
   run->add_option("SCENE", run_args->scene_path, "Scene file (TOML)")->required();
-  run->add_option("--law", run_args->laws, "One law NAME@V (default: the scene's first)");
+  run->add_option("--law", run_args->laws, "One law NAME@V (default: the scene's first)")
+      ->each([run_args](const std::string&) { run_args->laws_given = true; });
   run->add_option("--duration", run_args->duration_s,
                   "Simulated time after the flow starts [s] (default: the scene's)")
       ->each([run_args](const std::string&) { run_args->duration_given = true; });

@@ -33,6 +33,7 @@ grep -v '^#' "$data/datasets/quick/quick.csv" >"$in/good.csv"
 cp "$data/campaigns/quick.toml" "$in/spec.toml"
 cp "$data/scenes/dpm_bubble_quick.toml" "$in/dpm.toml"
 cp "$data/scenes/dbm_tiny.toml" "$in/dbm.toml"
+cp "$data/scenes/dpm_tiny.toml" "$in/dpm_tiny.toml"
 cp "$data/scenes/tfm_bubble.toml" "$in/tfm.toml"
 # A damaged packing that crashes libhdf5 itself (fuzz/regressions/README.md).
 cp "$data/../fuzz/regressions/libhdf5_global_heap_read.h5" "$in/crashes_libhdf5.h5"

@@ -270,7 +270,8 @@ TEST(SceneParse, EveryBadInputIsNamed) {
   expect_bad(edit(base, "time", "t_ref_s", "t_ref_s = 0.5"), {"[time] t_ref_s", "duration_s"});
   expect_bad(edit(base, "time", "duration_s", "duration_s = 0"), {"[time] duration_s"});
   expect_bad(edit(base, "grid", "cells_x", "cells_x = 100"), {"[grid]", "smaller than a particle"});
-  expect_bad(edit(base, "grid", "cells_y", "cells_y = 0"), {"[grid] cells_y", "[1, 100000]"});
+  expect_bad(edit(base, "grid", "cells_y", "cells_y = 0"), {"[grid] cells_y", "[2, 100000]"});
+  expect_bad(edit(base, "grid", "cells_x", "cells_x = 1"), {"[grid] cells_x", "[2, 100000]"});
   expect_bad(edit(base, "bubble", "eps_threshold", "eps_threshold = 0.3"),
              {"[bubble] eps_threshold"});
   expect_bad(edit(base, "bubble", "eps_threshold", "eps_threshold = 1.0"),

@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include "bed/builtin_models.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -104,6 +105,18 @@ BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
                         const BedRealization* start) {
   std::string why;
   if (!options.IsValid(&why)) throw Error(ErrorCode::kInvalidArgument, "bed run options: " + why);
+  if (options.duration_s > 0.0) {
+    // A duration given in place of the scene's obeys the scene's rules (its range, t_ref and
+    // every averaging window inside it), checked here before any work rather than found at the
+    // end of the run.
+    Scene with_duration = scene;
+    with_duration.time.duration_s = options.duration_s;
+    if (!with_duration.IsValid(&why)) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  "the duration " + core::format_number(options.duration_s) +
+                      " s given for the run (--duration, in place of [time] duration_s): " + why);
+    }
+  }
   return find_bed_model(scene.solver).Run(scene, std::move(law), options, progress, start);
 }
 

@@ -11,6 +11,7 @@
 #include <numeric>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 
 #include "draglab/drag_db/error.h"
 
@@ -34,6 +35,10 @@ std::string Num(double v) {
 [[noreturn]] void Fail(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, message);
 }
+
+/// A run that went wrong from valid input (divergence, no rest): a run-time failure, not bad
+/// input (the command line exits 1, not 2).
+[[noreturn]] void Diverged(const std::string& message) { throw std::runtime_error(message); }
 
 bool Finite(const std::array<double, 3>& a) {
   return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
@@ -631,16 +636,17 @@ void DemSystem::compute_forces(double dt) {
 
 void DemSystem::check_state(double dt) const {
   if (overflow_particle_ >= 0) {
-    Fail("DEM: particle " + std::to_string(overflow_particle_) + " has more than " +
-         std::to_string(kMaxContacts) + " contacts (limit of the contact history); overlaps are " +
-         "too large or the size ratio too wide; remedy: raise normal_stiffness or narrow the " +
-         "size distribution");
+    Diverged("DEM: particle " + std::to_string(overflow_particle_) + " has more than " +
+             std::to_string(kMaxContacts) +
+             " contacts (limit of the contact history); overlaps are " +
+             "too large or the size ratio too wide; remedy: raise normal_stiffness or narrow the " +
+             "size distribution");
   }
   if (max_overlap_ > options_.max_overlap_fraction || !std::isfinite(max_overlap_)) {
-    Fail("DEM diverged at t = " + Num(time_) + " s: overlap " + Num(max_overlap_) +
-         " of a diameter exceeds max_overlap_fraction = " + Num(options_.max_overlap_fraction) +
-         "; remedy: raise normal_stiffness (k_n = " + Num(options_.normal_stiffness) +
-         " N/m) or lower the impact velocities / external forces");
+    Diverged("DEM diverged at t = " + Num(time_) + " s: overlap " + Num(max_overlap_) +
+             " of a diameter exceeds max_overlap_fraction = " + Num(options_.max_overlap_fraction) +
+             "; remedy: raise normal_stiffness (k_n = " + Num(options_.normal_stiffness) +
+             " N/m) or lower the impact velocities / external forces");
   }
   const int n = static_cast<int>(p_.size());
   const double tol = 0.5 * d_max_;
@@ -662,16 +668,17 @@ void DemSystem::check_state(double dt) const {
     vmax2 = std::max(vmax2, v2);
   }
   if (bad >= 0) {
-    Fail("DEM diverged at t = " + Num(time_) + " s: particle " + std::to_string(bad) +
-         " is non-finite or outside the box (limit: half a diameter beyond a wall); remedy: " +
-         "lower dt (now " + Num(dt_) +
-         " s), raise normal_stiffness, or check the external "
-         "forces");
+    Diverged("DEM diverged at t = " + Num(time_) + " s: particle " + std::to_string(bad) +
+             " is non-finite or outside the box (limit: half a diameter beyond a wall); remedy: " +
+             "lower dt (now " + Num(dt_) +
+             " s), raise normal_stiffness, or check the external "
+             "forces");
   }
   if (dt > 0.0 && std::sqrt(vmax2) * dt > 0.25 * d_min_) {
-    Fail("DEM diverged at t = " + Num(time_) + " s: a particle moves " +
-         Num(std::sqrt(vmax2) * dt / d_min_) + " diameters per step (limit 0.25; contacts " +
-         "would be missed); remedy: lower dt (now " + Num(dt) + " s) or check the external forces");
+    Diverged("DEM diverged at t = " + Num(time_) + " s: a particle moves " +
+             Num(std::sqrt(vmax2) * dt / d_min_) + " diameters per step (limit 0.25; contacts " +
+             "would be missed); remedy: lower dt (now " + Num(dt) +
+             " s) or check the external forces");
   }
 }
 
@@ -807,10 +814,10 @@ void DemSystem::sort_particles() {
         }
       }
       if (count[owner] >= kMaxContacts) {
-        Fail("DEM: particle " + std::to_string(owner) + " has more than " +
-             std::to_string(kMaxContacts) + " contacts (limit of the contact history); " +
-             "overlaps are too large or the size ratio too wide; remedy: raise " +
-             "normal_stiffness or narrow the size distribution");
+        Diverged("DEM: particle " + std::to_string(owner) + " has more than " +
+                 std::to_string(kMaxContacts) + " contacts (limit of the contact history); " +
+                 "overlaps are too large or the size ratio too wide; remedy: raise " +
+                 "normal_stiffness or narrow the size distribution");
       }
       const std::size_t to = static_cast<std::size_t>(owner) * kMaxContacts + count[owner]++;
       partner[to] = other;
@@ -993,9 +1000,10 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
     if (ratio < settle.kinetic_energy_tolerance && dem.time() > 0.05) break;
   }
   if (!(ratio < settle.kinetic_energy_tolerance)) {
-    Fail("settle_particles: not at rest after SettleOptions.max_time = " + Num(settle.max_time) +
-         " s (KE/(m g d) = " + Num(ratio) + " > kinetic_energy_tolerance = " +
-         Num(settle.kinetic_energy_tolerance) + "); remedy: raise max_time or lower restitution");
+    Diverged("settle_particles: not at rest after SettleOptions.max_time = " +
+             Num(settle.max_time) + " s (KE/(m g d) = " + Num(ratio) +
+             " > kinetic_energy_tolerance = " + Num(settle.kinetic_energy_tolerance) +
+             "); remedy: raise max_time or lower restitution");
   }
   SettleResult result;
   result.particles = dem.particles();

@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -127,7 +129,12 @@ void DpmSimulation::Settle(const DpmProgress& progress) {
   const Scene& s = scene_;
   const DemOptions d = MakeDemOptions();
   SettleOptions so;
-  so.n = static_cast<int>(s.particle_count());
+  const std::int64_t count = s.particle_count();
+  if (count < 1 || count > std::numeric_limits<int>::max()) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "[particles]: " + std::to_string(count) + " particles is outside [1, 10000000]");
+  }
+  so.n = static_cast<int>(count);
   so.diameter = s.particles.diameter_m;
   so.density = s.particles.density_kg_m3;
   so.seed = s.seed;
@@ -393,6 +400,8 @@ const DpmStepDiagnostics& DpmSimulation::Step() {
       }
     } catch (const Error& e) {
       throw Error(e.code(), "DPM stopped at t = " + Num(m.time) + " s (DEM): " + e.what());
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error("DPM stopped at t = " + Num(m.time) + " s (DEM): " + e.what());
     }
     result_.dem_steps += k;
   }

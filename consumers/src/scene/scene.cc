@@ -165,15 +165,17 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                {{"cells_x",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    const std::int64_t v = as_integer(n, f, at);
-                   if (v < 1 || v > 100000)
-                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100000]");
+                   if (v < 2 || v > 100000)
+                     bad(at + ": " + f + " = " + std::to_string(v) +
+                         " is outside [2, 100000] (the gas solver needs two cells across)");
                    s.grid.cells_x = static_cast<int>(v);
                  }},
                 {"cells_y",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    const std::int64_t v = as_integer(n, f, at);
-                   if (v < 1 || v > 100000)
-                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100000]");
+                   if (v < 2 || v > 100000)
+                     bad(at + ": " + f + " = " + std::to_string(v) +
+                         " is outside [2, 100000] (the gas solver needs two cells across)");
                    s.grid.cells_y = static_cast<int>(v);
                  }},
                 {"cells_z",
@@ -629,6 +631,21 @@ bool Scene::IsValid(std::string* error) const {
       return fail(error, "[particles] count = " + std::to_string(particles.count) +
                              " is outside [1, 10000000]");
     }
+    if (solver == "dpm" && has_height) {
+      // The particle solver holds every particle: the count a bed height makes obeys the cap
+      // of [particles] count (checked in double: a tiny diameter overflows any integer).
+      const double n = (1.0 - eps_mf) * geometry.width_m * geometry.depth_m *
+                       particles.bed_height_mf_m /
+                       (std::acos(-1.0) / 6.0 * particles.diameter_m * particles.diameter_m *
+                        particles.diameter_m);
+      if (!(n <= 10000000.0)) {
+        return fail(error, "[particles] bed_height_mf_m = " + fmt(particles.bed_height_mf_m) +
+                               " m of diameter_m = " + fmt(particles.diameter_m) + " m makes " +
+                               fmt(n) +
+                               " particles, more than the 10000000 the DPM holds (a lower bed, "
+                               "larger particles or a narrower box)");
+      }
+    }
     const double h_mf = bed_height_mf_m();
     if (h_mf > geometry.height_m) {
       return fail(error, "[particles] count = " + std::to_string(particles.count) +
@@ -713,8 +730,8 @@ bool Scene::IsValid(std::string* error) const {
     }
   }
   // Grid: the void fraction needs cells at least one particle wide.
-  if (grid.cells_x < 1 || grid.cells_y < 1) {
-    return fail(error, "[grid] cells_x and cells_y must be >= 1 (got " +
+  if (grid.cells_x < 2 || grid.cells_y < 2) {
+    return fail(error, "[grid] cells_x and cells_y must be >= 2 (got " +
                            std::to_string(grid.cells_x) + ", " + std::to_string(grid.cells_y) +
                            ")");
   }
