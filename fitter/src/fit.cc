@@ -593,5 +593,11 @@ FitResult fit_requested(const std::vector<FitPoint>& points, const FitOptions& o
 
 }  // namespace internal
 
+int num_free_parameters(const FitOptions& options) {
+  const std::vector<bool> is_free =
+      internal::requested_free(internal::checked_form(options.form), options);
+  return static_cast<int>(std::count(is_free.begin(), is_free.end(), true));
+}
+
 }  // namespace fitter
 }  // namespace draglab

@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "draglab/consumers/scene.h"
+#include "draglab/core/files.h"
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
@@ -162,6 +163,18 @@ PipelineSummary run_pipeline(const PipelineOptions& options, const Messages& mes
   } catch (const Error& e) {
     throw Error(e.code(), std::string("--law-name: ") + e.what());
   }
+  // The report folder, and enough grid points for the fit: known now, found late otherwise (the
+  // law would be published before the report failed).
+  const std::size_t grid_points = spec.phi.size() * spec.re.size();
+  const int free_parameters = fitter::num_free_parameters(fitter::FitOptions());
+  if (grid_points < static_cast<std::size_t>(free_parameters) + 1) {
+    throw Error(ErrorCode::kInvalidArgument,
+                options.spec_path + ": [grid] phi x re gives " + std::to_string(grid_points) +
+                    " points, too few to fit Eq. 6's " + std::to_string(free_parameters) +
+                    " free parameters (need at least " + std::to_string(free_parameters + 1) +
+                    "): add phi or re values");
+  }
+  if (options.report) core::check_output_directory(out.out_dir, "--out");
   std::unique_ptr<consumers::Scene> regress_scene;
   if (!options.regress_scene.empty()) {
     if (!options.regress)

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "draglab/core/text.h"
 #include "draglab/core/toml_schema.h"
 
 #include "draglab/consumers/bed_model.h"
@@ -86,6 +87,21 @@ Key num(const std::string& name, Member member) {
                          const std::string& at) { member(s) = as_number(n, f, at); }};
 }
 
+/// A number whose absence selects a default (held as -1 in the Scene): a value written in the
+/// file must be >= 0, so that the default is never taken from a typo.
+template <typename Member>
+Key num_or_default(const std::string& name, Member member) {
+  return {name,
+          [member](Scene& s, const toml::node& n, const std::string& f, const std::string& at) {
+            const double v = as_number(n, f, at);
+            if (!(v >= 0.0)) {
+              bad(at + ": " + f + " = " + core::format_number(v) + " must be >= 0 (leave " + f +
+                  " out for its default)");
+            }
+            member(s) = v;
+          }};
+}
+
 // The sections and keys a scene file accepts, in documentation order.
 const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
   using S = Scene;
@@ -150,7 +166,7 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
               {"jet",
                {num("slot_width_m", [](S& s) -> double& { return s.jet.slot_width_m; }),
                 num("velocity_m_s", [](S& s) -> double& { return s.jet.velocity_m_s; }),
-                num("center_m", [](S& s) -> double& { return s.jet.center_m; }),
+                num_or_default("center_m", [](S& s) -> double& { return s.jet.center_m; }),
                 num("start_s", [](S& s) -> double& { return s.jet.start_s; }),
                 num("duration_s", [](S& s) -> double& { return s.jet.duration_s; }),
                 num("ramp_s", [](S& s) -> double& { return s.jet.ramp_s; })}},
@@ -216,7 +232,7 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.tfm.radial_distribution = as_text(n, f, at);
                  }},
-                num("restitution", [](S& s) -> double& { return s.tfm.restitution; }),
+                num_or_default("restitution", [](S& s) -> double& { return s.tfm.restitution; }),
                 num("packing_limit", [](S& s) -> double& { return s.tfm.packing_limit; }),
                 {"friction", [](S& s, const toml::node& n, const std::string& f,
                                 const std::string& at) { s.tfm.friction = as_text(n, f, at); }},
@@ -422,6 +438,16 @@ bool dbm_is_valid(const Scene& s, std::string* error) {
     return fail(error, "[dbm] dt_s = " + fmt(d.dt_s) + " s would take more than 1e9 steps");
   if (s.grid.cells_x < 2 || s.grid.cells_y < 2)
     return fail(error, "[grid] cells_x and cells_y must be >= 2 for the DBM's emulsion");
+  // The emulsion is a continuum of particles: its cells are at least one particle wide along
+  // the depth too (x and y are checked with every model).
+  const double dz = s.geometry.depth_m / s.grid.cells_z;
+  if (dz < s.particles.diameter_m)
+    return fail(error, "[grid] cells_z = " + std::to_string(s.grid.cells_z) + " makes cells " +
+                           fmt(dz) + " m deep, less than one particle ([particles] diameter_m = " +
+                           fmt(s.particles.diameter_m) + " m): at most " +
+                           std::to_string(static_cast<long long>(s.geometry.depth_m /
+                                                                 s.particles.diameter_m)) +
+                           " cells_z");
   return true;
 }
 

@@ -152,6 +152,10 @@ struct FitResult {
 /// Error(kOutOfValidity) if the optimizer does not converge.
 FitResult fit_law(const std::vector<FitPoint>& points, const FitOptions& options);
 
+/// The number of parameters `options` fits (its form's default set when `free` is empty): a fit
+/// needs at least one point more. Throws as fit_law does for an unknown form or parameter.
+int num_free_parameters(const FitOptions& options);
+
 /// Index of parameter `name_or_alias` of `form`; throws Error(kInvalidArgument) listing names.
 int parameter_index(const LawForm& form, const std::string& name_or_alias);
 
