@@ -111,4 +111,7 @@ fi
 cmake -S "$here" -B "$build_dir" "${cmake_args[@]}" >/dev/null
 target_args=()
 [ -n "${DRAGLAB_BUILD_TARGET:-}" ] && target_args=(--target "$DRAGLAB_BUILD_TARGET")
-cmake --build "$build_dir" -j "$jobs" "${target_args[@]}"
+# A built tree says nothing: the "Built target" lines of an up-to-date build are dropped, what
+# is compiled and every error still stream through.
+cmake --build "$build_dir" -j "$jobs" "${target_args[@]}" 2>&1 |
+  { grep --line-buffered -v -E '^\[ *[0-9]+%\] Built target |^Consolidate compiler generated' || true; }
