@@ -4,36 +4,74 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <deque>
 #include <string>
 
 namespace draglab {
 namespace cli {
 
-/// Remaining time of a job from its reported fraction done: the rate since the current pass
-/// began, extrapolated. Callers report either the fraction of the whole job (the stage text may
-/// change freely, e.g. "settle: KE = ...") or a fraction per stage that restarts from 0, so a pass
-/// begins at the first report and whenever the fraction drops.
+/// Remaining time of a job from its reported fraction done. Callers report either the fraction
+/// of the whole job (the stage text may change freely, e.g. "settle: KE = ...") or a fraction per
+/// stage that restarts from 0, so a pass begins at the first report and whenever the fraction
+/// drops. The rate is the slower of the pass's average and its recent rate (over the last fifth
+/// of the pass, at least 5 s): a job that slows down (a bed model whose later seconds cost more)
+/// is not promised the early rate, and trend() says when the two differ by more than 2x.
 class EtaEstimate {
  public:
+  enum class Trend { kSteady, kSlowing, kSpeedingUp, kStalled };
+
   /// fraction in [0, 1] at `elapsed_s` since the job started; returns the ETA in seconds, or -1
-  /// while less than 0.5 % of the pass is done (too little to extrapolate) or when finished.
+  /// while less than 0.5 % of the pass is done (too little to extrapolate), when nothing moved
+  /// recently (trend kStalled) or when finished.
   double Observe(double fraction, double elapsed_s) {
     if (!started_ || fraction < last_fraction_) {
       started_ = true;
       pass_start_s_ = elapsed_s;
       pass_start_fraction_ = fraction;
+      samples_.clear();
     }
     last_fraction_ = fraction;
+    if (samples_.empty() || elapsed_s - samples_.back().t >= kSampleSpacingS) {
+      samples_.push_back({elapsed_s, fraction});
+    }
+    trend_ = Trend::kSteady;
     const double done = fraction - pass_start_fraction_;
     if (done <= 0.005 || fraction >= 1.0) return -1.0;
-    return (elapsed_s - pass_start_s_) * (1.0 - fraction) / done;
+    const double pass_s = elapsed_s - pass_start_s_;
+    const double average_rate = done / pass_s;
+    const double window = std::max(kMinRecentS, kRecentShare * pass_s);
+    while (samples_.size() > 1 && samples_[1].t <= elapsed_s - window) samples_.pop_front();
+    const Sample& then = samples_.front();
+    double rate = average_rate;
+    if (elapsed_s > then.t) {
+      const double recent_rate = (fraction - then.f) / (elapsed_s - then.t);
+      if (recent_rate <= 0.0) {
+        trend_ = Trend::kStalled;
+        return -1.0;
+      }
+      if (recent_rate < 0.5 * average_rate) trend_ = Trend::kSlowing;
+      if (recent_rate > 2.0 * average_rate) trend_ = Trend::kSpeedingUp;
+      rate = std::min(rate, recent_rate);
+    }
+    return (1.0 - fraction) / rate;
   }
+  /// How the recent rate compares with the average at the last Observe.
+  Trend trend() const { return trend_; }
 
  private:
+  struct Sample {
+    double t, f;
+  };
+  static constexpr double kRecentShare = 0.2;      ///< Of the pass's elapsed time.
+  static constexpr double kMinRecentS = 5.0;       ///< Shortest recent window.
+  static constexpr double kSampleSpacingS = 0.05;  ///< Samples kept at most this often.
   bool started_ = false;
   double pass_start_s_ = 0.0, pass_start_fraction_ = 0.0, last_fraction_ = 0.0;
+  std::deque<Sample> samples_;
+  Trend trend_ = Trend::kSteady;
 };
 
 class ProgressLine {
@@ -50,7 +88,20 @@ class ProgressLine {
     const double since_last = seconds(last_, now);
     if (since_last < (tty_ ? 0.2 : 10.0) && fraction < 1.0) return;
     last_ = now;
-    const std::string eta = eta_s >= 0.0 ? format_seconds(eta_s) : "?";
+    std::string eta = eta_s >= 0.0 ? format_seconds(eta_s) : "?";
+    switch (eta_.trend()) {
+      case EtaEstimate::Trend::kSlowing:
+        eta += " (slowing down: at the recent rate)";
+        break;
+      case EtaEstimate::Trend::kSpeedingUp:
+        eta += " (speeding up)";
+        break;
+      case EtaEstimate::Trend::kStalled:
+        eta += " (no progress lately)";
+        break;
+      case EtaEstimate::Trend::kSteady:
+        break;
+    }
     std::fprintf(stderr, "%s[%s] %5.1f %%  elapsed %s  eta %s%s", tty_ ? "\r" : "", stage.c_str(),
                  100.0 * fraction, format_seconds(seconds(start_, now)).c_str(), eta.c_str(),
                  tty_ ? "   " : "\n");
