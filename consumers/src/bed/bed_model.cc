@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include "bed/builtin_models.h"
+#include "draglab/core/machine.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
@@ -44,6 +45,32 @@ std::string joined_keys(const Registry& r) {
   std::string out;
   for (const auto& [key, model] : r.models) out += (out.empty() ? "" : ", ") + key;
   return out;
+}
+
+/// Memory of a bed model's grid per cell, the largest measured (`/usr/bin/time -f %M` of
+/// `scene run` on tfm_bubble.toml at 30 x 120 and 60 x 240 cells: 27.0 and 46.0 MB, 1.8 kB per
+/// cell for the two-fluid model's fields and implicit systems; the DBM's emulsion measured below
+/// 1 kB per cell), rounded up.
+constexpr double kGridBytesPerCell = 2048.0;
+/// Share of the machine's memory a run may plan to take.
+constexpr double kMemoryShare = 0.8;
+
+/// The grid's memory against the machine, before any work: a grid that cannot fit is bad input
+/// naming [grid] (it would otherwise allocate for a while and die in std::bad_alloc).
+void check_grid_memory(const Scene& scene) {
+  const double cells = static_cast<double>(scene.grid.cells_x) * scene.grid.cells_y *
+                       (scene.solver == "dbm" ? scene.grid.cells_z : 1);
+  const double bytes = kGridBytesPerCell * cells;
+  const double memory = core::physical_memory_bytes();
+  if (memory <= 0.0 || bytes <= kMemoryShare * memory) return;
+  throw Error(ErrorCode::kInvalidArgument,
+              "[grid] " + core::format_number(cells) + " cells (cells_x x cells_y" +
+                  (scene.solver == "dbm" ? " x cells_z" : "") + ") need about " +
+                  core::format_number(bytes / 1073741824.0, 3) + " GiB, more than " +
+                  core::format_number(100.0 * kMemoryShare, 2) + " % of this machine's " +
+                  core::format_number(memory / 1073741824.0, 3) +
+                  " GiB: use fewer cells (at most about " +
+                  core::format_number(kMemoryShare * memory / kGridBytesPerCell, 3) + ")");
 }
 
 }  // namespace
@@ -117,6 +144,7 @@ BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
                       " s given for the run (--duration, in place of [time] duration_s): " + why);
     }
   }
+  check_grid_memory(scene);
   return find_bed_model(scene.solver).Run(scene, std::move(law), options, progress, start);
 }
 
