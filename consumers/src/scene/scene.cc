@@ -569,6 +569,13 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
       }
     }
   });
+  // Tables every model needs: named as missing, not through a default value the user never
+  // wrote ("width_m = 0").
+  for (const char* required : {"geometry", "particles"}) {
+    if (std::find(s.tables.begin(), s.tables.end(), required) == s.tables.end()) {
+      bad(origin + ": the [" + required + "] table is missing (docs/scenes.md lists its keys)");
+    }
+  }
   std::string error;
   if (!s.IsValid(&error)) bad(origin + ": " + error);
   return s;
