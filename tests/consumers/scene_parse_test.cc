@@ -218,7 +218,7 @@ TEST(SceneParse, EveryBadInputIsNamed) {
              {"[geometry] width_m", "number"});
   expect_bad("[scene\nname=1", {"not valid TOML"});
   expect_bad(edit(base, "particles", "diameter_m", "diameter_m = 0.0"),
-             {"[particles] diameter_m", "(0, "});
+             {"[particles] diameter_m", "[1e-06, "});
   expect_bad(edit(base, "particles", "diameter_m", "diameter_m = -2.5e-3"),
              {"[particles] diameter_m"});
   expect_bad(edit(base, "particles", "density_kg_m3", "density_kg_m3 = 0"),

@@ -617,7 +617,9 @@ bool Scene::IsValid(std::string* error) const {
     return false;
   }
   const double d = particles.diameter_m;
-  if (!in_range(d, 0.0, 0.1, true, false, "[particles] diameter_m", "m", error)) return false;
+  // From fine powders (Geldart C, tens of microns) to coarse beads; below a micron the drag laws'
+  // minimum fluidization has no root the solvers can find.
+  if (!in_range(d, 1e-6, 0.1, false, false, "[particles] diameter_m", "m", error)) return false;
   if (!in_range(particles.density_kg_m3, 0.0, 30000.0, true, false, "[particles] density_kg_m3",
                 "kg/m^3", error) ||
       !in_range(particles.restitution, 0.0, 1.0, true, false,
