@@ -6,7 +6,9 @@
 #include <map>
 #include <mutex>
 
+#include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
+#include "draglab/core/files.h"
 #include "draglab/core/machine.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
@@ -145,6 +147,12 @@ BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
     }
   }
   check_grid_memory(scene);
+  if (scene.outputs.fields || scene.outputs.particles) {
+    // Before the settling or the first step, not when the first file is due.
+    core::check_output_directory(
+        internal::scene_output_directory(scene, options.output_directory),
+        options.output_directory.empty() ? "[outputs] directory" : "the output directory");
+  }
   return find_bed_model(scene.solver).Run(scene, std::move(law), options, progress, start);
 }
 
