@@ -554,11 +554,17 @@ void check_database_path(const std::string& path, const DatabaseOptions& options
                                           (read_only ? " (a read-only open does not create it)"
                                                      : " (create_if_missing is off)"));
   }
-  if (::access(parent.c_str(), W_OK) != 0) {
-    throw Error(ErrorCode::kDatabase, "cannot create database " + in_quotes(path) + ": directory " +
-                                          in_quotes(parent) + " is not writable (" +
-                                          std::strerror(errno) + ")");
+  // A directory the database cannot be created in is bad input (an output path that cannot be
+  // written). Tried with a probe file: access() says yes to root on read-only mounts and /proc.
+  std::string probe = (parent == "/" ? std::string() : parent) + "/.draglab_db_probe_XXXXXX";
+  const int fd = ::mkstemp(probe.data());
+  if (fd < 0) {
+    throw Error(ErrorCode::kInvalidArgument, "cannot create database " + in_quotes(path) +
+                                                 ": directory " + in_quotes(parent) +
+                                                 " is not writable (" + std::strerror(errno) + ")");
   }
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 // Whether a read-only open of `path` must use SQLite's immutable=1. A read-only connection to a
