@@ -11,7 +11,11 @@ Conventions: phi solids fraction, eps = 1 - phi; Re = rho eps d u / mu with u th
 slip; F = F_d / (3 pi mu d eps u), drag only; beta = 18 mu phi eps F / d^2 [kg m^-3 s^-1];
 K = F / (1 - phi) includes the mean pressure gradient.
 
-Every failing call raises DraglabError(code, message) with the status code of draglab.h.
+Every failing call raises DraglabError(code, message) with the status code of draglab.h. An
+argument of the wrong type raises DraglabTypeError and one of the wrong shape DraglabValueError:
+both are DraglabError (code INVALID_ARGUMENT) and also the built-in TypeError / ValueError, and
+both name the argument. Numbers must be real: complex values, strings, None and bools are refused,
+never converted. F_array broadcasts numpy inputs like numpy and returns the broadcast shape.
 No compiler is needed: only the shared library. It is found from the environment variable
 DRAGLAB_LIBRARY (a path to libdraglab), else next to this file, else in the libdir of the
 installed draglab's pkg-config file (`pkg-config --variable=libdir draglab`, so
@@ -22,13 +26,15 @@ ctypes.util.find_library("draglab"). Installable with `pip install ./drag_db/pyt
 import ctypes
 import ctypes.util
 import glob
+import numbers
 import os
+import re as _re
 import subprocess
 import sys
 from array import array
 
 __all__ = [
-    "DraglabError", "Database", "Law", "version", "library_path",
+    "DraglabError", "DraglabTypeError", "DraglabValueError", "Database", "Law", "version", "library_path",
     "OK", "INVALID_ARGUMENT", "OUT_OF_VALIDITY", "NOT_FOUND", "IMMUTABLE", "DATABASE_ERROR",
     "SCHEMA_TOO_NEW", "NOT_A_DATABASE", "INTERNAL",
     "RANGE_ERROR", "RANGE_CLAMP", "RANGE_EXTRAPOLATE",
@@ -60,6 +66,49 @@ class DraglabError(Exception):
         super().__init__("draglab error %d: %s" % (code, message))
         self.code = code
         self.message = message
+
+
+class DraglabTypeError(DraglabError, TypeError):
+    """An argument of the wrong type (named in the message); code INVALID_ARGUMENT."""
+
+    def __init__(self, message):
+        super().__init__(INVALID_ARGUMENT, message)
+
+
+class DraglabValueError(DraglabError, ValueError):
+    """Arguments of incompatible shapes or lengths (named in the message); code
+    INVALID_ARGUMENT."""
+
+    def __init__(self, message):
+        super().__init__(INVALID_ARGUMENT, message)
+
+
+def _describe(value):
+    """How a refused argument is shown: its type and a short repr."""
+    text = repr(value)
+    if len(text) > 40:
+        text = text[:37] + "..."
+    return "%s %s" % (type(value).__name__, text) if value is not None else "None"
+
+
+def _real(value, name):
+    """A real scalar argument as float; anything else raises DraglabTypeError naming `name`."""
+    if _np is not None and isinstance(value, _np.ndarray) and value.ndim == 0 \
+            and value.dtype.kind in "fiu":
+        return float(value)
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        if isinstance(value, numbers.Complex):
+            raise DraglabTypeError("%s must be a real number, got the complex %r (the imaginary "
+                                   "part is not dropped silently)" % (name, value))
+        raise DraglabTypeError("%s must be a real number, got %s" % (name, _describe(value)))
+    return float(value)
+
+
+def _text_argument(value, name, example):
+    if not isinstance(value, str):
+        raise DraglabTypeError("%s must be a str such as %s, got %s"
+                               % (name, example, _describe(value)))
+    return value
 
 
 # ---- locating and loading the library --------------------------------------------------------
@@ -182,19 +231,35 @@ except ImportError:  # pragma: no cover - depends on the interpreter
     _np = None
 
 
+def _real_ndarray(values, name):
+    """A numpy array of float64 from array-like `values` of real numbers (any shape)."""
+    data = _np.asarray(values)
+    if data.dtype.kind == "c":
+        raise DraglabTypeError("%s must be real, got a complex array (the imaginary part is not "
+                               "dropped silently)" % name)
+    if data.dtype.kind not in "fiu":
+        raise DraglabTypeError("%s must be an array of real numbers, got dtype %s"
+                               % (name, data.dtype))
+    return data.astype(_np.float64, copy=False)
+
+
 def _as_double_buffer(values, name):
-    """(ctypes pointer, keep-alive object, length) for a sequence of floats, without copying
+    """(ctypes pointer, keep-alive object, length) for a flat sequence of reals, without copying
     numpy float64 arrays or array('d') objects."""
     if _np is not None and isinstance(values, _np.ndarray):
-        contiguous = _np.ascontiguousarray(values, dtype=_np.float64)
+        contiguous = _np.ascontiguousarray(_real_ndarray(values, name)).reshape(-1)
         return contiguous.ctypes.data_as(_c_double_p), contiguous, contiguous.size
     if isinstance(values, array) and values.typecode == "d":
         address, length = values.buffer_info()
         return ctypes.cast(address, _c_double_p), values, length
+    if isinstance(values, (str, bytes)):
+        raise DraglabTypeError("%s must be a sequence of real numbers, got %s"
+                               % (name, _describe(values)))
     try:
         data = array("d", values)
     except TypeError:
-        raise TypeError("%s must be a sequence of numbers" % name) from None
+        raise DraglabTypeError("%s must be a flat sequence of real numbers (a numpy array for "
+                               "more dimensions), got %s" % (name, _describe(values))) from None
     address, length = data.buffer_info()
     return ctypes.cast(address, _c_double_p), data, length
 
@@ -215,6 +280,9 @@ class Database:
     def __init__(self, path=None, read_only=False):
         self._handle = None
         handle = _db_p()
+        if path is not None and not isinstance(path, (str, bytes, os.PathLike)):
+            raise DraglabTypeError("path must be a str, bytes or os.PathLike (or None for the "
+                                   "default database), got %s" % _describe(path))
         encoded = None if path is None else os.fsencode(path)
         opener = _db_open_readonly if read_only else _db_open
         _check(opener(encoded, ctypes.byref(handle)))
@@ -225,6 +293,7 @@ class Database:
         not need the database afterwards. range_policy: "error" (default), "clamp" or
         "extrapolate". A retracted version loads with .warning set."""
         self._require_open()
+        _text_argument(reference, "reference", "'bvk2007@1'")
         handle = _law_p()
         _check(_law_load(self._handle, reference.encode("utf-8"), ctypes.byref(handle)))
         law = Law(handle, warning=_message())
@@ -309,6 +378,10 @@ class Law:
                 raise DraglabError(INVALID_ARGUMENT, "range policy '%s' is not one of: %s"
                                    % (policy, ", ".join(_POLICY_NAMES)))
             policy = _POLICY_NAMES[policy]
+        elif isinstance(policy, bool) or not isinstance(policy, numbers.Integral):
+            raise DraglabTypeError("range_policy must be one of %s (or RANGE_ERROR, RANGE_CLAMP, "
+                                   "RANGE_EXTRAPOLATE), got %s"
+                                   % (", ".join(_POLICY_NAMES), _describe(policy)))
         _check(_law_set_range_policy(self._live(), int(policy)))
 
     @property
@@ -322,9 +395,12 @@ class Law:
     def F(self, phi, re, extra=None):
         """Canonical drag-only F(phi, Re), dimensionless."""
         out = ctypes.c_double()
+        phi, re = _real(phi, "phi"), _real(re, "re")
         if extra is None:
             _check(_law_F(self._live(), phi, re, ctypes.byref(out)))
         else:
+            if isinstance(extra, numbers.Number):
+                extra = [_real(extra, "extra")]
             pointer, keep, length = _as_double_buffer(extra, "extra")
             if length < self.num_extra:
                 raise DraglabError(INVALID_ARGUMENT, "%s needs %d extra input(s), got %d"
@@ -334,33 +410,71 @@ class Law:
         return out.value
 
     def F_array(self, phi, re):
-        """F over arrays in one call. Returns a numpy array for numpy input, else an
-        array('d'). On error raises DraglabError naming the first bad index."""
+        """F over arrays in one call. numpy input (either argument): broadcast like numpy, a
+        numpy array of the broadcast shape returned. Otherwise flat sequences of equal length
+        (or one of them a scalar), an array('d') returned. On a bad value raises DraglabError
+        naming the first bad index (and its place in the broadcast shape)."""
+        if _np is not None and (isinstance(phi, _np.ndarray) or isinstance(re, _np.ndarray)):
+            return self._F_ndarray(phi, re)
+        if isinstance(phi, numbers.Number) and not isinstance(re, numbers.Number):
+            phi = [_real(phi, "phi")] * len(self._sized(re, "re"))
+        elif isinstance(re, numbers.Number) and not isinstance(phi, numbers.Number):
+            re = [_real(re, "re")] * len(self._sized(phi, "phi"))
         phi_pointer, phi_keep, n = _as_double_buffer(phi, "phi")
         re_pointer, re_keep, n_re = _as_double_buffer(re, "re")
         if n != n_re:
-            raise DraglabError(INVALID_ARGUMENT, "phi and re have different lengths (%d, %d)"
-                               % (n, n_re))
-        if _np is not None and isinstance(phi, _np.ndarray):
-            out = _np.empty(n, dtype=_np.float64)
-            out_pointer = out.ctypes.data_as(_c_double_p)
-        else:
-            out = array("d", bytes(8 * n))
-            out_pointer = ctypes.cast(out.buffer_info()[0], _c_double_p) if n else None
+            raise DraglabValueError("phi and re have different lengths (%d, %d)" % (n, n_re))
+        out = array("d", bytes(8 * n))
+        out_pointer = ctypes.cast(out.buffer_info()[0], _c_double_p) if n else None
         _check(_law_F_n(self._live(), n, phi_pointer if n else None, re_pointer if n else None,
                         out_pointer))
         del phi_keep, re_keep
         return out
 
+    @staticmethod
+    def _sized(values, name):
+        try:
+            len(values)
+        except TypeError:
+            raise DraglabTypeError("%s must be a real number or a sequence of them, got %s"
+                                   % (name, _describe(values))) from None
+        return values
+
+    def _F_ndarray(self, phi, re):
+        phi_array, re_array = _real_ndarray(phi, "phi"), _real_ndarray(re, "re")
+        try:
+            phi_b, re_b = _np.broadcast_arrays(phi_array, re_array)
+        except ValueError:
+            raise DraglabValueError("phi of shape %s and re of shape %s do not broadcast together "
+                                    "(numpy's rules)" % (phi_array.shape, re_array.shape)) from None
+        shape = phi_b.shape
+        phi_flat = _np.ascontiguousarray(phi_b).reshape(-1)
+        re_flat = _np.ascontiguousarray(re_b).reshape(-1)
+        out = _np.empty(shape, dtype=_np.float64)
+        n = phi_flat.size
+        status = _law_F_n(self._live(), n, phi_flat.ctypes.data_as(_c_double_p) if n else None,
+                          re_flat.ctypes.data_as(_c_double_p) if n else None,
+                          out.ctypes.data_as(_c_double_p) if n else None)
+        if status != OK:
+            message = _message()
+            found = _re.search(r"index (\d+)", message)
+            if found and len(shape) > 1:
+                place = tuple(int(i) for i in _np.unravel_index(int(found.group(1)), shape))
+                message += " (element %s of the broadcast shape %s)" % (place, shape)
+            raise DraglabError(status, message)
+        return out
+
     def K(self, phi, re):
         """K = F / (1 - phi): total force including the mean pressure gradient part."""
         out = ctypes.c_double()
+        phi, re = _real(phi, "phi"), _real(re, "re")
         _check(_law_K(self._live(), phi, re, ctypes.byref(out)))
         return out.value
 
     def beta_d2_over_mu(self, phi, re):
         """beta d^2 / mu = 18 phi (1 - phi) F."""
         out = ctypes.c_double()
+        phi, re = _real(phi, "phi"), _real(re, "re")
         _check(_law_beta_d2_over_mu(self._live(), phi, re, ctypes.byref(out)))
         return out.value
 
@@ -369,19 +483,25 @@ class Law:
         fraction, gas viscosity [Pa s], gas density [kg/m^3], interstitial slip [m/s], particle
         diameter [m], particle density [kg/m^3] (must be > 0; unused)."""
         out = ctypes.c_double()
+        eps_g, mu_g, rho_g, slip, d_p, rho_s = (
+            _real(v, n) for v, n in ((eps_g, "eps_g"), (mu_g, "mu_g"), (rho_g, "rho_g"),
+                                     (slip, "slip"), (d_p, "d_p"), (rho_s, "rho_s")))
         _check(_law_beta(self._live(), eps_g, mu_g, rho_g, slip, d_p, rho_s, ctypes.byref(out)))
         return out.value
 
     def dga(self, eps_g, mu_g, rho_g, slip, d_p, rho_s=1.0):
         """MFiX's lDgA = beta / phi = 18 mu_g eps_g F / d_p^2 [kg m^-3 s^-1]."""
         out = ctypes.c_double()
+        eps_g, mu_g, rho_g, slip, d_p, rho_s = (
+            _real(v, n) for v, n in ((eps_g, "eps_g"), (mu_g, "mu_g"), (rho_g, "rho_g"),
+                                     (slip, "slip"), (d_p, "d_p"), (rho_s, "rho_s")))
         _check(_law_dga(self._live(), eps_g, mu_g, rho_g, slip, d_p, rho_s, ctypes.byref(out)))
         return out.value
 
     def export(self, format="c"):
         """Standalone source of this law version: format "c", "fortran" or "json"."""
         length = ctypes.c_size_t()
-        encoded = format.encode("utf-8")
+        encoded = _text_argument(format, "format", "'c', 'fortran' or 'json'").encode("utf-8")
         _check(_law_export(self._live(), encoded, None, 0, ctypes.byref(length)))
         buffer = ctypes.create_string_buffer(length.value + 1)
         _check(_law_export(self._live(), encoded, buffer, length.value + 1, ctypes.byref(length)))

@@ -6,12 +6,14 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <set>
 
 #include <ceres/ceres.h>
 #include <fmt/core.h>
+#include <glog/logging.h>
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
@@ -195,6 +197,15 @@ struct SolveOutcome {
   std::vector<double> covariance_z;  ///< num_free^2, row-major (if requested and ok).
 };
 
+/// Ceres reports a rank-deficient covariance through glog ("E... covariance_impl.cc] Error:
+/// Covariance matrix is near rank deficient"), a line a user cannot act on: the fit reports the
+/// parameters the data leave undetermined itself (undetermined_parameters). Only FATAL records
+/// (Ceres' own check failures, which abort) are kept. Set once: glog's flag is a process global.
+void silence_ceres_log() {
+  static std::once_flag once;
+  std::call_once(once, [] { FLAGS_minloglevel = google::GLOG_FATAL; });
+}
+
 /// Ceres Levenberg-Marquardt from z (updated in place); covariance of z if asked.
 SolveOutcome solve_lsq(const Model& m, const std::vector<FitPoint>& points, RobustLoss loss,
                        double loss_scale, std::vector<double>& z, bool want_covariance) {
@@ -223,6 +234,7 @@ SolveOutcome solve_lsq(const Model& m, const std::vector<FitPoint>& points, Robu
   out.brief = summary.BriefReport();
   out.message = summary.message;
   if (want_covariance && out.converged) {
+    silence_ceres_log();
     ceres::Covariance::Options cov_options;
     cov_options.algorithm_type = ceres::DENSE_SVD;
     cov_options.num_threads = 1;

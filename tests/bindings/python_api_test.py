@@ -11,6 +11,11 @@ Read-only opens: a database file 0444 in a directory 0555 is read without being 
 modification time and bytes unchanged); run as root (which ignores permissions), the check is
 repeated as nobody through `setpriv --reuid=65534 --regid=65534 --clear-groups`.
 
+Wrong arguments (bad-input findings P13, P16, P17, P20, P21, P25): a wrong type raises TypeError
+and a wrong shape ValueError (both also DraglabError), naming the argument; never a ctypes or
+AttributeError, never a silently dropped imaginary part; numpy shapes are kept (broadcast like
+numpy), each element equal to the scalar F at the same inputs.
+
 Environment: DRAGLAB_PYTHON_DIR (folder of draglab.py) and DRAGLAB_LIBRARY (path of libdraglab).
 Runs with the standard library only; numpy is exercised if it can be imported.
 """
@@ -141,6 +146,74 @@ class PythonApiTest(unittest.TestCase):
         self.assertIsInstance(out, numpy.ndarray)
         for i in range(11):
             self.assertEqual(out[i], self.law.F(float(phi[i]), float(re[i])))
+
+    def test_wrong_argument_types_name_the_argument(self):
+        cases = [
+            (lambda: self.law.F("0.3", 10.0), "phi"),
+            (lambda: self.law.F(None, 10.0), "phi"),
+            (lambda: self.law.F(0.3, [10.0]), "re"),
+            (lambda: self.law.F(0.3, 10 + 0j), "re"),
+            (lambda: self.law.F(True, 10.0), "phi"),
+            (lambda: self.law.K(0.3, "10"), "re"),
+            (lambda: self.law.beta_d2_over_mu(object(), 10.0), "phi"),
+            (lambda: self.law.beta("0.6", 1.8e-5, 1.2, 0.5, 5e-4), "eps_g"),
+            (lambda: self.law.dga(0.6, 1.8e-5, 1.2, 0.5, None), "d_p"),
+            (lambda: self.db.load(None), "reference"),
+            (lambda: self.db.load(b"bvk2007"), "reference"),
+            (lambda: draglab.Database(3), "path"),
+            (lambda: setattr(self.law, "range_policy", 1.5), "range_policy"),
+            (lambda: self.law.export(None), "format"),
+            (lambda: self.law.F_array("0.3", [1.0]), "phi"),
+            (lambda: self.law.F_array([0.3], None), "re"),
+            (lambda: self.law.F_array([[0.3]], [1.0]), "phi"),
+            (lambda: self.law.F_array([0.3, 1j], [1.0, 2.0]), "phi"),
+        ]
+        for call, name in cases:
+            with self.assertRaises(TypeError) as caught:
+                call()
+            self.assertIsInstance(caught.exception, draglab.DraglabError)
+            self.assertEqual(caught.exception.code, draglab.INVALID_ARGUMENT)
+            self.assertIn(name, caught.exception.message)
+        # Every real type is taken: ints, fractions, the array module, numpy scalars.
+        import fractions
+        self.assertEqual(self.law.F(fractions.Fraction(3, 10), 10), self.law.F(0.3, 10.0))
+
+    def test_list_shapes(self):
+        with self.assertRaises(ValueError) as caught:
+            self.law.F_array([0.3, 0.3], [1.0])
+        self.assertIn("lengths", caught.exception.message)
+        # A scalar against a sequence is repeated.
+        out = self.law.F_array(0.3, [1.0, 10.0])
+        self.assertEqual(list(out), [self.law.F(0.3, 1.0), self.law.F(0.3, 10.0)])
+
+    @unittest.skipIf(numpy is None, "numpy is not installed")
+    def test_numpy_shapes_and_types(self):
+        phi = numpy.array([[0.1, 0.2], [0.3, 0.4]])
+        re = numpy.array([0.0, 100.0])
+        out = self.law.F_array(phi, re)  # broadcast: (2, 2) against (2,)
+        self.assertEqual(out.shape, (2, 2))
+        for i in range(2):
+            for j in range(2):
+                self.assertEqual(out[i, j], self.law.F(phi[i, j], re[j]))
+        self.assertEqual(self.law.F_array(numpy.float64(0.3), numpy.array(10.0)).shape, ())
+        self.assertEqual(self.law.F_array(phi.T, 50.0).shape, (2, 2))  # non-contiguous
+        self.assertEqual(self.law.F_array(numpy.zeros((0, 3)) + 0.3, 1.0).shape, (0, 3))
+        with self.assertRaises(ValueError) as caught:
+            self.law.F_array(phi, numpy.array([1.0, 2.0, 3.0]))
+        self.assertIn("(2, 2)", caught.exception.message)
+        self.assertIn("(3,)", caught.exception.message)
+        with self.assertRaises(TypeError) as caught:
+            self.law.F_array(numpy.array([0.3 + 0.1j]), numpy.array([1.0]))
+        self.assertIn("complex", caught.exception.message)
+        with self.assertRaises(TypeError):
+            self.law.F_array(numpy.array(["0.3"]), numpy.array([1.0]))
+        with self.assertRaises(TypeError):
+            self.law.F(numpy.complex128(0.3), 1.0)
+        self.assertEqual(self.law.F(numpy.float32(0.25), numpy.int64(10)), self.law.F(0.25, 10.0))
+        bad = numpy.array([[0.3, 0.3], [0.3, numpy.nan]])
+        with self.assertRaises(draglab.DraglabError) as caught:
+            self.law.F_array(bad, 1.0)
+        self.assertIn("(1, 1)", caught.exception.message)
 
     def test_unknown_law(self):
         with self.assertRaises(draglab.DraglabError) as caught:

@@ -745,14 +745,15 @@ class DatabaseReadOnly : public ::testing::Test {
     const double F = db.load("site_law")->F(0.3, 50.0);
     if (F != expected_F_) fail("site_law F(0.3, 50) = " + std::to_string(F));  // same bits
     if (!db.check().ok) fail("check(): " + db.check().BriefReport());
-    if (error_of([&] { db.add_draft(bvk_record("new_law")); }).code() != ErrorCode::kDatabase) {
-      fail("add_draft was not refused with kDatabase");
+    if (error_of([&] { db.add_draft(bvk_record("new_law")); }).code() !=
+        ErrorCode::kInvalidArgument) {
+      fail("add_draft was not refused as bad input (kInvalidArgument)");
     }
-    if (error_of([&] { db.migrate(); }).code() != ErrorCode::kDatabase) {
-      fail("migrate was not refused with kDatabase");
+    if (error_of([&] { db.migrate(); }).code() != ErrorCode::kInvalidArgument) {
+      fail("migrate was not refused as bad input (kInvalidArgument)");
     }
-    if (error_of([&] { db.seed_literature(); }).code() != ErrorCode::kDatabase) {
-      fail("seed_literature was not refused with kDatabase");
+    if (error_of([&] { db.seed_literature(); }).code() != ErrorCode::kInvalidArgument) {
+      fail("seed_literature was not refused as bad input (kInvalidArgument)");
     }
     return failures;
   }

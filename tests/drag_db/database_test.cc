@@ -590,8 +590,16 @@ TEST(DatabaseOptionsAndPaths, ReadOnlyOpenReadsButRefusesWrites) {
   Database db(path, ro);
   EXPECT_EQ(db.resolve("ro").version, 1);
   EXPECT_NO_THROW(db.load("ro@1"));
-  EXPECT_EQ(code_of([&] { db.add_draft(bvk_record("ro")); }), ErrorCode::kDatabase);
-  EXPECT_EQ(code_of([&] { db.migrate(); }), ErrorCode::kDatabase);
+  // A change on a read-only open is bad input, and the message says what gives write access.
+  EXPECT_EQ(code_of([&] { db.add_draft(bvk_record("ro")); }), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(code_of([&] { db.migrate(); }), ErrorCode::kInvalidArgument);
+  try {
+    db.add_draft(bvk_record("ro"));
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("write permission on the file and on its directory"),
+              std::string::npos)
+        << e.what();
+  }
   EXPECT_EQ(code_of([&] { Database missing(dir.file("missing.db"), ro); }), ErrorCode::kNotFound);
   EXPECT_FALSE(fs::exists(dir.file("missing.db")));
 }

@@ -778,10 +778,19 @@ void require_schema(sqlite3* db, int minimum, const std::string& what) {
   }
 }
 
+// A change asked of a database that this process can only read is bad input, like an output
+// path that cannot be written; the remedy names what the user controls (the permissions), since
+// the command line opens a database it cannot write read-only by itself.
 void require_writable(sqlite3* db) {
   if (sqlite3_db_readonly(db, "main") == 1) {
-    throw Error(ErrorCode::kDatabase, "database " + in_quotes(db::database_path(db)) +
-                                          " is open read-only; open it read-write to change it");
+    const std::string path = db::database_path(db);
+    throw Error(ErrorCode::kInvalidArgument,
+                "database " + in_quotes(path) +
+                    " is open read-only, so it cannot be changed: changing it needs write "
+                    "permission on the file and on its directory " +
+                    in_quotes(parent_directory(path)) +
+                    " (SQLite keeps its -wal and -shm files there), and a read-write open (C "
+                    "API: draglab_db_open, not draglab_db_open_readonly)");
   }
 }
 
