@@ -54,6 +54,7 @@ struct SolverOptions {
   std::string collision = "trt";
   std::string boundary = "ibb";
   std::string wall_interpolation = "auto";
+  std::string rr_wall_correction = "on";
   std::string precision = "double";
   double tau = 0.0;
   double magic = 3.0 / 16.0;
@@ -149,6 +150,7 @@ lbm::RunOptions run_options(const SolverOptions& s) {
   r.collision = lbm::collision_from_string(s.collision);
   r.boundary = lbm::boundary_from_string(s.boundary);
   r.interpolation = lbm::wall_interpolation_from_string(s.wall_interpolation);
+  r.rr_wall_correction = s.rr_wall_correction == "on";
   r.precision = lbm::precision_from_string(s.precision);
   r.re = s.re;
   r.tau = s.tau;
@@ -670,6 +672,12 @@ void add_solver_options(CLI::App* cmd, SolverOptions* s, bool with_re) {
                   "linear) or bfl (Bouzidi linear)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "cli", "bfl"}));
+  cmd->add_option("--rr-wall-correction", s->rr_wall_correction,
+                  "rr with interpolated walls: correct the reflected values to TRT's wall at "
+                  "--magic (on), or not (off: only to compare; rr's own wall sits about half a "
+                  "node off near tau = 1/2)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--precision", s->precision, "double, or float (shifted populations)")
       ->capture_default_str()
       ->check(CLI::IsMember({"double", "float"}));

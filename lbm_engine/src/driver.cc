@@ -390,6 +390,17 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   settings.omega_minus = 1.0 / tau_minus;
   settings.force_x = force;
   settings.interpolated = interpolated;
+  // rr's odd moments relax with omega = 1: the reflected values are corrected to TRT's wall at
+  // Lambda = magic where rr's effective Lambda, (tau - 1/2)/2, is the smaller (lbm.h, Numerics).
+  const double wall_correction = 2.0 * options.magic / (tau - 0.5) - 1.0;
+  if (options.collision == Collision::kRegularized && interpolated && options.rr_wall_correction &&
+      wall_correction > 0.0) {
+    settings.wall_correction = wall_correction;
+    result.wall_corrected = true;
+    result.wall_reason +=
+        std::string(result.wall_reason.empty() ? "" : "; ") +
+        "rr: reflected values corrected to TRT's wall at Lambda = " + fmt("%g", options.magic);
+  }
   std::unique_ptr<SparseLattice> lattice_storage;
   std::unique_ptr<LinkTable> links_storage;
   std::unique_ptr<SolverBase> solver;
@@ -407,10 +418,11 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     // on one node share its memory).
     const double ranks_here = ranks_on_this_node(group);
     const double needed =
-        ranks_here * (static_cast<double>(d3q19::kQ) * static_cast<double>(element) *
-                          static_cast<double>(lattice.stride()) +
-                      static_cast<double>(lattice.memory_bytes()) +
-                      48.0 * static_cast<double>(grid.num_links()) / group.size());
+        ranks_here *
+        (static_cast<double>(d3q19::kQ) * static_cast<double>(element) *
+             static_cast<double>(lattice.stride()) +
+         static_cast<double>(lattice.memory_bytes()) +
+         80.0 * static_cast<double>(grid.num_links()) / group.size());  // link table + state
     const double available = machine_memory_bytes();
     if (available > 0.0 && needed > 0.9 * available) {
       throw Error(ErrorCode::kInvalidArgument,

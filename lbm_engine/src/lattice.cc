@@ -418,10 +418,10 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, WallScheme w
     bool fallback = false;
     wall_weights(wall, link.q, r2 >= 0, &weight_a, &weight_b, &fallback);
     if (fallback) ++table.fallback_links;
-    // Unused positions point at the link's own value (read with a zero weight, or not at all).
-    const bool interpolates = weight_a != 0.0 || weight_b != 0.0;
-    const std::int64_t a = interpolates && r2 >= 0 ? qb * stride_ + r2 : self;
-    const std::int64_t b = interpolates ? q * stride_ + r : self;
+    // Without a node behind, a points at the link's own value (read with a zero weight). Both
+    // positions are kept where the weights are zero too: rr's wall correction reads them.
+    const std::int64_t a = r2 >= 0 ? qb * stride_ + r2 : self;
+    const std::int64_t b = q * stride_ + r;
     table.self.push_back(self);
     table.a.push_back(a);
     table.b.push_back(b);
@@ -431,6 +431,20 @@ LinkTable SparseLattice::build_links(const arrays::VoxelGrid& grid, WallScheme w
     table.node.push_back(link.node);
     table.body.push_back(link.body);
     table.direction.push_back(static_cast<std::uint8_t>(q));
+  }
+  // Partners: a node's links are contiguous.
+  table.partner.assign(total, -1);
+  for (std::size_t begin = 0; begin < total;) {
+    std::size_t end = begin;
+    while (end < total && table.node[end] == table.node[begin]) ++end;
+    for (std::size_t l = begin; l < end; ++l) {
+      for (std::size_t m = begin; m < end; ++m) {
+        if (table.direction[m] == kOpposite[table.direction[l]]) {
+          table.partner[l] = static_cast<std::int64_t>(m);
+        }
+      }
+    }
+    begin = end;
   }
   // Per-row ranges (links are sorted by stored index, which rows partition).
   const std::int64_t rows = num_rows();

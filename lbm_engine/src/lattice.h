@@ -99,6 +99,9 @@ struct LinkTable {
   std::vector<std::int32_t> node;  ///< Fluid index r (row 0 at r holds its rest population).
   std::vector<std::int32_t> body;  ///< Body (sphere) the link belongs to.
   std::vector<std::uint8_t> direction;
+  /// The link of the same node along the opposite direction (both ends of the lattice line
+  /// through the node are walls: a one-node gap), or -1.
+  std::vector<std::int64_t> partner;
   std::size_t bodies = 0;
   std::int64_t fallback_links = 0;  ///< Interpolated links that fell back to bounce-back.
   /// Links of x-row r (of the lattice that built the table): [row_begin[r], row_begin[r+1]).
@@ -109,7 +112,7 @@ struct LinkTable {
   /// links of one node: chunk p is [result[p], result[p+1]).
   std::vector<std::int64_t> chunks(int parts) const;
   std::size_t memory_bytes() const {
-    return size() * (4 * sizeof(std::int64_t) + 2 * sizeof(double) + 2 * sizeof(std::int32_t) + 1);
+    return size() * (5 * sizeof(std::int64_t) + 2 * sizeof(double) + 2 * sizeof(std::int32_t) + 1);
   }
 };
 

@@ -267,6 +267,7 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"collision", to_string(o.collision)},
                       {"boundary", to_string(o.boundary)},
                       {"wall", wall},
+                      {"wall_corrected", wall_corrected},
                       {"pore_speed_ratio", pore_speed_ratio},
                       {"pore_speed_ratio_measured", pore_speed_ratio_measured},
                       {"mach_target", mach_target},

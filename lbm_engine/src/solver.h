@@ -11,7 +11,9 @@
 // fluid node r along c_i into a solid node, with wall fraction q, the value that comes back into r
 // along c_ib (ib = opp(i)) at the next step is, with post-collision values f* of this step,
 //   f_ib(r, t+1) = f + a (f*_i(r - c_i) - f) + b (f*_ib(r) - f),   f = f*_i(r),
-// with the weights a, b of the wall scheme (lattice.h, wall_weights). The central one, a = kappa,
+// with the weights a, b of the wall scheme (lattice.h, wall_weights), plus, with the regularized
+// collision, the wall correction of lbm.h (Numerics; SolverSettings::wall_correction). The
+// central one, a = kappa,
 // b = -kappa, kappa = (1 - 2q)/(1 + 2q), is
 // Ginzburg's central linear interpolation (CLI; Ginzburg & d'Humieres 2003, Ginzburg et al. 2008,
 // Khirevich et al. 2015). It is exact for a linear profile at the wall, reduces to halfway
@@ -64,6 +66,9 @@ struct SolverSettings {
   bool interpolated = true;
   /// Feed the interpolation's net mass leak back (off only to compare schemes in tests).
   bool mass_correction = true;
+  /// Regularized collision: coefficient 2 Lambda / (tau - 1/2) - 1 of the wall correction that
+  /// gives the reflected values TRT's wall at Lambda (lbm.h, Numerics); 0 = off.
+  double wall_correction = 0.0;
 };
 
 class SolverBase {
