@@ -1,6 +1,8 @@
 // RAII helpers over the SQLite C API (sqlite_util.h).
 #include "db/sqlite_util.h"
 
+#include <cerrno>
+#include <cstring>
 #include <ctime>
 
 namespace draglab {
@@ -41,6 +43,23 @@ void throw_sqlite_error(sqlite3* db, int rc, const std::string& context) {
   if (primary == SQLITE_READONLY) {
     throw Error(ErrorCode::kDatabase,
                 "database '" + path + "' is read-only (" + message + ") while " + context);
+  }
+  if (primary == SQLITE_IOERR || primary == SQLITE_FULL) {
+    // SQLite says only "disk I/O error" or "database or disk is full"; the system error, where
+    // SQLite kept one, says why. A write that stops short keeps none (errno 0).
+    const int os_error = db ? sqlite3_system_errno(db) : 0;
+    const int extended = db ? sqlite3_extended_errcode(db) : rc;
+    const bool write_failed = primary == SQLITE_FULL || os_error == ENOSPC || os_error == EFBIG ||
+                              os_error == EDQUOT || extended == SQLITE_IOERR_WRITE ||
+                              extended == SQLITE_IOERR_FSYNC || extended == SQLITE_IOERR_TRUNCATE ||
+                              extended == SQLITE_IOERR_SHMSIZE;
+    throw Error(ErrorCode::kDatabase,
+                "cannot write database '" + path + "' while " + context + ": " + message +
+                    (os_error != 0 ? " (" + std::string(std::strerror(os_error)) + ")" : "") +
+                    (write_failed ? "; a write failed, most often because the disk, a quota "
+                                    "or a file size limit is full: free space and run again (the "
+                                    "unfinished change was rolled back: nothing of it is stored)"
+                                  : ""));
   }
   throw Error(ErrorCode::kDatabase,
               "SQLite error while " + context + " in '" + path + "': " + message);
