@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include "draglab/core/files.h"
 #include "draglab/core/toml_schema.h"
 #include "draglab/lbm/lbm.h"
 
@@ -325,13 +326,7 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
 }
 
 CampaignSpec parse_campaign_spec(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw Error(ErrorCode::kInvalidArgument, "campaign spec '" + path + "' cannot be read");
-  }
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_campaign_spec_text(text.str(), path);
+  return parse_campaign_spec_text(core::read_text_input(path, "campaign spec"), path);
 }
 
 }  // namespace campaign

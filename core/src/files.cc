@@ -10,7 +10,9 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <mutex>
+#include <sstream>
 
 #include "draglab/drag_db/error.h"
 
@@ -122,6 +124,62 @@ bool is_path_error(int error) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Offset of the first byte that is not part of valid UTF-8 text (or a NUL), or npos.
+std::size_t first_non_text_byte(const std::string& text) {
+  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n;) {
+    const unsigned char c = p[i];
+    if (c == 0) return i;
+    const int extra = c < 0x80           ? 0
+                      : (c >> 5) == 0x6  ? 1
+                      : (c >> 4) == 0xe  ? 2
+                      : (c >> 3) == 0x1e ? 3
+                                         : -1;
+    if (extra < 0 || i + static_cast<std::size_t>(extra) >= n + (extra == 0 ? 1 : 0)) return i;
+    for (int k = 1; k <= extra; ++k) {
+      if ((p[i + static_cast<std::size_t>(k)] >> 6) != 0x2) return i;
+    }
+    i += static_cast<std::size_t>(extra) + 1;
+  }
+  return std::string::npos;
+}
+
+}  // namespace
+
+std::string read_text_input(const std::string& path, const std::string& what) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    const int error = errno;
+    throw Error(error == ENOENT ? ErrorCode::kNotFound : ErrorCode::kInvalidArgument,
+                what + " " + quoted(path) + " cannot be read: " + std::strerror(error));
+  }
+  if (S_ISDIR(st.st_mode)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                what + " " + quoted(path) + " is a directory, not a file");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw Error(ErrorCode::kInvalidArgument,
+                what + " " + quoted(path) + " cannot be read: " + std::strerror(errno));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string content = text.str();
+  if (content.find_first_not_of(" \t\r\n") == std::string::npos) {
+    throw Error(ErrorCode::kInvalidArgument, what + " " + quoted(path) + " is empty");
+  }
+  const std::size_t bad = first_non_text_byte(content);
+  if (bad != std::string::npos) {
+    throw Error(ErrorCode::kInvalidArgument,
+                what + " " + quoted(path) + " is not a text file (byte " + std::to_string(bad) +
+                    " is " + (content[bad] == 0 ? "a NUL" : "not UTF-8") + ")");
+  }
+  return content;
+}
 
 bool file_exists(const std::string& path) {
   struct stat st {};

@@ -221,6 +221,48 @@ TEST(CoreFiles, InMemoryHdf5FileSavesWholeOrNotAtAll) {
   EXPECT_EQ(dir.entries(), 1u);
 }
 
+// An input file is checked as what it is before a parser sees it: a directory, an empty file, a
+// NUL byte and bytes that are not UTF-8 are named (not reported as a missing key), valid UTF-8
+// (2-, 3- and 4-byte sequences) passes, a missing file is kNotFound.
+TEST(ReadTextInput, NamesWhatTheFileIs) {
+  TempDir dir;
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir.file(name), std::ios::binary) << text;
+    return dir.file(name);
+  };
+  auto message = [](const std::function<void()>& f, ErrorCode expected) {
+    try {
+      f();
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), expected) << e.what();
+      return std::string(e.what());
+    }
+    ADD_FAILURE() << "no error";
+    return std::string();
+  };
+  const std::string text = "[scene]\nname = \"\xc2\xb5m \xe2\x80\x94 \xf0\x9f\x98\x80\"\n";
+  EXPECT_EQ(read_text_input(write("ok.toml", text), "scene file"), text);
+  const auto bad = ErrorCode::kInvalidArgument;
+  EXPECT_NE(message([&] { read_text_input(dir.path(), "scene file"); }, bad)
+                .find("is a directory, not a file"),
+            std::string::npos);
+  EXPECT_NE(
+      message([&] { read_text_input(write("e.toml", " \n\t\n"), "spec"); }, bad).find("spec '"),
+      std::string::npos);
+  EXPECT_NE(message([&] { read_text_input(write("e2.toml", ""), "spec"); }, bad).find("is empty"),
+            std::string::npos);
+  EXPECT_NE(message([&] { read_text_input(write("n.toml", std::string("a\0b", 3)), "spec"); }, bad)
+                .find("byte 1 is a NUL"),
+            std::string::npos);
+  EXPECT_NE(message([&] { read_text_input(write("l.toml", "caf\xe9\n"), "spec"); }, bad)
+                .find("byte 3 is not UTF-8"),
+            std::string::npos);
+  EXPECT_NE(message([&] { read_text_input(write("t.toml", "ok\xe2\x80"), "spec"); }, bad)
+                .find("byte 2 is not UTF-8"),
+            std::string::npos);  // a sequence cut short by the end of the file
+  message([&] { read_text_input(dir.file("missing.toml"), "spec"); }, ErrorCode::kNotFound);
+}
+
 }  // namespace
 }  // namespace core
 }  // namespace draglab

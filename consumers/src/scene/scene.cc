@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/core/toml_schema.h"
 
@@ -582,11 +583,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
 }
 
 Scene load_scene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorCode::kNotFound, "scene file '" + path + "' cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), path);
+  return parse_scene(core::read_text_input(path, "scene file"), path);
 }
 
 bool Scene::IsValid(std::string* error) const {

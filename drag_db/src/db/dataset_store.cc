@@ -2,6 +2,7 @@
 // form. A dataset's identity is the SHA-256 of the canonical JSON of its points; the row holds
 // the same JSON, so what is loaded is byte for byte what was hashed.
 #include <sqlite3.h>
+#include <sys/stat.h>
 
 #include <cerrno>
 #include <cmath>
@@ -293,11 +294,29 @@ std::vector<std::string> split(const std::string& line, char separator) {
 }  // namespace
 
 Dataset read_dataset_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "dataset file '" + path + "' is a directory, not a file");
+  }
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
     throw Error(ErrorCode::kInvalidArgument,
                 "dataset file '" + path + "' cannot be read: " + std::strerror(errno));
   }
+  std::ostringstream whole;
+  whole << file.rdbuf();
+  const std::string text = whole.str();
+  // A binary file is named as such, not echoed back through "unknown column '...'" messages.
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && c != '\t' && c != '\r' && c != '\n') {
+      throw Error(ErrorCode::kInvalidArgument, "dataset file '" + path +
+                                                   "' is not a text file (byte " +
+                                                   std::to_string(i) + " is a control character)");
+    }
+  }
+  std::istringstream in(text);
   std::string line;
   int line_number = 0;
   std::vector<std::string> header;

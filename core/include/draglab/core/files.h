@@ -16,6 +16,12 @@
 namespace draglab {
 namespace core {
 
+/// The whole text of an input file the user named, checked as what it is: a missing file
+/// (kNotFound), a directory, an empty file (only white space) or a file that is not text (a NUL
+/// byte, or bytes that are not UTF-8) is refused (kInvalidArgument) naming `what` (e.g. "scene
+/// file") and the path, never passed on to a parser that would report a missing key instead.
+std::string read_text_input(const std::string& path, const std::string& what);
+
 /// Whether `path` is a regular file (after symbolic links).
 bool file_exists(const std::string& path);
 /// Whether `path` is a directory (after symbolic links).
