@@ -137,6 +137,22 @@ int main(int argc, char** argv) {
                 << "; draglab --help)\n";
       return 2;
     }
+    // The same one level down, for the command groups that need a subcommand (law, lbm, ...).
+    CLI::App* group = app.get_subcommand(arg);
+    if (group->get_require_subcommand_min() > 0 && i + 1 < argc && argv[i + 1][0] != '-') {
+      const std::string word = argv[i + 1];
+      std::string subcommands;
+      bool found = false;
+      for (const CLI::App* sub : group->get_subcommands([](CLI::App*) { return true; })) {
+        found = found || sub->get_name() == word;
+        subcommands += (subcommands.empty() ? "" : ", ") + sub->get_name();
+      }
+      if (!found) {
+        std::cerr << "error: unknown " << arg << " subcommand '" << word
+                  << "' (subcommands: " << subcommands << "; draglab " << arg << " --help)\n";
+        return 2;
+      }
+    }
     break;
   }
 
