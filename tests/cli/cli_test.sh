@@ -198,8 +198,9 @@ if [ "$(id -u)" -ne 0 ] || [ ${#as_user[@]} -gt 0 ]; then
   check "read-only directory: eval" 0 "${as_user[@]}" "$draglab" --db "$shared/shared.db" law eval bvk2007 --phi 0.4 --re 100 --json
   json_check "read-only directory: value" "abs(j['F'] - 30.7416) / 30.7416 < 2e-6"
   [ "$(grep -c 'opened read-only' "$work/err")" -eq 1 ] || { echo "FAIL: read-only note not said once"; failures=$((failures + 1)); }
-  check "read-only directory: change refused" 1 "${as_user[@]}" "$draglab" --db "$shared/shared.db" law retract ergun@1 --reason "read-only test"
-  grep -q "read-only" "$work/err" || { echo "FAIL: read-only change message"; failures=$((failures + 1)); }
+  # Bad input (bad-input finding B22): exit 2, naming the permission the change needs.
+  check "read-only directory: change refused" 2 "${as_user[@]}" "$draglab" --db "$shared/shared.db" law retract ergun@1 --reason "read-only test"
+  grep -q "read-only, so it cannot be changed: changing it needs write permission on the file and on its directory" "$work/err" || { echo "FAIL: read-only change message"; failures=$((failures + 1)); }
 fi
 chmod 755 "$shared"
 rm -rf "$shared"
