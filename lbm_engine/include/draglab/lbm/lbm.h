@@ -47,7 +47,8 @@
 // al. 2002 with the interpolated value), averaged over the two steps of an AA pair.
 // Regularized collision (rr): its odd non-equilibrium is dropped at every collision (odd moments
 // relax with omega = 1, an effective Lambda = (tau - 1/2)/2 that goes to 0 as tau -> 1/2), so
-// the same link closures put the wall about half a node off (+66 % on a phi 0.6 packing at d 16).
+// the same link closures put the wall about half a node off (docs/validation.md, "rr with TRT's
+// wall").
 // RunOptions::rr_wall_correction adds to each reflected value the difference between the
 // closures' steady residuals under TRT at Lambda = magic and under rr, which a link-wise analysis
 // gives as c (n- + g/2): n- the pre-collision odd non-equilibrium of the link pair at the wall
