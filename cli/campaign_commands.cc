@@ -137,8 +137,11 @@ struct PlanCommand {
 void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
   const campaign::CampaignSpec spec = campaign::parse_campaign_spec(resolve_spec_path(c.spec));
   if (c.jobs < 0 || c.jobs > 1024) throw UsageError("--jobs must be in [0, 1024] (0 = all cores)");
-  if (!std::isfinite(c.node_update_ns) || c.node_update_ns < 0.0) {
-    throw UsageError("--node-update-ns must be >= 0 (0 = measure on this machine)");
+  if (!std::isfinite(c.node_update_ns) || c.node_update_ns < 0.0 || c.node_update_ns > 1e6) {
+    throw UsageError(fmt::format(
+        "--node-update-ns = {} is outside [0, 1e+06] ns per fluid-node update (0 = measure on "
+        "this machine)",
+        format_number(c.node_update_ns)));
   }
   const int jobs =
       c.jobs > 0 ? c.jobs : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
@@ -151,6 +154,7 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                         {"re", p.re},
                         {"resolution", p.resolution},
                         {"units", p.units},
+                        {"collision", p.collision},
                         {"fluid_nodes", p.fluid_nodes},
                         {"steps", p.steps},
                         {"unit_seconds", p.unit_seconds},
@@ -186,7 +190,7 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
 }
 
 void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
-  if (c.jobs < 0) throw UsageError("--jobs must be >= 0 (0 = all cores)");
+  if (c.jobs < 0 || c.jobs > 1024) throw UsageError("--jobs must be in [0, 1024] (0 = all cores)");
   if (!(c.worker_timeout_s >= 1.0 && c.worker_timeout_s <= 86400.0)) {
     throw UsageError("--worker-timeout must be in [1, 86400] seconds");
   }

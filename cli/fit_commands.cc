@@ -38,6 +38,10 @@ struct FitArgs {
   std::string publish;
 };
 
+/// Larger than any coefficient of a drag law's form: beyond it a --set value is a typing error
+/// (and the fit's arithmetic overflows).
+constexpr double kMaxCoefficient = 1e6;
+
 std::vector<std::pair<std::string, double>> parse_assignments(const std::string& text) {
   std::vector<std::pair<std::string, double>> out;
   if (text.empty()) return out;
@@ -52,7 +56,11 @@ std::vector<std::pair<std::string, double>> parse_assignments(const std::string&
     }
     const std::vector<double> value =
         core::parse_number_list(item.substr(eq + 1), "--set " + item.substr(0, eq));
-    if (!std::isfinite(value[0])) throw UsageError("--set " + item + ": value must be finite");
+    if (!std::isfinite(value[0]) || std::abs(value[0]) > kMaxCoefficient) {
+      throw UsageError(fmt::format("--set {}: {} is outside [-{:g}, {:g}] (a law coefficient)",
+                                   item.substr(0, eq), item.substr(eq + 1), kMaxCoefficient,
+                                   kMaxCoefficient));
+    }
     out.push_back({item.substr(0, eq), value[0]});
     if (comma == std::string::npos) break;
     start = comma + 1;
@@ -176,6 +184,16 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
   }
 
   LawRecord stored;
+  if (publishing && fit.constraints_checked && !fit.constraints_satisfied) {
+    // A law that breaks the physics it must obey (F > 0, ...) is not stored, not even as a draft.
+    throw std::runtime_error(
+        "--publish " + args.publish +
+        ": nothing stored: the fitted law violates its constraints (" + fit.constraint_report +
+        ")" +
+        (args.set.empty() ? std::string()
+                          : "; the values fixed by --set " + args.set + " may be the cause") +
+        "; free more parameters, fix them at other values (--set), or fit more data");
+  }
   if (publishing) {
     if (args.dataset_id.empty()) {
       // The CSV's points become a stored (immutable, deduplicated) dataset so that the law's

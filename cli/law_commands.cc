@@ -79,6 +79,9 @@ nlohmann::json grid_point_json(const Law& law, double phi, double re,
 }
 
 /// Physical range of the inputs, checked before anything is opened or printed.
+/// Far beyond any gas-solid bed (and every law's fitted range): a larger Re is a typing error.
+constexpr double kMaxParticleReynolds = 1e7;
+
 void check_physical_inputs(const std::vector<double>& phis, const std::vector<double>& res,
                            const std::string& phi_field, const std::string& re_field) {
   for (double phi : phis) {
@@ -88,8 +91,9 @@ void check_physical_inputs(const std::vector<double>& phis, const std::vector<do
     }
   }
   for (double re : res) {
-    if (!std::isfinite(re) || re < 0.0) {
-      throw UsageError(fmt::format("{} = {} must be finite and >= 0", re_field, re));
+    if (!std::isfinite(re) || re < 0.0 || re > kMaxParticleReynolds) {
+      throw UsageError(fmt::format("{} = {} is outside [0, {:g}] (particle Reynolds number)",
+                                   re_field, re, kMaxParticleReynolds));
     }
   }
 }
@@ -481,7 +485,7 @@ void add_law_commands(CLI::App& app, CliContext& ctx) {
     cmd->add_option("law", o->ref, "NAME[@VERSION]")->required();
     cmd->add_option("--phi", o->phi, "Solids volume fraction phi = 1 - eps, in [0, 1)")
         ->each([o](const std::string&) { o->phi_given = true; });
-    cmd->add_option("--re", o->re, "Reynolds number rho eps d u/mu (u interstitial), >= 0")
+    cmd->add_option("--re", o->re, "Reynolds number rho eps d u/mu (u interstitial), [0, 1e7]")
         ->each([o](const std::string&) { o->re_given = true; });
     cmd->add_option("--y", o->extra,
                     "Extra inputs of polydisperse forms: size ratio y = d_i/<d> (Sauter mean)");

@@ -38,7 +38,9 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 using workflows::number_or_null;
-constexpr double kMaxRe = 1000.0;  // the range; beyond it the Mach budget needs d > 80
+constexpr int kMaxThreads = 1024;       // as campaign run --threads-per-unit
+constexpr double kMaxReferenceF = 1e6;  // far above any drag F of a fixed bed
+constexpr double kMaxRe = 1000.0;       // the range; beyond it the Mach budget needs d > 80
 
 /// Which geometry: a packing file or an ordered array.
 struct CaseOptions {
@@ -68,12 +70,20 @@ struct SolverOptions {
   double min_gap_nodes = 0.0;  // opt-in gap check; 0 = run sub-node gaps and report them
 };
 
+/// lbm run's solver settings: the operator chosen per run (resolution.h, choose_collision).
+SolverOptions auto_collision() {
+  SolverOptions s;
+  s.collision = "auto";
+  return s;
+}
+
 struct RunCommand {
   CaseOptions case_options;
-  SolverOptions solver;
+  SolverOptions solver = auto_collision();
   double d = kNaN;
   std::string fields;
   double d_hydro = 0.0;
+  bool d_hydro_given = false;
   bool calibrate = false;
 };
 
@@ -167,7 +177,10 @@ lbm::RunOptions run_options(const SolverOptions& s) {
         fmt::format("--min-gap-nodes = {} is outside [0, 100] (0 = no check)", s.min_gap_nodes));
   }
   if (s.max_steps < 1) throw UsageError("--max-steps must be >= 1");
-  if (s.threads < 0) throw UsageError("--threads must be >= 0 (0 = all)");
+  if (s.threads < 0 || s.threads > kMaxThreads) {
+    throw UsageError(
+        fmt::format("--threads = {} is outside [0, {}] (0 = all)", s.threads, kMaxThreads));
+  }
   std::string error;
   if (!r.IsValid(&error)) throw UsageError(error);
   return r;
@@ -203,6 +216,18 @@ void on_every_rank(const mpi::Communicator& group, const std::function<void()>& 
     if (!group.is_root()) throw mpi::EndedByRank0(code);
     if (code == 2) throw UsageError(o.substr(1));
     throw std::runtime_error(o.substr(1));
+  }
+}
+
+/// The calibration runs: one that does not converge is a run-time failure (exit 1), as in lbm
+/// run; bad options stay bad input.
+lbm::CalibrationResult calibrate(const lbm::CalibrationOptions& co,
+                                 const lbm::ProgressCallback& progress) {
+  try {
+    return lbm::calibrate_hydrodynamic_diameter(co, progress);
+  } catch (const Error& e) {
+    if (e.code() == ErrorCode::kOutOfValidity) throw std::runtime_error(e.what());
+    throw;
   }
 }
 
@@ -242,10 +267,10 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     the_case = load_case(c.case_options);
     lbm::check_run_size(the_case.packing, c.d, options, "--d");
     if (!c.fields.empty() && root) core::check_output_file(c.fields, "--fields");
-    if (c.d_hydro != 0.0 && c.calibrate) {
+    if (c.d_hydro_given && c.calibrate) {
       throw UsageError("give --d-hydro or --calibrate, not both");
     }
-    if (c.d_hydro != 0.0) {
+    if (c.d_hydro_given) {
       if (!std::isfinite(c.d_hydro) || c.d_hydro < 0.5 * c.d || c.d_hydro > 1.5 * c.d) {
         throw UsageError(fmt::format("--d-hydro = {} is outside [0.5 d, 1.5 d] = [{}, {}]",
                                      c.d_hydro, 0.5 * c.d, 1.5 * c.d));
@@ -270,12 +295,14 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     lbm::CalibrationOptions co;
     co.diameter = c.d;
     co.run = options;
-    const lbm::CalibrationResult cal =
-        lbm::calibrate_hydrodynamic_diameter(co, report("lbm calibrate"));
+    // The run's own operator (auto chooses it from the run's phi, Re and d).
+    co.run.collision =
+        lbm::choose_collision(the_case.packing.phi(), options.re, c.d, options.collision).collision;
+    const lbm::CalibrationResult cal = calibrate(co, report("lbm calibrate"));
     progress.finish();
     if (root)
       ctx.info(fmt::format("calibration: d_h/d = {:.5f} ({} at d = {:.4g}, {:.1f} s)", cal.ratio,
-                           lbm::Scheme{options.collision, options.boundary}.name(), cal.diameter,
+                           lbm::Scheme{co.run.collision, options.boundary}.name(), cal.diameter,
                            cal.wall_s));
     calibration_json = {{"d_h_over_d", cal.ratio},
                         {"phi", cal.calibration.phi},
@@ -285,7 +312,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
                         {"wall_s", cal.wall_s}};
     options.use_hydrodynamic_diameter = true;
     options.hydrodynamic_diameter = cal.ratio * c.d;
-  } else if (c.d_hydro != 0.0) {
+  } else if (c.d_hydro_given) {
     options.use_hydrodynamic_diameter = true;
     options.hydrodynamic_diameter = c.d_hydro;
   }
@@ -378,9 +405,13 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
                              options.use_hydrodynamic_diameter
                                  ? fmt::format(" (d_h = {:.4g})", options.hydrodynamic_diameter)
                                  : "");
-    std::cout << fmt::format(
-        "scheme           {} + {}, {}, tau = {:.4g}{}\n", lbm::to_string(options.collision), r.wall,
-        lbm::to_string(options.precision), r.tau, options.re == 0.0 ? " (Stokes mode)" : "");
+    std::cout << fmt::format("scheme           {} + {}, {}, tau = {:.4g}{}\n",
+                             lbm::to_string(r.collision), r.wall, lbm::to_string(options.precision),
+                             r.tau, options.re == 0.0 ? " (Stokes mode)" : "");
+    if (!r.collision_reason.empty()) {
+      std::cout << fmt::format("collision        auto -> {}: {}\n", lbm::to_string(r.collision),
+                               r.collision_reason);
+    }
     if (!r.wall_reason.empty()) {
       std::cout << fmt::format("wall             {}: {}\n", r.wall, r.wall_reason);
     }
@@ -440,7 +471,10 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
 }
 
 void run_bench(const CliContext& ctx, const BenchCommand& b) {
-  if (b.threads < 0) throw UsageError("--threads must be >= 0 (0 = all)");
+  if (b.threads < 0 || b.threads > kMaxThreads) {
+    throw UsageError(
+        fmt::format("--threads = {} is outside [0, {}] (0 = all)", b.threads, kMaxThreads));
+  }
   if (b.repeat < 1 || b.repeat > 100) throw UsageError("--repeat must lie in [1, 100]");
   ctx.info(
       "lbm bench: all-fluid box, phi = 0.4 packing, the blocks-8 geometry and in-place bandwidth "
@@ -507,8 +541,9 @@ void run_convergence_command(const CliContext& ctx, const ConvergenceCommand& c)
     }
   }
   if (!std::isnan(c.reference)) {
-    if (!std::isfinite(c.reference) || c.reference <= 0.0) {
-      throw UsageError("--reference must be a finite F > 0");
+    if (!std::isfinite(c.reference) || c.reference <= 0.0 || c.reference > kMaxReferenceF) {
+      throw UsageError(fmt::format("--reference = {} is outside (0, {:g}] (a drag F)",
+                                   format_number(c.reference), kMaxReferenceF));
     }
     co.reference_F = c.reference;
   }
@@ -604,7 +639,7 @@ void run_calibrate(const CliContext& ctx, const CalibrateCommand& c) {
   std::string error;
   if (!co.IsValid(&error)) throw UsageError(error);
   ProgressLine progress(!ctx.quiet);
-  const lbm::CalibrationResult r = lbm::calibrate_hydrodynamic_diameter(
+  const lbm::CalibrationResult r = calibrate(
       co, [&progress](double f, const std::string&) { progress.update(f, "lbm calibrate"); });
   progress.finish();
   const lbm::Scheme scheme{co.run.collision, co.run.boundary};
@@ -659,10 +694,19 @@ void add_solver_options(CLI::App* cmd, SolverOptions* s, bool with_re) {
                     "Target Reynolds number U d/nu (superficial), [0, 1000]; 0 = "
                     "Stokes flow (linear equilibrium)");
   }
-  cmd->add_option("--collision", s->collision,
-                  "Collision: bgk (seed baseline), trt, rr (regularized, robust at high Re)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"bgk", "trt", "rr"}));
+  if (s->collision == "auto") {
+    cmd->add_option("--collision", s->collision,
+                    "Collision: auto (trt where kappa Re/d is within what it holds, rr with "
+                    "TRT's wall beyond; the result says which and why), bgk (seed baseline), "
+                    "trt, rr (regularized, robust at high Re)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"auto", "bgk", "trt", "rr"}));
+  } else {
+    cmd->add_option("--collision", s->collision,
+                    "Collision: bgk (seed baseline), trt, rr (regularized, robust at high Re)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"bgk", "trt", "rr"}));
+  }
   cmd->add_option("--boundary", s->boundary,
                   "Wall: bb (halfway bounce-back) or ibb (interpolated bounce-back with q)")
       ->capture_default_str()
@@ -738,7 +782,8 @@ void add_lbm_commands(CLI::App& app, CliContext& ctx) {
                   "for ParaView");
   run->add_option("--d-hydro", rc->d_hydro,
                   "Normalise with this hydrodynamic diameter (lattice units; draglab lbm "
-                  "calibrate)");
+                  "calibrate), [0.5 d, 1.5 d]")
+      ->each([rc](const std::string&) { rc->d_hydro_given = true; });
   run->add_flag("--calibrate", rc->calibrate,
                 "Calibrate d_h first (dilute SC array, same d, scheme and tau) and normalise "
                 "with it");

@@ -13,9 +13,13 @@
 //   draglab lbm run --array sc --phi 0.125 --d 16 --re 0 --json
 #include <unistd.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <regex>
 
 #include <fmt/core.h>
 
@@ -60,6 +64,43 @@ void CliContext::warn(const std::string& message) const {
 }
 
 void CliContext::print_json(const nlohmann::json& j) const { std::cout << j.dump(2) << '\n'; }
+
+/// Every number option of `app` and its subcommands names a word, NaN or an infinity as what it
+/// is, before its own range check: a range check would call "abc" out of range, and options whose
+/// "not given" is NaN would read a typed NaN as missing.
+void require_finite_numbers(CLI::App* app) {
+  for (CLI::Option* option : app->get_options()) {
+    const std::string type = option->get_type_name();
+    if (type.rfind("FLOAT", 0) != 0 && type.rfind("INT", 0) != 0 && type.rfind("UINT", 0) != 0) {
+      continue;
+    }
+    // The allowed range, where the option's help gives one ("..., [4, 512]").
+    const std::string help = option->get_description();
+    std::smatch range;
+    const std::string allowed =
+        std::regex_search(
+            help, range,
+            std::regex(R"([\[(]\s*-?[0-9.][0-9.eE+^-]*\s*,\s*-?[0-9.][-0-9.eE+^ ]*[\])])"))
+            ? " (allowed: " + range.str() + ")"
+            : std::string();
+    option->transform(CLI::Validator(
+        [allowed](std::string& text) -> std::string {
+          errno = 0;
+          char* end = nullptr;
+          const double x = std::strtod(text.c_str(), &end);
+          if (text.empty() || end == text.c_str() || *end != '\0') {
+            return "'" + text + "' is not a number" + allowed;
+          }
+          if (std::isnan(x)) return text + " is not a number (NaN)" + allowed;
+          if (std::isinf(x)) return text + " is not a finite number" + allowed;
+          return std::string();
+        },
+        ""));
+  }
+  for (CLI::App* sub : app->get_subcommands([](CLI::App*) { return true; })) {
+    require_finite_numbers(sub);
+  }
+}
 
 }  // namespace cli
 }  // namespace draglab
@@ -117,6 +158,7 @@ int main(int argc, char** argv) {
   draglab::cli::add_scene_commands(app, ctx);
   draglab::cli::add_sensitivity_commands(app, ctx);
   draglab::cli::add_regress_commands(app, ctx);
+  draglab::cli::require_finite_numbers(&app);
 
   // CLI11 answers a mistyped command with "A subcommand is required": name it instead.
   for (int i = 1; i < argc; ++i) {
@@ -165,7 +207,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);  // prints the message and the usage hint
+    std::cerr << "error: " << e.what() << "\nRun with --help for more information.\n";
     return 2;
   }
 

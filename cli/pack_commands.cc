@@ -27,6 +27,7 @@ struct PackOptions {
   // random
   double phi = std::nan("");
   bool phi_given = false;
+  bool n_given = false;
   int n = 0;
   std::string dist = "mono";
   double size_ratio = 2.0;
@@ -114,8 +115,7 @@ void print_statistics(const arrays::Packing& p, const arrays::PackingStatistics&
 void check_phi_given(const PackOptions& o) {
   if (!o.phi_given) throw UsageError("--phi is required");
   if (!std::isfinite(o.phi)) {
-    throw UsageError("--phi: '" + std::to_string(o.phi) +
-                     "' is not a finite number (random packings: (0, 0.64])");
+    throw UsageError("--phi: '" + std::to_string(o.phi) + "' is not a finite number");
   }
 }
 
@@ -130,7 +130,7 @@ arrays::Packing generate(const PackOptions& o, const CliContext& ctx,
     if (!oo.IsValid(&error)) throw UsageError(with_option_names(error));
     return arrays::generate_ordered_packing(oo);
   }
-  if (o.n == 0) throw UsageError("--n is required for random packings (or use --ordered)");
+  if (!o.n_given) throw UsageError("--n is required for random packings (or use --ordered)");
   const arrays::RandomPackingOptions r = random_options(o);
   ProgressLine progress(!ctx.quiet);
   arrays::Packing p = arrays::generate_random_packing(
@@ -274,7 +274,9 @@ void add_pack_commands(CLI::App& app, CliContext& ctx) {
                     "Solids fraction: random (0, 0.64], ordered up to close "
                     "packing")
         ->each([o](const std::string&) { o->phi_given = true; });
-    cmd->add_option("--n", o->n, "Number of spheres (random), >= 1");
+    cmd->add_option("--n", o->n, "Number of spheres (random), >= 1")->each([o](const std::string&) {
+      o->n_given = true;
+    });
     cmd->add_option("--dist", o->dist, "Size distribution: mono, bi or lognormal")
         ->capture_default_str()
         ->check(CLI::IsMember({"mono", "bi", "lognormal"}));

@@ -236,6 +236,12 @@ void add_scene_commands(CLI::App& app, CliContext& ctx) {
   auto* scene = app.add_subcommand(
       "scene", "Fluidized-bed scenes (TOML, docs/scenes.md): minimum fluidization, checks");
   scene->require_subcommand(1);
+  scene->footer(
+      "Examples:\n"
+      "  draglab scene check data/scenes/dpm_bubble_quick.toml\n"
+      "  draglab scene umf data/scenes/dpm_bubble_quick.toml\n"
+      "  draglab scene run data/scenes/dpm_bubble_quick.toml --law gidaspow@1\n"
+      "Scene format: docs/scenes.md.");
 
   auto umf_args = std::make_shared<SceneArgs>();
   auto* umf = scene->add_subcommand(

@@ -273,6 +273,9 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
         if (!(v > 0.0 && std::isfinite(v)))
           throw UsageError(fmt::format("{}: {} is not a positive number ({}, {})", flag,
                                        format_number(v), step.description, step.range));
+        if (v >= 1e9)  // far beyond every model's range, and beyond an int on the way there
+          throw UsageError(fmt::format("{}: {} is outside {} ({})", flag, format_number(v),
+                                       step.range, step.description));
         wp.time_resolutions.push_back(v);
       }
     }

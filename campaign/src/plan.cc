@@ -84,6 +84,7 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
     for (double re : spec.re) {
       for (double d : spec.resolutions) {
         PlannedPoint p;
+        p.collision = lbm::to_string(lbm::choose_collision(phi, re, d, collision).collision);
         p.phi = phi;
         p.re = re;
         p.resolution = d;
@@ -153,19 +154,20 @@ std::string CampaignPlan::BriefReport() const {
 
 std::string CampaignPlan::FullReport() const {
   std::ostringstream out;
-  out << "phi     Re      d      units  fluid nodes  steps     unit time   memory/unit  d needed  "
-         "resolution\n";
+  out << "phi     Re      d      units  collision  fluid nodes  steps     unit time   memory/unit  "
+         "d needed  resolution\n";
   for (const PlannedPoint& p : points) {
-    char line[200];
-    std::snprintf(line, sizeof line,
-                  "%-7.3g %-7.4g %-6.4g %-6d %-12.3g %-9.3g %-11s %-12s %-9.3g %s\n", p.phi, p.re,
-                  p.resolution, p.units, p.fluid_nodes, p.steps, duration(p.unit_seconds).c_str(),
-                  format("%.2g GiB", p.memory_bytes / 1073741824.0).c_str(), p.d_needed,
-                  p.resolution_verdict.c_str());
+    char line[220];
+    std::snprintf(
+        line, sizeof line, "%-7.3g %-7.4g %-6.4g %-6d %-10s %-12.3g %-9.3g %-11s %-12s %-9.3g %s\n",
+        p.phi, p.re, p.resolution, p.units, p.collision.c_str(), p.fluid_nodes, p.steps,
+        duration(p.unit_seconds).c_str(), format("%.2g GiB", p.memory_bytes / 1073741824.0).c_str(),
+        p.d_needed, p.resolution_verdict.c_str());
     out << line;
   }
   out << "d needed: the largest of the bounds from the pores' hydraulic diameter, the boundary "
-         "layer and the cell Reynolds number the collision holds (lbm/resolution.h)\n";
+         "layer and the cell Reynolds number the collision holds (lbm/resolution.h); collision "
+         "auto runs trt where kappa Re/d is within what trt holds, rr with TRT's wall beyond\n";
   out << "time per fluid-node update (one core, measured): "
       << format("%.3g", node_update_seconds * 1e9) << " ns\n";
   out << BriefReport() << "\n";

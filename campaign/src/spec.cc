@@ -129,8 +129,8 @@ bool CampaignSpec::IsValid(std::string* error) const {
                   "lattice units per diameter", error)) {
     return false;
   }
-  if (collision != "trt" && collision != "bgk" && collision != "rr") {
-    return fail(error, "[lbm] collision = '" + collision + "' is not one of trt, bgk, rr");
+  if (collision != "auto" && collision != "trt" && collision != "bgk" && collision != "rr") {
+    return fail(error, "[lbm] collision = '" + collision + "' is not one of auto, trt, bgk, rr");
   }
   if (boundary != "ibb" && boundary != "bb") {
     return fail(error, "[lbm] boundary = '" + boundary + "' is not one of ibb, bb");
@@ -272,7 +272,14 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
       if (v < 1 || v > 100000) bad(field + " = " + std::to_string(v) + " is outside [1, 100000]");
       s.spheres = static_cast<int>(v);
     }
-    if (id == "packing.box_size") s.box_size = number();
+    if (id == "packing.box_size") {
+      s.box_size = number();
+      // 0 stands for "not given" in the spec; typed, it is a box of no size.
+      if (!(s.box_size > 0.0)) {
+        bad(field + " = " + format_number(s.box_size) +
+            " is outside [1.5, 100] sphere diameters (or leave it out for spheres)");
+      }
+    }
     if (id == "packing.distribution") s.distribution = text();
     if (id == "packing.size_ratio") s.size_ratio = number();
     if (id == "packing.large_fraction") s.large_fraction = number();

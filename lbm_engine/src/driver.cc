@@ -298,7 +298,11 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
                 "lbm run: the voxel grid has no bodies, so there is no drag to measure");
   }
 
+  if (options.collision == Collision::kAuto) {
+    throw Error(ErrorCode::kInternal, "lbm run: the collision must be chosen before the run");
+  }
   RunResult result;
+  result.collision = options.collision;
   result.phi_lattice = grid.phi_lattice();
   result.phi = phi_exact > 0.0 ? phi_exact : result.phi_lattice;
   result.d = options.use_hydrodynamic_diameter ? options.hydrodynamic_diameter : grid.resolution();
@@ -807,7 +811,8 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   em.boundary = options.boundary;
   em.collision = options.collision;
   em.tau = tau;
-  em.magic = options.collision == Collision::kTrt   ? options.magic
+  em.wall_corrected = result.wall_corrected;
+  em.magic = options.collision == Collision::kTrt || result.wall_corrected ? options.magic
              : options.collision == Collision::kBgk ? (tau - 0.5) * (tau - 0.5)
                                                     : 0.5 * (tau - 0.5);
   em.d = grid.resolution();
@@ -846,21 +851,24 @@ RunOptions pore_speed_options(const RunOptions& options) {
 /// lattice (resolution.h).
 RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
                       Fields* fields, const ProgressCallback& progress) {
+  const double phi = phi_exact > 0.0 ? phi_exact : grid.phi_lattice();
+  const double d =
+      options.use_hydrodynamic_diameter ? options.hydrodynamic_diameter : grid.resolution();
+  const CollisionChoice choice = choose_collision(phi, options.re, d, options.collision);
   auto finish = [&](RunResult r) {
+    r.collision_reason = choice.reason;
     if (!r.converged && options.throw_on_failure) {
       throw Error(ErrorCode::kOutOfValidity, "lbm run: " + r.diagnosis);
     }
     return r;
   };
   RunOptions quiet = options;
+  quiet.collision = choice.collision;
   quiet.throw_on_failure = false;
   if (options.re == 0.0) return finish(run_impl(grid, phi_exact, quiet, fields, progress, nullptr));
-  const double phi = phi_exact > 0.0 ? phi_exact : grid.phi_lattice();
-  const double d =
-      options.use_hydrodynamic_diameter ? options.hydrodynamic_diameter : grid.resolution();
-  VelocityPlan plan = plan_velocity(phi, options.re, d, options.collision, options.mach_target, 0.0,
+  VelocityPlan plan = plan_velocity(phi, options.re, d, quiet.collision, options.mach_target, 0.0,
                                     false, options.tau);
-  std::string refusal = cell_reynolds_refusal(plan, options.re, d, options.collision);
+  std::string refusal = cell_reynolds_refusal(plan, options.re, d, quiet.collision);
   if (!refusal.empty()) throw Error(ErrorCode::kInvalidArgument, "lbm run: " + refusal);
   RunResult stokes;
   if (options.tau == 0.0) {
@@ -874,7 +882,7 @@ RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const Run
     stokes =
         run_impl(grid, phi_exact, pore_speed_options(options), nullptr, stokes_progress, nullptr);
     if (stokes.converged && stokes.final_pore_speed_ratio > 0.0) {
-      plan = plan_velocity(phi, options.re, d, options.collision, options.mach_target,
+      plan = plan_velocity(phi, options.re, d, quiet.collision, options.mach_target,
                            stokes.final_pore_speed_ratio, true);
     }
   }
@@ -888,10 +896,10 @@ RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const Run
                             "estimated from phi");
     }
   }
-  if (plan.cell_reynolds > stable_cell_reynolds(options.collision)) {
+  if (plan.cell_reynolds > stable_cell_reynolds(quiet.collision)) {
     r.warnings.push_back("cell Reynolds number kappa Re / d = " + fmt("%.3g", plan.cell_reynolds) +
-                         " is beyond " + fmt("%g", stable_cell_reynolds(options.collision)) +
-                         ", where " + to_string(options.collision) +
+                         " is beyond " + fmt("%g", stable_cell_reynolds(quiet.collision)) +
+                         ", where " + to_string(quiet.collision) +
                          " has held in every measured packing; it may diverge (at --d " +
                          fmt("%g", plan.d_stable) + " it would not)");
   }
@@ -901,6 +909,7 @@ RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const Run
 }  // namespace
 
 double predicted_steps(double phi, double re, double d, Collision collision) {
+  collision = choose_collision(phi, re, d, collision).collision;
   const double stokes_tau = collision == Collision::kTrt ? 1.5 : 1.0;
   auto steps_at = [phi, d](double tau, double re) {
     const double nu = (tau - 0.5) / 3.0;

@@ -26,6 +26,10 @@
 // was measured; the growth is this scaling argument, not a fit (the finite-Re validation showed
 // 0.67 % at Re = 100, d = 33.5 against Richardson, where the former sqrt growth for both schemes
 // estimated 0.37 %).
+// rr with TRT's wall correction (RunOptions::rr_wall_correction) keeps a wall shift of its own
+// against TRT at the same d that falls as 1/d^2 in F and does not grow with Re: an offset
+// kCorrectedWallOffset / d, not thinned: the largest offset measured on SC and random packings,
+// rounded up (docs/validation.md, "rr with TRT's wall").
 // Float storage adds kFloatError (float and double F differ by ~1e-6 on the same cases).
 #include "error_model.h"
 
@@ -40,6 +44,7 @@ constexpr double kBounceBackOffset = 0.15;
 constexpr double kInterpolatedOffset = 0.2;
 constexpr double kLambdaOffset = 0.35;
 constexpr double kBoundaryLayerRe = 10.0;
+constexpr double kCorrectedWallOffset = 0.8;
 constexpr double kFloatError = 1e-5;
 
 double vdh2005(double phi) {
@@ -69,6 +74,7 @@ double discretisation_error_estimate(const ErrorModelInput& in) {
   offset += kLambdaOffset * std::sqrt(std::abs(in.magic - 3.0 / 16.0));
   const double thinning = 1.0 + std::max(0.0, in.re) / kBoundaryLayerRe;
   offset *= in.boundary == Boundary::kHalfwayBounceBack ? std::sqrt(thinning) : thinning;
+  if (in.wall_corrected) offset += kCorrectedWallOffset / in.d;
   double error = sensitivity * 2.0 * offset / in.d;
   if (in.precision == Precision::kFloat) error += kFloatError;
   return error;

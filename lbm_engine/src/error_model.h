@@ -16,7 +16,9 @@ struct ErrorModelInput {
   Collision collision = Collision::kTrt;
   double tau = 1.0;
   double magic = 3.0 / 16.0;  ///< Lambda; (tau - 1/2)^2 for BGK, (tau - 1/2)/2 regularized.
-  double d = 16.0;            ///< Nodes per diameter (the voxelization's, not a calibrated one).
+  /// Regularized with TRT's wall correction (magic then TRT's): adds its remaining wall shift.
+  bool wall_corrected = false;
+  double d = 16.0;  ///< Nodes per diameter (the voxelization's, not a calibrated one).
   double phi = 0.1;
   double re = 0.0;
   Precision precision = Precision::kDouble;

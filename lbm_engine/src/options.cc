@@ -29,6 +29,8 @@ const char* to_string(Collision c) {
       return "trt";
     case Collision::kRegularized:
       return "rr";
+    case Collision::kAuto:
+      return "auto";
   }
   return "?";
 }
@@ -37,8 +39,9 @@ Collision collision_from_string(const std::string& s) {
   if (s == "bgk") return Collision::kBgk;
   if (s == "trt") return Collision::kTrt;
   if (s == "rr" || s == "regularized") return Collision::kRegularized;
+  if (s == "auto") return Collision::kAuto;
   throw Error(ErrorCode::kInvalidArgument,
-              "unknown collision model '" + s + "' (allowed: bgk, trt, rr)");
+              "unknown collision model '" + s + "' (allowed: auto, bgk, trt, rr)");
 }
 
 const char* to_string(Boundary b) {
@@ -101,8 +104,8 @@ bool RunOptions::IsValid(std::string* error) const {
     return false;
   };
   if (collision != Collision::kBgk && collision != Collision::kTrt &&
-      collision != Collision::kRegularized) {
-    return fail("collision: unknown model (allowed: bgk, trt, rr)");
+      collision != Collision::kRegularized && collision != Collision::kAuto) {
+    return fail("collision: unknown model (allowed: auto, bgk, trt, rr)");
   }
   if (boundary != Boundary::kHalfwayBounceBack && boundary != Boundary::kInterpolated) {
     return fail("boundary: unknown scheme (allowed: bb, ibb)");
@@ -207,6 +210,8 @@ std::string RunResult::FullReport() const {
                     "; at the end max|u|/nu = " + format("%.3g", final_cell_reynolds) + ", kappa " +
                     format("%.3g", final_pore_speed_ratio) + ")\n"
               : std::string())
+      << "collision            " << to_string(collision)
+      << (collision_reason.empty() ? std::string() : " (auto: " + collision_reason + ")") << "\n"
       << "wall                 " << wall
       << (wall_reason.empty() ? std::string() : " (" + wall_reason + ")") << "\n"
       << "body force           " << format("%.6g", body_force) << "\n"
@@ -264,7 +269,7 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"superficial_velocity", superficial_velocity},
                       {"stokes_mode", stokes_mode},
                       {"fluid_nodes", fluid_nodes},
-                      {"collision", to_string(o.collision)},
+                      {"collision", to_string(collision)},
                       {"boundary", to_string(o.boundary)},
                       {"wall", wall},
                       {"wall_corrected", wall_corrected},
@@ -290,7 +295,11 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"fallback_links", fallback_links},
                       {"boundary_links", boundary_links},
                       {"warnings", warnings}};
-  if (o.collision == Collision::kTrt) j["magic"] = o.magic;
+  if (collision == Collision::kTrt) j["magic"] = o.magic;
+  if (o.collision == Collision::kAuto) {  // a run that named its operator keeps its record
+    j["collision_requested"] = to_string(o.collision);
+    j["collision_reason"] = collision_reason;
+  }
   if (ranks > 1) j["ranks"] = ranks;  // a one-rank run's record stays as it always was
   j["d_hydrodynamic"] =
       o.use_hydrodynamic_diameter ? nlohmann::json(o.hydrodynamic_diameter) : nlohmann::json();

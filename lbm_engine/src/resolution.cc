@@ -36,6 +36,7 @@ double max_cell_reynolds(Collision collision) {
     case Collision::kTrt:
       return kTrtMaxCellReynolds;
     case Collision::kRegularized:
+    case Collision::kAuto:
       return std::numeric_limits<double>::infinity();
   }
   return kTrtMaxCellReynolds;
@@ -44,6 +45,28 @@ double max_cell_reynolds(Collision collision) {
 double stable_cell_reynolds(Collision collision) {
   return std::isfinite(max_cell_reynolds(collision)) ? kTrtStableCellReynolds
                                                      : std::numeric_limits<double>::infinity();
+}
+
+CollisionChoice choose_collision(double phi, double re, double d, Collision requested) {
+  if (requested != Collision::kAuto) return {requested, std::string()};
+  if (re <= 0.0) {
+    return {Collision::kTrt, "Stokes flow: TRT, whose wall does not move with tau at Lambda 3/16"};
+  }
+  const double kappa = estimated_pore_speed_ratio(phi);
+  const double cell_re = kappa * re / d;
+  const std::string what = "kappa Re / d = " + fmt("%.3g", kappa) + " x " + fmt("%g", re) + " / " +
+                           fmt("%.4g", d) + " = " + fmt("%.3g", cell_re);
+  if (cell_re <= kTrtStableCellReynolds) {
+    return {Collision::kTrt, what + " <= " + fmt("%g", kTrtStableCellReynolds) +
+                                 ", where TRT has held in every measured packing: TRT, whose "
+                                 "wall is exact at Lambda 3/16"};
+  }
+  return {Collision::kRegularized,
+          what + " > " + fmt("%g", kTrtStableCellReynolds) +
+              ", beyond what TRT holds in every measured packing (it would need --d " +
+              fmt("%g", std::ceil(kappa * re / kTrtStableCellReynolds)) +
+              "): rr, which holds it, with TRT's wall correction (its remaining wall error is "
+              "in error_estimate)"};
 }
 
 std::string VelocityPlan::Summary() const {
@@ -58,6 +81,7 @@ std::string VelocityPlan::Summary() const {
 
 VelocityPlan plan_velocity(double phi, double re, double d, Collision collision, double mach_target,
                            double kappa, bool kappa_measured, double tau) {
+  collision = choose_collision(phi, re, d, collision).collision;
   VelocityPlan plan;
   plan.kappa = kappa > 0.0 ? kappa : estimated_pore_speed_ratio(phi);
   plan.kappa_measured = kappa > 0.0 && kappa_measured;

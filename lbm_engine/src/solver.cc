@@ -280,6 +280,9 @@ constexpr std::int64_t kProgressRows = 64;
 /// finite Re, where the correction's feedback through the moments of a node with several wall
 /// links exceeds one.
 constexpr double kWallCorrectionRate = 0.1;
+/// The feedback grows with the correction's factor c (large as tau -> 1/2): the rate is also
+/// held to kWallCorrectionGain / c, which keeps rate x c, the filtered loop gain, bounded.
+constexpr double kWallCorrectionGain = 5.0;
 
 /// Links ahead that the link pass prefetches.
 constexpr std::int64_t kLinkPrefetch = 16;
@@ -315,8 +318,10 @@ class Solver final : public SolverBase {
     receive_down_.resize(send_down_.size());
     receive_up_.resize(send_up_.size());
     set_force(settings.force_x);
-    if (settings.interpolated && settings.wall_correction > 0.0)
+    if (settings.interpolated && settings.wall_correction > 0.0) {
       wall_state_.assign(links.size(), 0.0);
+      wall_rate_ = std::min(kWallCorrectionRate, kWallCorrectionGain / settings.wall_correction);
+    }
   }
 
   void set_force(double force_x) override {
@@ -821,7 +826,7 @@ class Solver final : public SolverBase {
   }
 
   /// The regularized collision's wall correction of link l (lbm.h, Numerics), added to the plain
-  /// closure's value k = f + a (f_a - f) + b (f_b - f): relaxed by kWallCorrectionRate per step
+  /// closure's value k = f + a (f_a - f) + b (f_b - f): relaxed by wall_rate_ per step
   /// towards its implicit steady value, which damps its feedback through the wall node's moments
   /// and leaves the steady state as it is. `update` false (a force-only pass) keeps the state.
   double wall_correction(std::int64_t l, double k, double f, double fa, double fb, const T* base,
@@ -842,7 +847,7 @@ class Solver final : public SolverBase {
       target = (k + c * (0.5 * (fa - f + fb) + g)) / (1.0 + 0.5 * c) - k;
     }
     double& state = wall_state_[static_cast<std::size_t>(l)];
-    const double next = state + kWallCorrectionRate * (target - state);
+    const double next = state + wall_rate_ * (target - state);
     if (update) state = next;
     return next;
   }
@@ -859,7 +864,8 @@ class Solver final : public SolverBase {
   std::vector<double> even_force_;
   std::vector<std::vector<double>> partial_force_;  ///< Per work range.
   std::vector<double> partial_defect_;              ///< Per work range.
-  std::vector<double> wall_state_;   ///< Per link: rr's wall correction (empty: off).
+  std::vector<double> wall_state_;  ///< Per link: rr's wall correction (empty: off).
+  double wall_rate_ = kWallCorrectionRate;
   double pending_defect_ = 0.0;      ///< Net mass added by the last interpolation pass.
   double force_magnitude_ = 0.0;     ///< See force_magnitude().
   std::int64_t boundary_nodes_ = 0;  ///< This rank's.

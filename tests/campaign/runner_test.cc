@@ -196,6 +196,7 @@ TEST(CampaignRunner, DivergingUnitIsRecordedFailedAndTheOthersComplete) {
   spec.re = {300, 0};
   spec.spheres = 8;
   spec.resolutions = {8};
+  spec.collision = "trt";  // auto would run rr there
   spec.extrapolation = "finest";
   RunCampaignOptions options;
   options.jobs = 1;

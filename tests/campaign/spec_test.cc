@@ -140,7 +140,7 @@ TEST(CampaignSpec, OtherRangesAndTypes) {
                 .find("[grid] realizations must be an integer"),
             std::string::npos);
   EXPECT_NE(parse_error(edit("collision = \"trt\"", "collision = \"mrt\""))
-                .find("[lbm] collision = 'mrt' is not one of trt, bgk, rr"),
+                .find("[lbm] collision = 'mrt' is not one of auto, trt, bgk, rr"),
             std::string::npos);
   EXPECT_NE(parse_error(edit("resolutions = [10, 14, 20]", "resolutions = [3, 14, 20]"))
                 .find("[lbm] resolutions[0] = 3 is outside [4, 512]"),

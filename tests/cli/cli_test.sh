@@ -141,6 +141,12 @@ grep -q "beta d^2/mu" "$work/out" || { echo "FAIL: lbm run table"; failures=$((f
 check "lbm run Re = 1" 0 "$draglab" lbm run --array sc --phi 0.2 --d 6 --re 1 --json --threads 1
 # The engine adjusts the body force until the achieved Re is within 1 % of the target.
 json_check "lbm run achieved Re" "j['converged'] and abs(j['re'] - 1) <= 0.01 and j['re_target'] == 1"
+# The default operator is chosen per run: TRT within its stable cell Reynolds number, rr with
+# TRT's wall beyond (kappa Re / d = 4.95 x 40 / 8 = 24.7 > 23), and the record says which and why.
+check "lbm run collision auto" 0 "$draglab" lbm run --array sc --phi 0.3 --d 8 --re 40 --json --threads 1
+json_check "lbm run auto picks rr" "j['converged'] and j['collision'] == 'rr' and j['collision_requested'] == 'auto' and '> 23' in j['collision_reason'] and j['wall_corrected']"
+check "lbm run named collision" 0 "$draglab" lbm run --array sc --phi 0.3 --d 8 --re 40 --collision trt --json --threads 1
+json_check "lbm run named trt keeps its record" "j['collision'] == 'trt' and 'collision_requested' not in j"
 check "lbm calibrate" 0 "$draglab" lbm calibrate --d 5 --json --threads 1
 json_check "lbm calibrate keys" "0.8 < j['d_h_over_d'] < 1.2 and j['scheme'] == 'trt-bb' and j['calibration']['F_input'] > 0"
 check "lbm convergence" 0 "$draglab" lbm convergence --array sc --phi 0.125 --re 0 --d 5,6,7 --schemes trt-bb,trt-ibb --json --threads 1

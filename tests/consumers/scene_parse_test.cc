@@ -246,8 +246,10 @@ TEST(SceneParse, EveryBadInputIsNamed) {
   expect_bad(edit(base, "particles", "bed_height_mf_m", "count = 100000"),
              {"does not fit the box"});
   expect_bad(edit(base, "particles", "bed_height_mf_m", "bed_height_mf_m = 0.22\ncount = 1000"),
-             {"exactly one of count and bed_height_mf_m"});
+             {"give exactly one of count"});
   expect_bad(edit(base, "particles", "bed_height_mf_m", "# none"), {"exactly one"});
+  expect_bad(edit(base, "particles", "bed_height_mf_m", "bed_height_mf_m = 0"),
+             {"neither has a usable value", "bed_height_mf_m = 0)"});
   expect_bad(edit(base, "particles", "bed_height_mf_m", "count = 0"), {"[particles] count"});
   // Times and steps: a DEM step above t_c/20 (t_c = 1.2e-4 s) is refused.
   expect_bad(edit(base, "dem", "dem_dt_s", "dem_dt_s = 1e-5"),

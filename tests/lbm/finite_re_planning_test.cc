@@ -104,7 +104,7 @@ TEST(VelocityPlan, MachTargetSetsTheVelocityAndReCellTheStability) {
   EXPECT_NEAR(p.tau, 0.5 + 3.0 * u * 16.0 / 30.0, 1e-15);
   EXPECT_NEAR(p.nu, (p.tau - 0.5) / 3.0, 1e-15);
   EXPECT_NEAR(p.velocity * 16.0 / p.nu, 30.0, 1e-9);  // the plan realises the target Re
-  // Stability is judged with the finite-Re kappa: 2.7 / 0.4^1.7 = 12.93.
+  // Stability is judged with the finite-Re kappa: 2.7 / 0.4^1.7 = 12.82.
   EXPECT_NEAR(p.kappa_stability, 2.7 / std::pow(0.4, 1.7), 1e-12);
   EXPECT_NEAR(p.cell_reynolds, p.kappa_stability * 30.0 / 16.0, 1e-12);
   EXPECT_TRUE(p.within_limit());
@@ -130,6 +130,43 @@ TEST(VelocityPlan, RefusalNamesTheLimitAndTheResolutionThatHolds) {
   // The regularized operator has no limit.
   const VelocityPlan r = plan_velocity(0.6, 30.0, 10.0, Collision::kRegularized, 0.1, 0.0, false);
   EXPECT_TRUE(r.within_limit());
+}
+
+TEST(CollisionChoice, AutoTakesTrtWithinItsStableCellReynoldsAndRrBeyond) {
+  // kappa at phi 0.6 is 2.7 / 0.4^1.7 = 12.82: Re 30 gives kappa Re / d = 24.0 at d 16 (beyond
+  // TRT's 23) and 16.0 at d 24 (within).
+  const double limit = stable_cell_reynolds(Collision::kTrt);
+  const double kappa = estimated_pore_speed_ratio(0.6);
+  EXPECT_EQ(choose_collision(0.6, 0.0, 8.0, Collision::kAuto).collision, Collision::kTrt);
+  const CollisionChoice within = choose_collision(0.6, 30.0, 24.0, Collision::kAuto);
+  ASSERT_LE(kappa * 30.0 / 24.0, limit);
+  EXPECT_EQ(within.collision, Collision::kTrt);
+  EXPECT_NE(within.reason.find("<= 23"), std::string::npos) << within.reason;
+  const CollisionChoice beyond = choose_collision(0.6, 30.0, 16.0, Collision::kAuto);
+  ASSERT_GT(kappa * 30.0 / 16.0, limit);
+  EXPECT_EQ(beyond.collision, Collision::kRegularized);
+  // The reason names the cell Reynolds number and the d at which TRT would hold.
+  EXPECT_NE(beyond.reason.find("= 24 > 23"), std::string::npos) << beyond.reason;
+  EXPECT_NE(beyond.reason.find("--d " +
+                               std::to_string(static_cast<int>(std::ceil(kappa * 30.0 / limit)))),
+            std::string::npos)
+      << beyond.reason;
+  // The switch sits exactly at the limit, and a named operator is kept whatever Re_cell.
+  const double d_switch = kappa * 100.0 / limit;
+  EXPECT_EQ(choose_collision(0.6, 100.0, d_switch * 1.001, Collision::kAuto).collision,
+            Collision::kTrt);
+  EXPECT_EQ(choose_collision(0.6, 100.0, d_switch * 0.999, Collision::kAuto).collision,
+            Collision::kRegularized);
+  const CollisionChoice named = choose_collision(0.6, 1000.0, 8.0, Collision::kTrt);
+  EXPECT_EQ(named.collision, Collision::kTrt);
+  EXPECT_TRUE(named.reason.empty());
+  // Auto is never refused, and plans for the operator it picks: TRT's Stokes tau cap (1.5)
+  // where TRT runs, rr's (1) where it does not.
+  EXPECT_TRUE(plan_velocity(0.6, 30.0, 10.0, Collision::kAuto, 0.1, 0.0, false).within_limit());
+  EXPECT_EQ(plan_velocity(0.1, 0.5, 64.0, Collision::kAuto, 0.3, 0.0, false).tau, 1.5);
+  EXPECT_EQ(plan_velocity(0.6, 30.0, 10.0, Collision::kAuto, 0.3, 0.0, false, 0.0).tau,
+            plan_velocity(0.6, 30.0, 10.0, Collision::kRegularized, 0.3, 0.0, false).tau);
+  EXPECT_EQ(resolution_needed(0.6, 300.0, Collision::kAuto).stability, 0.0);
 }
 
 TEST(ResolutionRule, BoundsFollowTheirFormulas) {

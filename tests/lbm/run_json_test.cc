@@ -32,8 +32,18 @@ TEST(RunResultJson, ScalarsSchemeAndNullForWhatWasNotMeasured) {
   EXPECT_EQ(j["collision"], to_string(Collision::kTrt));
   EXPECT_DOUBLE_EQ(j["magic"].get<double>(), 3.0 / 16.0);
   EXPECT_TRUE(j["d_hydrodynamic"].is_null());
-  o.collision = Collision::kRegularized;
-  EXPECT_FALSE(nlohmann::json::parse(r.ToJson(o)).contains("magic"));  // TRT only
+  // The record names the operator that ran (RunResult::collision), whatever was asked.
+  r.collision = Collision::kRegularized;
+  const nlohmann::json rr = nlohmann::json::parse(r.ToJson(o));
+  EXPECT_EQ(rr["collision"], "rr");
+  EXPECT_FALSE(rr.contains("magic"));                // TRT only
+  EXPECT_FALSE(rr.contains("collision_requested"));  // named, not chosen
+  o.collision = Collision::kAuto;
+  r.collision_reason = "kappa Re / d = 30 > 23";
+  const nlohmann::json chosen = nlohmann::json::parse(r.ToJson(o));
+  EXPECT_EQ(chosen["collision"], "rr");
+  EXPECT_EQ(chosen["collision_requested"], "auto");
+  EXPECT_EQ(chosen["collision_reason"], r.collision_reason);
 }
 
 }  // namespace

@@ -129,9 +129,7 @@ ConsumerResult consumer_result(const Scene& scene, const Law& law, const BedResu
   return stored;
 }
 
-BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
-                        const BedRunOptions& options, const BedProgress& progress,
-                        const BedRealization* start) {
+void check_run_options(const Scene& scene, const BedRunOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) throw Error(ErrorCode::kInvalidArgument, "bed run options: " + why);
   if (options.duration_s > 0.0) {
@@ -146,6 +144,12 @@ BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
                       " s given for the run (--duration, in place of [time] duration_s): " + why);
     }
   }
+}
+
+BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
+                        const BedRunOptions& options, const BedProgress& progress,
+                        const BedRealization* start) {
+  check_run_options(scene, options);
   check_grid_memory(scene);
   if (scene.outputs.fields || scene.outputs.particles) {
     // Before the settling or the first step, not when the first file is due.

@@ -2,6 +2,7 @@
 // family's neutral form, and its full DpmResult as the stored JSON. Its realization is a packing
 // settled with the scene's seed; its time resolution the DEM steps per contact time.
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -10,6 +11,7 @@
 #include "bed/builtin_models.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/regress.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -70,6 +72,11 @@ class DpmBedModel : public BedModel {
   }
   double time_resolution_of(const Scene& scene) const override { return scene.time.contact_steps; }
   Scene WithTimeResolution(const Scene& scene, double value) const override {
+    // The scene's own check names the range; a value beyond int must not wrap on the way there.
+    if (!(std::abs(value) < 1e9)) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  "[dem] contact_steps = " + core::format_number(value) + " is outside [20, 1000]");
+    }
     Scene s = scene;
     s.time.contact_steps = static_cast<int>(value);
     s.time.dem_dt_s = 0.0;  // the DEM step follows contact_steps

@@ -653,7 +653,16 @@ bool Scene::IsValid(std::string* error) const {
     const bool has_count = particles.count > 0;
     const bool has_height = particles.bed_height_mf_m != 0.0;
     if (has_count == has_height) {
-      return fail(error, "[particles] give exactly one of count and bed_height_mf_m");
+      // A 0 typed in the file reads as "not given": say so with the ranges.
+      return fail(
+          error,
+          "[particles] give exactly one of count, in [1, 10000000], and bed_height_mf_m, "
+          "in (0, " +
+              fmt(geometry.height_m) + "] m (the box height)" +
+              (has_count ? std::string(": both are given")
+                         : std::string(": neither has a usable value (count = " +
+                                       std::to_string(particles.count) + ", bed_height_mf_m = " +
+                                       fmt(particles.bed_height_mf_m) + ")")));
     }
     if (has_height && !in_range(particles.bed_height_mf_m, 0.0, geometry.height_m, true, false,
                                 "[particles] bed_height_mf_m", "m (the box height)", error)) {

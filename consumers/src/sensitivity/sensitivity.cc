@@ -479,6 +479,7 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   scene.Validate();
   std::string why;
   if (!options.IsValid(&why)) Fail(why);
+  check_run_options(scene, options.run);  // before the realizations are prepared
   if (!load_law) Fail("run_sensitivity: no law loader given");
   const std::vector<std::string> laws = options.laws.empty() ? scene.laws : options.laws;
   const BedModel& model = find_bed_model(scene.solver);
@@ -733,6 +734,7 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
   scene.Validate();
   std::string why;
   if (!options.IsValid(&why)) Fail(why);
+  check_run_options(scene, options.run);
   if (!load_law) Fail("run_work_precision: no law loader given");
   const BedModel& model = find_bed_model(scene.solver);
   const TimeResolution resolution = model.time_resolution();

@@ -47,7 +47,7 @@ struct CampaignSpec {
   double min_gap =
       0.0;  ///< [packing] forced min surface gap in d; 0 = none (hard-sphere structure).
   std::vector<double> resolutions;  ///< [lbm] resolutions d (lattice units per diameter), >= 4.
-  std::string collision = "trt";    ///< [lbm] trt, bgk or rr.
+  std::string collision = "auto";   ///< [lbm] auto (per unit: lbm::choose_collision), trt, bgk, rr.
   std::string boundary = "ibb";     ///< [lbm] ibb or bb.
   double tolerance = 1e-5;          ///< [lbm] convergence tolerance (relative change per T).
   std::int64_t max_steps = 200000;  ///< [lbm] step limit of one unit.
@@ -172,6 +172,7 @@ struct PlannedPoint {
   double d_needed = 0.0;
   std::string resolution_verdict;
   std::string resolution_detail;  ///< lbm::ResolutionNeed::Summary().
+  std::string collision;          ///< The operator the units run ("auto" resolved per point).
 };
 
 /// What `draglab campaign plan` predicts before any work: units, memory and run time, from the

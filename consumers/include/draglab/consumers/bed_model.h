@@ -148,8 +148,12 @@ void register_bed_model(std::unique_ptr<BedModel> model);
 std::vector<std::string> bed_model_keys();
 /// Throws Error(kInvalidArgument) naming the registered keys when `key` is not one.
 const BedModel& find_bed_model(const std::string& key);
+/// Checks run controls against the scene before any work (a duration in place of the scene's
+/// obeys the scene's rules: its range, t_ref and averaging windows inside it). Throws
+/// Error(kInvalidArgument) naming the option.
+void check_run_options(const Scene& scene, const BedRunOptions& options);
 /// Runs `scene` with the model its `solver` names (from `start`, if given: see BedModel::Run),
-/// after checking the options.
+/// after checking the options (check_run_options).
 BedResult run_bed_model(const Scene& scene, std::shared_ptr<const Law> law,
                         const BedRunOptions& options = BedRunOptions(),
                         const BedProgress& progress = nullptr,

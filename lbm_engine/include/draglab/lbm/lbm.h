@@ -57,23 +57,25 @@
 // (implicitly, so its feedback is divided out): f_ib(x, t+1) = (K + c ((f*_i(x - c_i) - f*_i(x)
 // + f*_ib(x))/2 + g)) / (1 + c/2), K the plain closure; a link in a one-node gap is solved
 // together with the opposite link of its node. The correction is relaxed towards that value
-// with a factor 1/10 per step, which damps its feedback through the wall node's moments and
-// leaves the steady state unchanged. It is applied where c > 0 (tau < 1/2 + 2 Lambda).
-// Precision::kFloat stores the shifted populations in float and collides in float (16 SIMD lanes
-// instead of 8); moments, forces and the link pass arithmetic are accumulated in double. Shifting
-// keeps the O(Ma) deviations at float's 7 digits (F agrees with double to ~1e-6 on the simple-cubic
-// cases); the momentum balance then has a noise floor of ~1e-5, so the float convergence test
-// accepts a balance up to max(tolerance, 1e-4).
+// with a factor min(1/10, 5/c) per step, which damps its feedback through the wall node's moments
+// (a feedback that grows with c) and leaves the steady state unchanged. It is applied where c > 0
+// (tau < 1/2 + 2 Lambda). Precision::kFloat stores the shifted populations in float and collides in
+// float (16 SIMD lanes instead of 8); moments, forces and the link pass arithmetic are accumulated
+// in double. Shifting keeps the O(Ma) deviations at float's 7 digits (F agrees with double to ~1e-6
+// on the simple-cubic cases); the momentum balance then has a noise floor of ~1e-5, so the float
+// convergence test accepts a balance up to max(tolerance, 1e-4).
 //
 // Automatic choices (RunOptions::tau == 0): Re = 0 -> tau = 1.5 for TRT (its steady state does
 // not depend on tau at fixed Lambda, and a larger viscosity converges faster), 1 otherwise;
 // Re > 0 -> the velocity plan of draglab/lbm/resolution.h: a short Stokes run on the same
 // lattice measures kappa = max|u|/U, U = mach_target c_s / kappa, tau = min(tau_Stokes,
-// 1/2 + 3 U d / Re). A run whose cell Reynolds number kappa Re / d is beyond what the operator
-// holds is refused before any stepping (Error(kInvalidArgument), naming the d that would hold);
-// a run that blows up is diagnosed as an instability (where, when, the cell Reynolds number
-// there, the d that would hold). The body force starts from the force balance with the BVK 2007
-// drag and is rescaled until Re is within re_tolerance of the target.
+// 1/2 + 3 U d / Re). Collision::kAuto (the default) runs TRT where kappa Re / d is within what
+// TRT held in every measured packing (and in Stokes flow), rr with TRT's wall beyond it
+// (RunResult::collision, collision_reason). A run whose cell Reynolds number kappa Re / d is
+// beyond what the chosen operator holds is refused before any stepping (Error(kInvalidArgument),
+// naming the d that would hold); a run that blows up is diagnosed as an instability (where, when,
+// the cell Reynolds number there, the d that would hold). The body force starts from the force
+// balance with the BVK 2007 drag and is rescaled until Re is within re_tolerance of the target.
 //
 // Convergence: characteristic time T = d^2 / (nu (1 + Re)) steps (momentum crossing a diameter by
 // diffusion, or by advection at higher Re); checks every T/10; converged when the relative
@@ -92,8 +94,9 @@
 // viscosity-dependent wall of BGK (Lambda = (tau - 1/2)^2), regularized ((tau - 1/2)/2) or TRT
 // with another Lambda, and a growth with Re from the thinning boundary layer: sqrt(1 + Re/10) for
 // bounce-back (first order), 1 + Re/10 for the interpolated wall (second order;
-// src/error_model.cc). It is an a-priori scale for one run; campaigns should still extrapolate in
-// d.
+// src/error_model.cc). rr with TRT's wall adds what is left of its wall shift, 0.8/d lattice
+// units (the largest measured against TRT at the same d, rounded up). It is an a-priori scale for
+// one run; campaigns should still extrapolate in d.
 #pragma once
 
 #include <array>
@@ -114,9 +117,12 @@ enum class Collision {
   kTrt,          ///< Two relaxation times, magic parameter Lambda (default 3/16).
   kRegularized,  ///< Regularized BGK (non-equilibrium projected on 2nd-order Hermite): robust at
                  ///< high Re / tau -> 1/2.
+  /// Chosen per run (choose_collision in resolution.h): TRT where the cell Reynolds number is
+  /// within what TRT held in every measured packing, rr with TRT's wall beyond it.
+  kAuto,
 };
 const char* to_string(Collision c);
-Collision collision_from_string(const std::string& s);  ///< "bgk", "trt", "rr"
+Collision collision_from_string(const std::string& s);  ///< "bgk", "trt", "rr", "auto"
 
 enum class Boundary {
   kHalfwayBounceBack,  ///< Ladd's link bounce-back, wall at q = 1/2 regardless of geometry.
@@ -152,7 +158,7 @@ constexpr double kMaxReynolds = 1e4;
 using ProgressCallback = std::function<void(double fraction, const std::string& status)>;
 
 struct RunOptions {
-  Collision collision = Collision::kTrt;
+  Collision collision = Collision::kAuto;
   double magic = 3.0 / 16.0;  ///< TRT Lambda = (tau+ - 1/2)(tau- - 1/2).
   Boundary boundary = Boundary::kInterpolated;
   WallInterpolation interpolation = WallInterpolation::kAuto;  ///< With kInterpolated.
@@ -260,7 +266,10 @@ struct RunResult {
   /// The wall scheme used: "bb", "cli" or "bfl", and why (the automatic choice).
   std::string wall;
   std::string wall_reason;
-  bool wall_corrected = false;            ///< rr: the reflected values carry TRT's wall correction.
+  bool wall_corrected = false;  ///< rr: the reflected values carry TRT's wall correction.
+  /// The operator that ran (never kAuto) and, when RunOptions::collision was kAuto, why.
+  Collision collision = Collision::kTrt;
+  std::string collision_reason;
   bool stokes_mode = false;               ///< Linear equilibrium used.
   double mass_change_rel = 0.0;           ///< (fluid mass at end - at start) / start.
   double convergence_residual = 0.0;      ///< Last relative change of F per characteristic time.
@@ -283,7 +292,7 @@ struct RunResult {
 /// estimate. Calibrated on the measured step counts of 60 units (phi 0.1 - 0.4, Re 0 - 25,
 /// d = 10): every unit within a factor 2.6, median 1.2 (docs/campaigns.md). phi in (0, 1),
 /// re >= 0, d > 0.
-double predicted_steps(double phi, double re, double d, Collision collision = Collision::kTrt);
+double predicted_steps(double phi, double re, double d, Collision collision = Collision::kAuto);
 
 /// The resolutions a run accepts, lattice units per sphere diameter: below 4 a sphere is a few
 /// voxels; above 512 the box of even one sphere outgrows any memory.

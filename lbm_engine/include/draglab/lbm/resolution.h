@@ -47,11 +47,22 @@ double estimated_pore_speed_ratio(double phi);
 
 /// The cell Reynolds number kappa Re / d (kappa estimated) beyond which every measured run of
 /// `collision` diverged (docs/validation.md, the stability map): runs are refused above it.
-/// Infinite for the regularized operator (robust, but its wall moves with tau).
+/// Infinite for the regularized operator (robust; a divergence is diagnosed, not refused) and
+/// for kAuto.
 double max_cell_reynolds(Collision collision);
 /// The cell Reynolds number at which every measured run of `collision` was stable, whatever
 /// phi: the resolution suggested to a refused or diverged run. Infinite for regularized.
 double stable_cell_reynolds(Collision collision);
+
+/// The operator of a run: `requested` itself, or for Collision::kAuto TRT in Stokes flow and
+/// where the estimated cell Reynolds number kappa Re / d is within stable_cell_reynolds(kTrt)
+/// (TRT's wall is exact at Lambda 3/16), the regularized operator beyond it (with TRT's wall
+/// where the wall is interpolated: RunOptions::rr_wall_correction).
+struct CollisionChoice {
+  Collision collision = Collision::kTrt;
+  std::string reason;  ///< Why, for an automatic choice (empty otherwise).
+};
+CollisionChoice choose_collision(double phi, double re, double d, Collision requested);
 
 /// The velocity and relaxation plan of one finite-Re run.
 struct VelocityPlan {
@@ -73,7 +84,7 @@ struct VelocityPlan {
 
 /// The plan at solids fraction phi, target Re > 0 and resolution d: U from the Mach target and
 /// kappa, tau = min(stokes_tau, 1/2 + 3 U d / Re). `tau` > 0 forces the relaxation time (U
-/// then follows from Re).
+/// then follows from Re). Collision::kAuto plans for the operator choose_collision picks.
 VelocityPlan plan_velocity(double phi, double re, double d, Collision collision, double mach_target,
                            double kappa, bool kappa_measured, double tau = 0.0);
 
@@ -90,8 +101,9 @@ struct ResolutionNeed {
   double d = 0.0;               ///< The largest of the three.
   std::string Summary() const;  ///< "d >= 48 (gaps 23, boundary layer 45, stability 48)".
 };
-ResolutionNeed resolution_needed(double phi, double re, Collision collision,
-                                 double kappa = 0.0);  ///< kappa 0: estimated from phi.
+/// kappa 0: estimated from phi. Collision::kAuto has no stability bound (rr takes over where
+/// TRT's ends).
+ResolutionNeed resolution_needed(double phi, double re, Collision collision, double kappa = 0.0);
 
 }  // namespace lbm
 }  // namespace draglab
