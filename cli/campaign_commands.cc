@@ -32,6 +32,7 @@ struct RunCommand {
   int jobs = 0;
   int threads_per_unit = 0;
   double worker_timeout_s = 30.0;
+  double checkpoint_interval = 600.0;
 };
 
 struct ExportCommand {
@@ -199,6 +200,10 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
   options.resume = c.resume;
   options.threads_per_unit = c.threads_per_unit;
   options.worker_timeout_s = c.worker_timeout_s;
+  if (!(c.checkpoint_interval >= 0.0 && c.checkpoint_interval <= 1e6)) {
+    throw UsageError("--checkpoint-interval must be in [0, 1e6] seconds");
+  }
+  options.checkpoint_interval = c.checkpoint_interval;
   const bool distributed = mpi::size() > 1;
   if (distributed && mpi::rank() != 0) {
     // A worker: the spec comes from rank 0 (no copy of the file needed here), no output.
@@ -451,6 +456,11 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
                     "MPI: seconds of silence after which a worker rank is presumed dead and its "
                     "unit handed to another, [1, 86400]")
         ->check(CLI::Range(1.0, 86400.0))
+        ->capture_default_str();
+    cmd->add_option("--checkpoint-interval", o->checkpoint_interval,
+                    "One process: seconds between the checkpoints of each unit's LBM run (kept "
+                    "beside the database; a unit taken over after a kill goes on from its "
+                    "checkpoint), [0, 1e6]")
         ->capture_default_str();
     cmd->footer(
         "Examples:\n  draglab campaign run data/campaigns/quick.toml --db q.db --jobs 2\n"

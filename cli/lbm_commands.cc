@@ -85,6 +85,8 @@ struct RunCommand {
   double d_hydro = 0.0;
   bool d_hydro_given = false;
   bool calibrate = false;
+  std::string checkpoint;
+  double checkpoint_interval = 600.0;
 };
 
 struct ConvergenceCommand {
@@ -267,6 +269,24 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     the_case = load_case(c.case_options);
     lbm::check_run_size(the_case.packing, c.d, options, "--d");
     if (!c.fields.empty() && root) core::check_output_file(c.fields, "--fields");
+    options.checkpoint = c.checkpoint;
+    options.checkpoint_interval = c.checkpoint_interval;
+    if (!std::isfinite(c.checkpoint_interval) || c.checkpoint_interval < 0.0 ||
+        c.checkpoint_interval > 1e6) {
+      throw UsageError(
+          fmt::format("--checkpoint-interval = {} s is outside [0, 1e6]", c.checkpoint_interval));
+    }
+    if (!c.checkpoint.empty()) {
+      const std::string mine = group.size() == 1
+                                   ? c.checkpoint
+                                   : c.checkpoint + ".rank" + std::to_string(group.rank()) + "of" +
+                                         std::to_string(group.size());
+      if (core::file_exists(mine)) {
+        lbm::check_checkpoint_file(mine);
+      } else {
+        core::check_output_file(c.checkpoint, "--checkpoint");
+      }
+    }
     if (c.d_hydro_given && c.calibrate) {
       throw UsageError("give --d-hydro or --calibrate, not both");
     }
@@ -295,6 +315,7 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     lbm::CalibrationOptions co;
     co.diameter = c.d;
     co.run = options;
+    co.run.checkpoint.clear();  // the run itself keeps it
     // The run's own operator (auto chooses it from the run's phi, Re and d).
     co.run.collision =
         lbm::choose_collision(the_case.packing.phi(), options.re, c.d, options.collision).collision;
@@ -784,6 +805,13 @@ void add_lbm_commands(CLI::App& app, CliContext& ctx) {
                   "Normalise with this hydrodynamic diameter (lattice units; draglab lbm "
                   "calibrate), [0.5 d, 1.5 d]")
       ->each([rc](const std::string&) { rc->d_hydro_given = true; });
+  run->add_option("--checkpoint", rc->checkpoint,
+                  "Checkpoint file: the run resumes from it if it exists (the same run), "
+                  "rewrites it every --checkpoint-interval seconds and when --max-steps stops "
+                  "it (run again with a larger --max-steps to go on), and removes it at the end");
+  run->add_option("--checkpoint-interval", rc->checkpoint_interval,
+                  "Seconds between checkpoints, [0, 1e6] (0: at every convergence check)")
+      ->capture_default_str();
   run->add_flag("--calibrate", rc->calibrate,
                 "Calibrate d_h first (dilute SC array, same d, scheme and tau) and normalise "
                 "with it");
@@ -798,6 +826,7 @@ void add_lbm_commands(CLI::App& app, CliContext& ctx) {
       "  draglab lbm run --array sc --phi 0.5235987755982988 --d 24 --re 0   # touching\n"
       "  draglab lbm run --array sc --phi 0.2 --d 12 --re 0 --boundary bb --calibrate\n"
       "  draglab lbm run --array sc --phi 0.1 --d 16 --re 0 --fields flow.h5\n"
+      "  draglab lbm run --packing p.h5 --d 48 --re 300 --checkpoint p_d48.ckpt   # resumable\n"
       "  mpirun -np 4 draglab lbm run --packing p.h5 --d 64 --re 100   # one box on 4 ranks");
   run->callback([&ctx, rc] {
     ctx.runs_on_ranks = true;  // the ranks share the box

@@ -168,8 +168,15 @@ bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token
   return got;
 }
 
+std::string unit_checkpoint_path(const std::string& db_path, std::int64_t campaign_id,
+                                 std::int64_t unit_id) {
+  return db_path + ".campaign-" + std::to_string(campaign_id) + "-unit-" + std::to_string(unit_id) +
+         ".checkpoint";
+}
+
 UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int threads,
-                         std::atomic<double>* fraction, const mpi::Communicator& group) {
+                         std::atomic<double>* fraction, const mpi::Communicator& group,
+                         const std::string& checkpoint, double checkpoint_interval) {
   UnitOutcome out;
   const auto start = Clock::now();
   try {
@@ -186,10 +193,27 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
     ro.max_steps = spec.max_steps;
     ro.threads = threads;
     ro.ranks = group;
+    ro.checkpoint = checkpoint;
+    ro.checkpoint_interval = checkpoint_interval;
     ro.throw_on_failure = false;  // a failed unit is a result: recorded with its diagnosis
-    out.run = lbm::run(packing, unit.resolution, ro, [fraction](double f, const std::string&) {
+    const lbm::ProgressCallback progress = [fraction](double f, const std::string&) {
       fraction->store(std::clamp(f, 0.0, 1.0));
-    });
+    };
+    std::string stale;
+    try {
+      out.run = lbm::run(packing, unit.resolution, ro, progress);
+    } catch (const Error& e) {
+      // A checkpoint another run wrote (an earlier code version that planned the unit
+      // differently, or a damaged file): the unit starts afresh.
+      if (checkpoint.empty() || e.code() != ErrorCode::kInvalidArgument ||
+          std::string(e.what()).rfind("checkpoint '", 0) != 0) {
+        throw;
+      }
+      stale = e.what();
+      std::remove(checkpoint.c_str());
+      out.run = lbm::run(packing, unit.resolution, ro, progress);
+    }
+    if (!stale.empty()) out.run.warnings.push_back("started afresh: " + stale);
     out.done = out.run.converged && std::isfinite(out.run.F);
     out.diagnosis = out.run.converged ? "" : out.run.diagnosis;
     if (out.run.converged && !std::isfinite(out.run.F)) out.diagnosis = "non-finite drag";
@@ -507,6 +531,11 @@ void validate_run(const CampaignSpec& spec, const RunCampaignOptions& options) {
                 "threads per unit = " + std::to_string(options.threads_per_unit) +
                     " is outside [0, 1024] (0 = cores / jobs)");
   }
+  if (!(options.checkpoint_interval >= 0.0 && options.checkpoint_interval <= 1e6)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "checkpoint interval = " + core::format_number(options.checkpoint_interval) +
+                    " s is outside [0, 1e6]");
+  }
   if (!(options.worker_timeout_s >= 1.0 && options.worker_timeout_s <= 86400.0)) {
     throw Error(ErrorCode::kInvalidArgument,
                 "worker timeout = " + core::format_number(options.worker_timeout_s) +
@@ -602,7 +631,9 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
         }
         std::atomic<double>& fraction = fractions[w];
         // Engine progress also refreshes the line (the callback throttles).
-        const UnitOutcome o = execute_unit(spec, unit, threads, &fraction);
+        const UnitOutcome o =
+            execute_unit(spec, unit, threads, &fraction, mpi::Communicator::self(),
+                         unit_checkpoint_path(db_path, id, unit.id), options.checkpoint_interval);
         const bool ours = commit_unit(wdb, unit, token, o);
         std::lock_guard<std::mutex> g(mutex);
         cost_done += in_flight_cost[w];

@@ -81,9 +81,16 @@ bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token
 
 /// Generates the unit's packing and runs the LBM engine, on the ranks of `group` together
 /// (every one of them calls it with the same unit); failures are outcomes, not exceptions.
+/// `checkpoint`: the run's checkpoint file (lbm::RunOptions::checkpoint), empty for none.
 UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int threads,
                          std::atomic<double>* fraction,
-                         const mpi::Communicator& group = mpi::Communicator::self());
+                         const mpi::Communicator& group = mpi::Communicator::self(),
+                         const std::string& checkpoint = "", double checkpoint_interval = 600.0);
+
+/// Where a unit run by this process keeps its checkpoint: beside the database, so that the
+/// process that takes the unit over after a kill goes on from it.
+std::string unit_checkpoint_path(const std::string& db_path, std::int64_t campaign_id,
+                                 std::int64_t unit_id);
 
 /// Commits an outcome; false if the unit was no longer claimed by `token` (nothing written).
 bool commit_unit(Database& db, const ClaimedUnit& unit, const std::string& token,

@@ -236,6 +236,11 @@ void check_output_directory(const std::string& path, const std::string& field) {
 
 void write_file_atomically(const std::string& path, const void* data, std::size_t size,
                            const std::string& field) {
+  write_file_atomically(path, std::vector<FilePiece>{{data, size}}, field);
+}
+
+void write_file_atomically(const std::string& path, const std::vector<FilePiece>& pieces,
+                           const std::string& field) {
   if (path.empty()) throw Error(ErrorCode::kInvalidArgument, field + ": empty path (give a file)");
   std::string temporary = path + ".tmp_XXXXXX";
   // Registered before mkstemp fills in the name: the slot points at this string's buffer.
@@ -254,17 +259,19 @@ void write_file_atomically(const std::string& path, const void* data, std::size_
                 field + " " + quoted(path) + ": " + step + " failed: " + std::strerror(error) +
                     " (nothing was written)");
   };
-  const char* bytes = static_cast<const char*>(data);
-  std::size_t written = 0;
-  while (written < size) {
-    const ssize_t n = ::write(fd, bytes + written, size - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int error = errno;
-      ::close(fd);
-      fail("writing", error);
+  for (const FilePiece& piece : pieces) {
+    const char* bytes = static_cast<const char*>(piece.data);
+    std::size_t written = 0;
+    while (written < piece.size) {
+      const ssize_t n = ::write(fd, bytes + written, piece.size - written);
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        const int error = errno;
+        ::close(fd);
+        fail("writing", error);
+      }
+      written += static_cast<std::size_t>(n);
     }
-    written += static_cast<std::size_t>(n);
   }
   if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
     const int error = errno;

@@ -243,6 +243,7 @@ CalibrationResult calibrate_hydrodynamic_diameter(const CalibrationOptions& opti
   r.use_hydrodynamic_diameter = false;
   r.hydrodynamic_diameter = 0.0;
   r.throw_on_failure = true;
+  r.checkpoint.clear();  // several runs: none resumes another's state
 
   // Progress weights: nodes x diffusive steps ~ L^5 per run.
   const ScArray calibration_array = sc_array(options.diameter, options.phi);

@@ -277,6 +277,7 @@ ConvergenceResult run_convergence(const ConvergenceOptions& options,
       r.collision = sc.scheme.collision;
       r.boundary = sc.scheme.boundary;
       r.throw_on_failure = false;
+      r.checkpoint.clear();                 // several runs: none resumes another's state
       r.use_hydrodynamic_diameter = false;  // a calibrated d_h belongs to one resolution only
       const std::string label = sc.scheme.name() +
                                 format(" d=%g", realised_resolution(options.packing, d)) + " (" +

@@ -34,6 +34,10 @@
 //    steady growth as such. No blind retry: halving the velocity at the same Re does not change
 //    the cell Reynolds number, which decides stability.
 //  - Unsteady flow: see lbm.h (Convergence) and averaging.h.
+//  - Checkpoint (RunOptions::checkpoint): the loop's state (LoopState, checkpoint.h) and the
+//    solver's, written at a check. Checks fall on multiples of the check interval whatever the
+//    stops (a stop by max_steps saves the state before its off-schedule check), so a resumed run
+//    makes the uninterrupted run's decisions and reaches its bits.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -45,7 +49,10 @@
 #include <vector>
 
 #include "averaging.h"
+#include "checkpoint.h"
 #include "collision.h"
+#include "drag_db_version.h"
+#include "draglab/core/files.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/lbm/resolution.h"
@@ -57,6 +64,7 @@
 #if defined(_OPENMP)
 #include <omp.h>
 #endif
+#include <glob.h>
 #include <unistd.h>
 
 namespace draglab {
@@ -251,6 +259,116 @@ void widen_for_resolution(const RunOptions& options, double d, RunResult* result
       fmt("%.3g", factor) + "; extrapolate in d");
 }
 
+/// This rank's checkpoint file (RunOptions::checkpoint).
+std::string checkpoint_file(const RunOptions& options, const mpi::Communicator& group) {
+  if (group.size() == 1) return options.checkpoint;
+  return options.checkpoint + ".rank" + std::to_string(group.rank()) + "of" +
+         std::to_string(group.size());
+}
+
+std::string exact(double x) { return fmt("%.17g", x); }
+
+std::string hex(std::uint64_t x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(x));
+  return text;
+}
+
+/// What a checkpoint must share with the run that resumes from it: the geometry (the grid's
+/// solid flags and this rank's lattice and links), the operator, the relaxation times, the
+/// initial force and every option of the loop. Left out: max_steps (raised to go on), threads
+/// (they change the order of the force sums, i.e. the last bits) and the checkpoint settings.
+Fingerprint run_fingerprint(const arrays::VoxelGrid& grid, const SparseLattice& lattice,
+                            const LinkTable& links, const RunOptions& options,
+                            const SolverSettings& settings, const RunResult& result,
+                            std::int64_t interval, const mpi::Communicator& group) {
+  std::uint64_t weights = fnv1a(links.weight_a.data(), links.weight_a.size() * sizeof(double));
+  weights = fnv1a(links.weight_b.data(), links.weight_b.size() * sizeof(double), weights);
+  weights = fnv1a(links.self.data(), links.self.size() * sizeof(std::int64_t), weights);
+  return {
+      // What the user set (so that the message names the cause first) ...
+      {"grid", std::to_string(grid.dims[0]) + "x" + std::to_string(grid.dims[1]) + "x" +
+                   std::to_string(grid.dims[2]) + " solid " +
+                   hex(fnv1a(grid.solid.data(), grid.solid.size()))},
+      {"rank", std::to_string(group.rank()) + " of " + std::to_string(group.size())},
+      {"phi", exact(result.phi)},
+      {"d", exact(result.d)},
+      {"re", exact(options.re)},
+      {"collision", to_string(options.collision)},
+      {"boundary", to_string(options.boundary)},
+      {"precision", to_string(options.precision)},
+      {"re_tolerance", exact(options.re_tolerance)},
+      {"tolerance", exact(options.tolerance)},
+      {"mach_limit", exact(options.mach_limit)},
+      {"average_time", exact(options.average_time)},
+      {"average_tolerance", exact(options.average_tolerance)},
+      // ... then what the engine made of it.
+      {"lattice", std::to_string(lattice.num_stored()) + " stored nodes, stride " +
+                      std::to_string(lattice.stride())},
+      {"links", std::to_string(links.size()) + " " + hex(weights)},
+      {"wall", result.wall},
+      {"stokes_mode", settings.stokes ? "on" : "off"},
+      {"tau", exact(result.tau)},
+      {"tau_minus", exact(result.tau_minus)},
+      {"wall_correction", exact(settings.wall_correction)},
+      {"initial_force", exact(result.body_force)},
+      {"check_interval", std::to_string(interval)},
+  };
+}
+
+/// A checkpoint of the same name written by another number of ranks ("" if none): the state of
+/// a decomposed box belongs to its split.
+std::string checkpoint_of_other_ranks(const std::string& base, int ranks) {
+  if (ranks > 1 && core::file_exists(base)) return base;
+  glob_t found{};
+  std::string other;
+  if (::glob((base + ".rank0of*").c_str(), 0, nullptr, &found) == 0) {
+    const std::string mine = base + ".rank0of" + std::to_string(ranks);
+    for (std::size_t k = 0; k < found.gl_pathc && other.empty(); ++k) {
+      if (found.gl_pathv[k] != mine) other = found.gl_pathv[k];
+    }
+  }
+  ::globfree(&found);
+  return other;
+}
+
+/// Resumes from `path` when it exists (collective: every rank has its file or none does);
+/// false when there is none. Throws Error(kInvalidArgument) for another run's file, a damaged
+/// one, or ranks whose files disagree.
+bool resume_from_checkpoint(const std::string& path, const Fingerprint& fingerprint,
+                            const mpi::Communicator& group, SolverBase* solver, LoopState* loop,
+                            RunResult* result) {
+  const std::int64_t present = group.sum(std::int64_t{core::file_exists(path) ? 1 : 0});
+  if (present == 0) return false;
+  if (present != group.size()) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "checkpoint '" + path + "': only " + std::to_string(present) + " of the " +
+                    std::to_string(group.size()) +
+                    " ranks have their checkpoint file; remedy: remove the files (the run then "
+                    "starts afresh)");
+  }
+  std::string code;
+  on_all_ranks(group,
+               [&] { code = load_run_checkpoint(path, fingerprint, loop, solver->state()); });
+  if (group.sum(loop->step) != loop->step * group.size()) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "checkpoint '" + path +
+                    "': the ranks' files hold different steps; remedy: remove the files (the run "
+                    "then starts afresh)");
+  }
+  solver->set_force(loop->force);
+  result->history = loop->history;
+  result->mach_max = loop->mach_max;
+  result->warnings.insert(result->warnings.end(), loop->warnings.begin(), loop->warnings.end());
+  result->resumed_from_step = loop->step;
+  if (code != kDragDbVersion) {
+    result->warnings.push_back("resumed at step " + std::to_string(loop->step) +
+                               " from a checkpoint written by draglab " + code + " (this is " +
+                               kDragDbVersion + ")");
+  }
+  return true;
+}
+
 /// The force that brings Re to target_re: a secant step in log G against log Re through the last
 /// adjustment (*last_log_force, *last_log_re, updated), or with the BVK estimate's slope at the
 /// first one.
@@ -343,10 +461,18 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   result.tau_minus = tau_minus;
   result.nu = nu;
   const double target_u = target_re > 0.0 ? target_re * nu / d : budget_u;
-  double force = force_for_velocity(target_u, nu, d, phi, target_re);
+  // Everything the run loop carries from check to check, kept together for a checkpoint.
+  LoopState loop;
+  double& force = loop.force;
+  force = force_for_velocity(target_u, nu, d, phi, target_re);
   result.body_force = force;
+  // RunOptions::checkpoint: removed at the end by the run that resumed from it or wrote it,
+  // unless max_steps stopped the run (it can go on from there).
+  std::string checkpoint_path;
+  bool checkpoint_owned = false, keep_checkpoint = false;
 
   auto fail = [&](const std::string& diagnosis) {
+    if (checkpoint_owned && !keep_checkpoint) std::remove(checkpoint_path.c_str());
     result.converged = false;
     result.diagnosis = diagnosis;
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -482,40 +608,92 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   result.characteristic_steps = interval * kChecksPerTime;
 
   std::vector<double> body_force;
-  std::vector<std::pair<double, double>> window;  // (F, U) at the checks since the last change
-  double balance = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, double>>& window = loop.window;
+  double& balance = loop.balance;
+  balance = std::numeric_limits<double>::infinity();
   // Float storage rounds every population to ~1e-7 relative each step, which leaves a noise
   // floor in the momentum balance (measured ~1e-6 .. 1e-5); double reaches round-off.
   const double balance_tolerance = options.precision == Precision::kFloat
                                        ? std::max(options.tolerance, kFloatBalanceFloor)
                                        : options.tolerance;
-  std::int64_t step = 0;
-  double stepping_s = 0.0;
-  int adjustments = 0;
+  std::int64_t& step = loop.step;
+  double& stepping_s = loop.stepping_s;
+  int& adjustments = loop.adjustments;
   // Unsteady flow (averaging.h): once detected, the force is held and F averaged.
-  bool averaging = false;
-  int averaging_restarts = 0;
-  std::int64_t averaging_start = 0;
-  std::vector<double> series_F, series_re;
-  std::vector<std::vector<double>> series_body;  // per body, the averaging samples
+  bool& averaging = loop.averaging;
+  int& averaging_restarts = loop.averaging_restarts;
+  std::int64_t& averaging_start = loop.averaging_start;
+  std::vector<double>& series_F = loop.series_F;
+  std::vector<double>& series_re = loop.series_re;
+  std::vector<std::vector<double>>& series_body = loop.series_body;
   TimeAverage average_F, average_re;
-  double last_log_force = std::numeric_limits<double>::quiet_NaN(), last_log_re = last_log_force;
-  double relative_change = std::numeric_limits<double>::infinity();
-  bool mach_warned = false;
+  double& last_log_force = loop.last_log_force;
+  double& last_log_re = loop.last_log_re;
+  last_log_force = last_log_re = std::numeric_limits<double>::quiet_NaN();
+  double& relative_change = loop.relative_change;
+  relative_change = std::numeric_limits<double>::infinity();
+  bool& mach_warned = loop.mach_warned;
   auto last_progress = Clock::now();
-  double F_mean = 0.0, U = 0.0, re_lattice = 0.0, mach = 0.0;
+  double& F_mean = loop.F_mean;
+  double& U = loop.U;
+  double& re_lattice = loop.re_lattice;
+  double& mach = loop.mach;
   MomentSummary m;
   // The largest speed at the last healthy check: where and how fast the flow was before a
   // blow-up, for the diagnosis.
-  double last_max_speed = 0.0;
-  std::int64_t last_max_node = -1, last_check_step = 0;
+  double& last_max_speed = loop.last_max_speed;
+  std::int64_t& last_max_node = loop.last_max_node;
+  std::int64_t& last_check_step = loop.last_check_step;
+
+  // Checkpoint: resume from it (the same run only), then rewrite it now and then.
+  const std::size_t loop_warnings_from = result.warnings.size();
+  Fingerprint fingerprint;
+  std::int64_t saved_step = 0;
+  if (!options.checkpoint.empty()) {
+    checkpoint_path = checkpoint_file(options, group);
+    const std::string other = checkpoint_of_other_ranks(options.checkpoint, group.size());
+    if (!other.empty()) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  "checkpoint '" + other + "' was written by another number of ranks than " +
+                      std::to_string(group.size()) +
+                      "; remedy: run on the ranks that wrote it, or remove its files (the run "
+                      "then starts afresh)");
+    }
+    fingerprint = run_fingerprint(grid, lattice, links, options, settings, result, interval, group);
+    if (resume_from_checkpoint(checkpoint_path, fingerprint, group, solver.get(), &loop, &result)) {
+      checkpoint_owned = true;
+      saved_step = step;
+    }
+  }
+  auto last_checkpoint = Clock::now();
+  auto save_checkpoint = [&] {
+    loop.history = result.history;
+    loop.mach_max = result.mach_max;
+    loop.warnings.assign(result.warnings.begin() + static_cast<std::ptrdiff_t>(loop_warnings_from),
+                         result.warnings.end());
+    on_all_ranks(group,
+                 [&] { save_run_checkpoint(checkpoint_path, fingerprint, loop, solver->state()); });
+    checkpoint_owned = true;
+    saved_step = step;
+    ++result.checkpoints_written;
+    last_checkpoint = Clock::now();
+  };
   auto instability = [&](const std::string& what, std::int64_t node) {
     return diverged_diagnosis(lattice, options, d, nu, target_re, phi, step, what, node,
                               last_max_speed, last_max_node, last_check_step);
   };
 
   while (true) {
+    if (!checkpoint_path.empty() && step > saved_step) {
+      bool due = seconds_since(last_checkpoint) >= options.checkpoint_interval;
+      if (group.size() > 1) due = group.sum(std::int64_t{due ? 1 : 0}) > 0;  // one clock for all
+      if (due) save_checkpoint();
+    }
     if (step >= options.max_steps) {
+      if (!checkpoint_path.empty()) {
+        if (step > saved_step) save_checkpoint();
+        keep_checkpoint = true;
+      }
       result.steps = step;
       result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
       if (fields != nullptr) solver->fill_fields(fields);
@@ -528,16 +706,28 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
                        ? ", Re = " + fmt("%.5g", re_lattice) + " for target " + fmt("%g", target_re)
                        : std::string()) +
                   "; remedy: raise max_steps (or loosen the tolerance); at high Re the flow "
-                  "may be unsteady");
+                  "may be unsteady" +
+                  (checkpoint_path.empty() ? std::string()
+                                           : "; the checkpoint '" + options.checkpoint +
+                                                 "' holds step " + std::to_string(step) +
+                                                 ": the same run with a larger max_steps goes "
+                                                 "on from there"));
     }
-    const std::int64_t pairs =
-        std::max<std::int64_t>(1, std::min(interval, options.max_steps - step) / 2);
+    // Checks at every multiple of the interval (a resumed run keeps the schedule), the last
+    // one cut short at max_steps (rounded up to a pair).
+    const std::int64_t next_check = (step / interval + 1) * interval;
+    const std::int64_t pairs = (std::min(next_check, options.max_steps) - step + 1) / 2;
     const auto t_step = Clock::now();
     for (std::int64_t p = 0; p < pairs; ++p) {
       solver->advance_pair(p + 1 == pairs ? &body_force : nullptr);
     }
     stepping_s += seconds_since(t_step);
     step += 2 * pairs;
+    if (!checkpoint_path.empty() && step % interval != 0) {
+      // Cut short by max_steps: the state before this check, which the run that goes on
+      // from it will not make.
+      save_checkpoint();
+    }
     result.steps = step;
     result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
 
@@ -823,6 +1013,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   widen_for_resolution(options, grid.resolution(), &result);
   result.error_estimate = result.discretisation_error + result.convergence_residual;
   if (fields != nullptr) solver->fill_fields(fields);
+  if (checkpoint_owned) std::remove(checkpoint_path.c_str());
   result.wall_s = seconds_since(start);
   if (progress) progress(1.0, "converged after " + std::to_string(step) + " steps");
   return result;
@@ -842,6 +1033,7 @@ RunOptions pore_speed_options(const RunOptions& options) {
   s.stokes_mode = RunOptions::StokesMode::kOn;
   s.tolerance = kPoreSpeedTolerance;
   s.throw_on_failure = false;
+  s.checkpoint.clear();  // the run it plans keeps the checkpoint
   return s;
 }
 

@@ -160,6 +160,11 @@ bool RunOptions::IsValid(std::string* error) const {
                 format("%g", hydrodynamic_diameter));
   }
   if (threads < 0 || threads > 4096) return fail("threads: must be in [0, 4096] (0 = all)");
+  if (!(std::isfinite(checkpoint_interval) && checkpoint_interval >= 0.0 &&
+        checkpoint_interval <= 1e6)) {
+    return fail("checkpoint_interval: must be in [0, 1e6] seconds, got " +
+                format("%g", checkpoint_interval));
+  }
   return true;
 }
 
@@ -229,6 +234,12 @@ std::string RunResult::FullReport() const {
       << "wall time            " << format("%.4g", wall_s) << " s, " << format("%.4g", mflups)
       << " MFLUPS, " << format("%.4g", static_cast<double>(memory_bytes) / 1048576.0) << " MiB"
       << (ranks > 1 ? " on " + std::to_string(ranks) + " ranks" : std::string()) << "\n";
+  if (resumed_from_step > 0 || checkpoints_written > 0) {
+    out << "checkpoint           "
+        << (resumed_from_step > 0 ? "resumed at step " + std::to_string(resumed_from_step)
+                                  : std::string("started afresh"))
+        << ", " << checkpoints_written << " written\n";
+  }
   for (const std::string& w : warnings) out << "warning              " << w << "\n";
   if (!history.empty()) {
     out << "history (last points): step, F, Re, relative change per characteristic time\n";
@@ -301,6 +312,10 @@ std::string RunResult::ToJson(const RunOptions& o) const {
     j["collision_reason"] = collision_reason;
   }
   if (ranks > 1) j["ranks"] = ranks;  // a one-rank run's record stays as it always was
+  if (!o.checkpoint.empty()) {
+    j["resumed_from_step"] = resumed_from_step;
+    j["checkpoints_written"] = checkpoints_written;
+  }
   j["d_hydrodynamic"] =
       o.use_hydrodynamic_diameter ? nlohmann::json(o.hydrodynamic_diameter) : nlohmann::json();
   // JSON has no NaN: what a failed run did not measure is null.

@@ -496,6 +496,17 @@ class Solver final : public SolverBase {
   std::size_t bytes() const override {
     return populations_.bytes() + wall_state_.size() * sizeof(double);
   }
+  std::vector<StateSection> state() override {
+    std::vector<StateSection> sections = {
+        {"populations", populations_.data(), populations_.bytes()},
+        {"mass_defect", &pending_defect_, sizeof pending_defect_},
+        {"force_magnitude", &force_magnitude_, sizeof force_magnitude_}};
+    if (!wall_state_.empty()) {
+      sections.push_back(
+          {"wall_correction", wall_state_.data(), wall_state_.size() * sizeof(double)});
+    }
+    return sections;
+  }
   double deviation(int i, std::int64_t n) const override {
     return populations_.data()[i * populations_.stride() + n];
   }

@@ -37,6 +37,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "checkpoint.h"
 #include "collision.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/mpi/communicator.h"
@@ -90,6 +91,10 @@ class SolverBase {
   /// the first rank of a decomposed box (the others get the dims only). Collective.
   virtual void fill_fields(Fields* fields) const = 0;
   virtual std::size_t bytes() const = 0;
+  /// The state a checkpoint keeps (populations, rr's wall correction, the pending mass defect):
+  /// byte ranges of the solver's own storage, read from for writing and written into when
+  /// resuming (checkpoint.h). This rank's share of a decomposed box.
+  virtual std::vector<StateSection> state() = 0;
   /// g_i = f_i - w_i of fluid node n in the streamed layout (pre-collision, as after
   /// advance_pair): for tests and diagnostics.
   virtual double deviation(int i, std::int64_t n) const = 0;

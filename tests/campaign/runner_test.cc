@@ -1,7 +1,8 @@
 // The campaign runner end to end on tiny Stokes campaigns (8 spheres, d = 10, ~0.3 s a unit):
 // SIGKILL mid-run then --resume (nothing lost, nothing duplicated, finished units untouched),
 // deterministic packings, a diverging unit recorded as failed with its diagnosis, the
-// one-process lock, and bad specs that exit 2 and write nothing.
+// one-process lock, bad specs that exit 2 and write nothing, and a unit killed mid-run that goes
+// on from its checkpoint.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -181,6 +182,80 @@ TEST(CampaignRunner, SigkillThenResumeLosesNothingAndDuplicatesNothing) {
     EXPECT_EQ(split(a[i]).first, split(b[i]).first);
     EXPECT_NEAR(split(a[i]).second, split(b[i]).second, 1e-4 * split(a[i]).second);
   }
+}
+
+// A unit killed mid-run goes on from its checkpoint. Set-up: one unit at Re 10 (8 spheres, phi
+// 0.3, d 12, a few seconds) with a checkpoint at every convergence check, killed once its
+// first checkpoint is on disk. Reference: the same spec run without a kill in another database,
+// on the same single thread: the resumed unit must give its F bit for bit, say where it went on
+// from, and leave no checkpoint behind.
+const char* kCheckpointSpec = R"(# 1 unit at Re 10 (tests/campaign/runner_test.cc)
+[campaign]
+name = "resumable"
+[grid]
+phi = [0.3]
+re = [10]
+realizations = 1
+seed = 5
+[packing]
+spheres = 8
+[lbm]
+resolutions = [12]
+[dataset]
+extrapolation = "finest"
+)";
+
+TEST(CampaignRunner, UnitKilledMidRunGoesOnFromItsCheckpoint) {
+  TempDir dir;
+  const std::string db = dir.file("ck.db"), spec = dir.file("resumable.toml");
+  write_file(spec, kCheckpointSpec);
+  const std::vector<std::string> run_args = {
+      "campaign", "run", spec, "--jobs", "1", "--threads-per-unit", "1", "--checkpoint-interval",
+      "0"};
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, 1);
+    dup2(null, 2);
+    std::vector<const char*> argv = {DRAGLAB_CLI, "--db", db.c_str()};
+    for (const std::string& a : run_args) argv.push_back(a.c_str());
+    argv.push_back(nullptr);
+    execv(DRAGLAB_CLI, const_cast<char* const*>(argv.data()));
+    _exit(127);
+  }
+  const std::string checkpoint = db + ".campaign-1-unit-1.checkpoint";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!campaign_test::exists(checkpoint) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_EQ(kill(child, SIGKILL), 0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the unit finished before it could be killed";
+  ASSERT_TRUE(campaign_test::exists(checkpoint));
+
+  std::string out, err;
+  std::vector<std::string> resume = {"--db", db};
+  resume.insert(resume.end(), run_args.begin(), run_args.end());
+  resume.push_back("--resume");
+  ASSERT_EQ(run_cli(resume, dir.path(), &out, &err), 0) << err;
+  EXPECT_FALSE(campaign_test::exists(checkpoint)) << "a finished unit removes its checkpoint";
+
+  const std::string reference_db = dir.file("reference.db");
+  std::vector<std::string> reference = {"--db", reference_db};
+  reference.insert(reference.end(), run_args.begin(), run_args.end());
+  ASSERT_EQ(run_cli(reference, dir.path(), &out, &err), 0) << err;
+
+  RawDb resumed_raw(db), reference_raw(reference_db);
+  const auto resumed = nlohmann::json::parse(
+      resumed_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
+  const auto fresh = nlohmann::json::parse(
+      reference_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
+  EXPECT_GT(resumed["resumed_from_step"].get<long long>(), 0) << resumed.dump();
+  EXPECT_EQ(fresh["resumed_from_step"].get<long long>(), 0);
+  EXPECT_EQ(resumed["F"].get<double>(), fresh["F"].get<double>());  // the same bits
+  EXPECT_EQ(resumed["steps"], fresh["steps"]);
 }
 
 TEST(CampaignRunner, DivergingUnitIsRecordedFailedAndTheOthersComplete) {

@@ -18,7 +18,9 @@
 #   2. the fields written from 3 ranks (gathered on rank 0) equal the single-process file, with
 #      one XDMF file;
 #   3. `mpirun -np 1` runs as one process: the same F bit for bit;
-#   4. bad input: more ranks than the box has pairs of z-planes: exit 2 on every rank, the message
+#   4. a checkpoint (a file per rank), stopped twice by --max-steps and resumed: the F of the
+#      run that never stopped, bit for bit; files of 2 ranks are refused by 3;
+#   5. bad input: more ranks than the box has pairs of z-planes: exit 2 on every rank, the message
 #      once, nothing written; a run that does not converge on 2 ranks: exit 1, the diagnosis once,
 #      no drag.
 # Usage: mpi_lbm_test.sh DRAGLAB MPIRUN
@@ -100,7 +102,30 @@ f_np1="$(field np1.json F)"
 check "mpirun -np 1: the single-process F bit for bit ($f_one, $f_np1)" \
   test -n "$f_one" -a "$f_one" = "$f_np1"
 
-# --- 4. bad input and failures ------------------------------------------------------------------
+# --- 4. a checkpoint per rank: stopped twice, then resumed to the bits of the run that never stopped
+steps2="$(field stokes2.json steps)"
+run_mpi -np 2 "$draglab" -q --json "${base[@]}" --re 0 --checkpoint ck --max-steps $((steps2 / 3)) \
+  >ck1.json 2>ck1.err
+code=$?
+check "checkpoint on 2 ranks: stopped by --max-steps, exit 1 (got $code), one file per rank" \
+  bash -c "[ $code = 1 ] && [ -s ck.rank0of2 ] && [ -s ck.rank1of2 ]"
+run_mpi -np 2 "$draglab" -q --json "${base[@]}" --re 0 --checkpoint ck \
+  --max-steps $((2 * steps2 / 3 + 1)) >ck2.json 2>ck2.err
+run_mpi -np 2 "$draglab" -q --json "${base[@]}" --re 0 --checkpoint ck >ck3.json 2>ck3.err ||
+  { cat ck3.err; fail=1; }
+f_ref="$(field stokes2.json F)"
+f_ck="$(field ck3.json F)"
+check "checkpoint on 2 ranks: resumed twice, the uninterrupted F bit for bit ($f_ref, $f_ck)" \
+  test -n "$f_ck" -a "$f_ck" = "$f_ref" -a "$(field ck3.json steps)" = "$steps2"
+check "checkpoint on 2 ranks: resumed from the second stop, the files removed at the end" \
+  bash -c "[ \"\$(/usr/bin/python3 -c 'import json; print(json.load(open(\"ck3.json\"))[\"resumed_from_step\"] > 0)')\" = True ] && ! ls ck.rank* 2>/dev/null"
+run_mpi -np 2 "$draglab" -q --json "${base[@]}" --re 0 --checkpoint ck --max-steps 40 >/dev/null 2>&1
+run_mpi -np 3 "$draglab" -q "${base[@]}" --re 0 --checkpoint ck >ck4.out 2>ck4.err
+code=$?
+check "checkpoint of 2 ranks read by 3: exit 2 (got $code), its files left, no result" \
+  bash -c "[ $code = 2 ] && [ -s ck.rank0of2 ] && [ ! -s ck4.out ] && grep -q 'another number of ranks' ck4.err"
+
+# --- 5. bad input and failures ------------------------------------------------------------------
 # d = 4: a 10-plane box, room for 5 ranks of 2 planes.
 run_mpi -np 6 "$draglab" -q lbm run --packing p.h5 --d 4 --re 0 --threads 1 --fields no.h5 \
   >many.out 2>many.err

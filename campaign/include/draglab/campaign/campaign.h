@@ -133,6 +133,10 @@ struct RunCampaignOptions {
   /// MPI: a worker rank silent this long (no heartbeat) is presumed dead, and its unit goes back
   /// to the queue for another rank; [1, 86400] s.
   double worker_timeout_s = 30.0;
+  /// One process (not MPI): each unit's LBM run keeps a checkpoint beside the database
+  /// ("<db_path>.campaign-<id>-unit-<unit>.checkpoint", lbm::RunOptions::checkpoint), rewritten
+  /// every this many seconds, [0, 1e6]; a unit taken over after a kill goes on from it.
+  double checkpoint_interval = 600.0;
   /// Progress: units finished (done + failed), total, and a status line (ETA included).
   std::function<void(std::int64_t finished, std::int64_t total, const std::string& line)> progress;
 };

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace draglab {
 namespace core {
@@ -44,6 +45,13 @@ void check_output_directory(const std::string& path, const std::string& field);
 /// SIGINT, SIGTERM or SIGHUP (left at their default action) end the process during the write, the
 /// temporary file is removed. `field` names the option or the kind of file in the message.
 void write_file_atomically(const std::string& path, const void* data, std::size_t size,
+                           const std::string& field);
+/// The same for a file made of several pieces written one after the other (no copy of them).
+struct FilePiece {
+  const void* data;
+  std::size_t size;
+};
+void write_file_atomically(const std::string& path, const std::vector<FilePiece>& pieces,
                            const std::string& field);
 inline void write_file_atomically(const std::string& path, const std::string& contents,
                                   const std::string& field) {

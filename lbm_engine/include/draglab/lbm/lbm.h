@@ -193,6 +193,15 @@ struct RunOptions {
   /// and gets the same result (fields on the group's rank 0 only). Default: this process alone.
   mpi::Communicator ranks = mpi::Communicator::self();
   bool throw_on_failure = true;  ///< Throw draglab::Error on divergence / non-convergence.
+  /// Checkpoint file, empty for none. A run that finds it resumes from it, bit for bit where
+  /// the uninterrupted run would have been (the same grid and options, max_steps, threads and
+  /// the checkpoint's own settings aside; another run's file is refused with
+  /// Error(kInvalidArgument) naming what differs); it is rewritten after every
+  /// checkpoint_interval seconds of stepping and when max_steps stops the run (raise max_steps
+  /// and run again to go on), and removed when the run converges or fails otherwise. Rank r of
+  /// a decomposed box keeps its share in "<checkpoint>.rank<r>of<n>".
+  std::string checkpoint;
+  double checkpoint_interval = 600.0;  ///< Seconds of stepping, in [0, 1e6]; 0: at every check.
   bool IsValid(std::string* error) const;
 };
 
@@ -276,6 +285,8 @@ struct RunResult {
   double discretisation_error = 0.0;      ///< The discretisation part of error_estimate.
   std::int64_t characteristic_steps = 0;  ///< Steps per characteristic time (see run()).
   std::size_t memory_bytes = 0;           ///< Populations plus lattice tables.
+  std::int64_t resumed_from_step = 0;     ///< The checkpoint's step it went on from (0: none).
+  int checkpoints_written = 0;
   std::string BriefReport() const;
   std::string FullReport() const;
   /// Every scalar of the run as a JSON object (text) with the options that shaped it
@@ -284,6 +295,11 @@ struct RunResult {
   /// did not converge) is null.
   std::string ToJson(const RunOptions& options) const;
 };
+
+/// Before any work: a RunOptions::checkpoint that exists must be a draglab checkpoint (else
+/// Error(kInvalidArgument) naming it); whether it was written by the same run is checked when
+/// the run starts.
+void check_checkpoint_file(const std::string& path);
 
 /// A-priori number of time steps a run with the automatic relaxation time (RunOptions::tau == 0)
 /// needs to converge at tolerance ~1e-5, for planning (draglab campaign plan): the larger of
