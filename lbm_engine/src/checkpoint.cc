@@ -2,6 +2,7 @@
 #include "checkpoint.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -75,6 +76,7 @@ Json state_json(const LoopState& s) {
   }
   j["history"] = doubles_json(history);
   j["warnings"] = s.warnings;
+  j["measured_pore_speed_ratio"] = double_bits(s.measured_pore_speed_ratio);
   return j;
 }
 
@@ -115,6 +117,7 @@ LoopState json_state(const Json& j) {
         {static_cast<std::int64_t>(history[k]), history[k + 1], history[k + 2], history[k + 3]});
   }
   s.warnings = j.at("warnings").get<std::vector<std::string>>();
+  s.measured_pore_speed_ratio = bits_double(j.at("measured_pore_speed_ratio").get<std::uint64_t>());
   return s;
 }
 
@@ -225,6 +228,18 @@ std::string load_run_checkpoint(const std::string& path, const Fingerprint& fing
   }
   read_checkpoint_sections(path, sections, kField);
   return code;
+}
+
+double checkpoint_pore_speed_ratio(const std::string& path) {
+  if (!core::file_exists(path)) return 0.0;
+  try {
+    const Json header = Json::parse(read_checkpoint_header(path, kField));
+    const double kappa =
+        bits_double(header.at("state").at("measured_pore_speed_ratio").get<std::uint64_t>());
+    return std::isfinite(kappa) && kappa > 0.0 ? kappa : 0.0;
+  } catch (const std::exception&) {
+    return 0.0;
+  }
 }
 
 void check_checkpoint_file(const std::string& path) {

@@ -62,6 +62,9 @@ struct LoopState {
   std::int64_t last_max_node = -1, last_check_step = 0;
   std::vector<HistoryPoint> history;
   std::vector<std::string> warnings;  ///< Those the loop added.
+  /// The pore-speed ratio kappa a Stokes run measured for the velocity plan (0: none), so that
+  /// a resumed run plans with it instead of running that Stokes run again.
+  double measured_pore_speed_ratio = 0.0;
 };
 
 /// What must be equal for a run to resume from a checkpoint, as (name, value) text pairs (the
@@ -79,6 +82,10 @@ void save_run_checkpoint(const std::string& path, const Fingerprint& fingerprint
 /// wrote it.
 std::string load_run_checkpoint(const std::string& path, const Fingerprint& fingerprint,
                                 LoopState* state, const std::vector<StateSection>& sections);
+
+/// The measured pore-speed ratio a checkpoint's run planned with, 0 if it has none or the file
+/// is missing or unreadable (the run then reports what is wrong with it).
+double checkpoint_pore_speed_ratio(const std::string& path);
 
 /// 64-bit FNV-1a of `bytes` bytes, continuing from `seed` (for the grid's hash).
 std::uint64_t fnv1a(const void* data, std::size_t bytes,

@@ -647,6 +647,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
 
   // Checkpoint: resume from it (the same run only), then rewrite it now and then.
   const std::size_t loop_warnings_from = result.warnings.size();
+  loop.measured_pore_speed_ratio = plan != nullptr && plan->kappa_measured ? plan->kappa : 0.0;
   Fingerprint fingerprint;
   std::int64_t saved_step = 0;
   if (!options.checkpoint.empty()) {
@@ -1063,7 +1064,16 @@ RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const Run
   std::string refusal = cell_reynolds_refusal(plan, options.re, d, quiet.collision);
   if (!refusal.empty()) throw Error(ErrorCode::kInvalidArgument, "lbm run: " + refusal);
   RunResult stokes;
-  if (options.tau == 0.0) {
+  // A run that goes on from a checkpoint plans with the kappa its Stokes run measured.
+  const double resumed_kappa =
+      options.checkpoint.empty() || options.tau != 0.0
+          ? 0.0
+          : checkpoint_pore_speed_ratio(checkpoint_file(options, options.ranks));
+  if (resumed_kappa > 0.0) {
+    plan = plan_velocity(phi, options.re, d, quiet.collision, options.mach_target, resumed_kappa,
+                         true);
+    stokes.converged = true;
+  } else if (options.tau == 0.0) {
     ProgressCallback stokes_progress;
     if (progress) {
       stokes_progress = [&progress](double fraction, const std::string& status) {

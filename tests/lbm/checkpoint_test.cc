@@ -9,7 +9,8 @@
 //    correction state the checkpoint must carry;
 //  - phi 0.2, d 10, Stokes: the Stokes-mode rescaling of the state at each check.
 // Each is stopped twice before converging, once off the check schedule (an odd max_steps), and
-// must then give F, the step count and the history bit for bit, and remove its checkpoint.
+// must then give F, the step count and the history bit for bit, and remove its checkpoint; a
+// finite-Re run goes on with the velocity plan (the measured kappa) its first part made.
 // Refusals: another run's checkpoint (a different Re), a file that is not a checkpoint and a
 // truncated one are Error(kInvalidArgument) naming the file, before any stepping.
 #include <gtest/gtest.h>
@@ -73,6 +74,9 @@ void expect_resumed_run_is_bit_identical(double phi, double d, double re, Collis
   EXPECT_EQ(last.re, reference.re);
   EXPECT_EQ(last.steps, reference.steps);
   EXPECT_EQ(last.collision, reference.collision);
+  // A resumed run plans with the kappa its first part measured (no second Stokes run).
+  EXPECT_EQ(last.pore_speed_ratio, reference.pore_speed_ratio);
+  EXPECT_EQ(last.pore_speed_ratio_measured, reference.pore_speed_ratio_measured);
   ASSERT_EQ(last.history.size(), reference.history.size());
   for (std::size_t k = 0; k < last.history.size(); ++k) {
     EXPECT_EQ(last.history[k].step, reference.history[k].step);
