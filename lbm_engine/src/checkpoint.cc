@@ -117,7 +117,8 @@ LoopState json_state(const Json& j) {
         {static_cast<std::int64_t>(history[k]), history[k + 1], history[k + 2], history[k + 3]});
   }
   s.warnings = j.at("warnings").get<std::vector<std::string>>();
-  s.measured_pore_speed_ratio = bits_double(j.at("measured_pore_speed_ratio").get<std::uint64_t>());
+  // (absent from the first checkpoints: the run then measures kappa again)
+  s.measured_pore_speed_ratio = bits_double(j.value("measured_pore_speed_ratio", std::uint64_t{0}));
   return s;
 }
 
@@ -235,7 +236,7 @@ double checkpoint_pore_speed_ratio(const std::string& path) {
   try {
     const Json header = Json::parse(read_checkpoint_header(path, kField));
     const double kappa =
-        bits_double(header.at("state").at("measured_pore_speed_ratio").get<std::uint64_t>());
+        bits_double(header.at("state").value("measured_pore_speed_ratio", std::uint64_t{0}));
     return std::isfinite(kappa) && kappa > 0.0 ? kappa : 0.0;
   } catch (const std::exception&) {
     return 0.0;
