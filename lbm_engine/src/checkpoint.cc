@@ -1,6 +1,7 @@
 // checkpoint.cc: writing and reading the checkpoint file (checkpoint.h).
 #include "checkpoint.h"
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -47,6 +48,14 @@ std::vector<double> json_doubles(const Json& a) {
   return v;
 }
 
+/// The loop state's double scalars, in the order the header stores them.
+template <typename State>
+auto scalar_fields(State& s) {
+  return std::array{&s.stepping_s,      &s.force,   &s.last_log_force, &s.last_log_re,
+                    &s.relative_change, &s.balance, &s.F_mean,         &s.U,
+                    &s.re_lattice,      &s.mach,    &s.mach_max,       &s.last_max_speed};
+}
+
 Json state_json(const LoopState& s) {
   Json j;
   j["step"] = s.step;
@@ -57,9 +66,9 @@ Json state_json(const LoopState& s) {
   j["mach_warned"] = s.mach_warned;
   j["last_max_node"] = s.last_max_node;
   j["last_check_step"] = s.last_check_step;
-  j["scalars"] =
-      doubles_json({s.stepping_s, s.force, s.last_log_force, s.last_log_re, s.relative_change,
-                    s.balance, s.F_mean, s.U, s.re_lattice, s.mach, s.mach_max, s.last_max_speed});
+  std::vector<double> scalars;
+  for (const double* x : scalar_fields(s)) scalars.push_back(*x);
+  j["scalars"] = doubles_json(scalars);
   std::vector<double> window;
   for (const auto& w : s.window) {
     window.push_back(w.first);
@@ -90,20 +99,10 @@ LoopState json_state(const Json& j) {
   s.mach_warned = j.at("mach_warned").get<bool>();
   s.last_max_node = j.at("last_max_node").get<std::int64_t>();
   s.last_check_step = j.at("last_check_step").get<std::int64_t>();
-  const std::vector<double> x = json_doubles(j.at("scalars"));
-  if (x.size() != 12) throw std::runtime_error("scalars");
-  s.stepping_s = x[0];
-  s.force = x[1];
-  s.last_log_force = x[2];
-  s.last_log_re = x[3];
-  s.relative_change = x[4];
-  s.balance = x[5];
-  s.F_mean = x[6];
-  s.U = x[7];
-  s.re_lattice = x[8];
-  s.mach = x[9];
-  s.mach_max = x[10];
-  s.last_max_speed = x[11];
+  const std::vector<double> scalars = json_doubles(j.at("scalars"));
+  const auto fields = scalar_fields(s);
+  if (scalars.size() != fields.size()) throw std::runtime_error("scalars");
+  for (std::size_t k = 0; k < fields.size(); ++k) *fields[k] = scalars[k];
   const std::vector<double> window = json_doubles(j.at("window"));
   for (std::size_t k = 0; k + 1 < window.size(); k += 2) {
     s.window.push_back({window[k], window[k + 1]});

@@ -53,6 +53,7 @@
 #include "collision.h"
 #include "drag_db_version.h"
 #include "draglab/core/files.h"
+#include "draglab/core/machine.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/lbm/resolution.h"
@@ -156,15 +157,6 @@ void on_all_ranks(const mpi::Communicator& group, Step&& step) {
     const std::size_t colon = f.find(':');
     throw Error(static_cast<ErrorCode>(std::stoi(f.substr(0, colon))), f.substr(colon + 1));
   }
-}
-
-double machine_memory_bytes() {
-#if defined(_SC_PHYS_PAGES) && defined(_SC_PAGESIZE)
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
-#else
-  return 0.0;
-#endif
 }
 
 /// The wall scheme of a run, recorded in result->wall with the reason for an automatic choice.
@@ -553,7 +545,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
              static_cast<double>(lattice.stride()) +
          static_cast<double>(lattice.memory_bytes()) +
          80.0 * static_cast<double>(grid.num_links()) / group.size());  // link table + state
-    const double available = machine_memory_bytes();
+    const double available = core::physical_memory_bytes();
     if (available > 0.0 && needed > 0.9 * available) {
       throw Error(ErrorCode::kInvalidArgument,
                   "lbm run: the lattice needs about " + fmt("%.3g", needed / 1073741824.0) +
@@ -1136,7 +1128,7 @@ RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
   return run_planned(grid, phi_exact, options, fields, progress);
 }
 
-double physical_memory_bytes() { return machine_memory_bytes(); }
+double physical_memory_bytes() { return core::physical_memory_bytes(); }
 
 double estimated_run_bytes(double nodes, Precision precision) {
   // Populations (19 per node) plus flags, links and fields: a generous per-node budget.
@@ -1186,7 +1178,7 @@ void check_run_size(const arrays::Packing& packing, double resolution, const Run
                                           kWholeGridBytesPerNode * nodes
                                     : estimated_run_bytes(nodes, options.precision);
   const double bytes = per_rank * ranks_on_this_node(options.ranks);
-  const double memory = machine_memory_bytes();
+  const double memory = core::physical_memory_bytes();
   if (memory > 0.0 && bytes > 0.8 * memory) {
     throw Error(
         ErrorCode::kInvalidArgument,
