@@ -273,16 +273,16 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
 }
 
 void run_publish(const CliContext& ctx, const std::string& ref) {
-  const std::size_t at = ref.find('@');
-  if (at == std::string::npos || at == 0 || at + 1 == ref.size() ||
-      ref.find_first_not_of("0123456789", at + 1) != std::string::npos) {
+  LawReference law;
+  if (!LawReference::TryParse(ref, &law) || ref.find('@') == std::string::npos ||
+      law.version_number() < 0) {
     throw UsageError(
         "law publish needs NAME@VERSION with a version number (e.g. vdh2004_refit@1), "
         "got '" +
         ref + "'");
   }
   auto db = ctx.open_database();
-  const LawRecord out = db->publish(ref.substr(0, at), std::stoi(ref.substr(at + 1)));
+  const LawRecord out = db->publish(law.name, law.version_number());
   if (ctx.json) {
     ctx.print_json({{"law", out.name},
                     {"version", out.version},

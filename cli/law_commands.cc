@@ -373,11 +373,11 @@ void run_export(const CliContext& ctx, const std::string& ref, const std::string
 
 // ---- law retract ----------------------------------------------------------------------------
 void run_retract(const CliContext& ctx, const std::string& ref, const std::string& reason) {
-  const std::size_t at = ref.find('@');
-  if (at == std::string::npos || ref.find_first_not_of("0123456789", at + 1) != std::string::npos ||
-      at + 1 == ref.size()) {
-    throw UsageError("law retract needs an explicit NAME@VERSION (e.g. " + ref.substr(0, at) +
-                     "@1), got '" + ref + "'");
+  LawReference law;
+  if (!LawReference::TryParse(ref, &law) || ref.find('@') == std::string::npos ||
+      law.version_number() < 0) {
+    throw UsageError("law retract needs an explicit NAME@VERSION (e.g. " + law.name + "@1), got '" +
+                     ref + "'");
   }
   if (reason.find_first_not_of(" \t") == std::string::npos || reason.size() < 3) {
     throw UsageError("--reason '" + reason +

@@ -4,12 +4,42 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "draglab/drag_db/error.h"
-#include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/law.h"
 #include "drag_db_version.h"
+#include "draglab/drag_db/dataset.h"
+#include "draglab/drag_db/error.h"
+#include "draglab/drag_db/law.h"
 
 namespace draglab {
+
+LawReference LawReference::Parse(const std::string& text) {
+  LawReference reference;
+  if (!TryParse(text, &reference)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "law reference '" + text +
+                    "' is malformed: use name, name@latest, name@<version> or name@<hash prefix>");
+  }
+  return reference;
+}
+
+bool LawReference::TryParse(const std::string& text, LawReference* out) {
+  const std::size_t at = text.find('@');
+  out->name = text.substr(0, at);
+  out->selector = at == std::string::npos ? "latest" : text.substr(at + 1);
+  return !out->name.empty() && !out->selector.empty();
+}
+
+std::string LawReference::Format(const std::string& name, int version) {
+  return name + "@" + std::to_string(version);
+}
+
+int LawReference::version_number() const {
+  if (selector.empty() || selector.size() > 9 ||
+      selector.find_first_not_of("0123456789") != std::string::npos) {
+    return -1;
+  }
+  return std::stoi(selector);
+}
+
 namespace {
 
 template <typename E, std::size_t N>
@@ -41,9 +71,8 @@ const std::pair<ReynoldsDefinition, const char*> kReynolds[] = {
     {ReynoldsDefinition::kSuperficialDiameter, "superficial_diameter"},
     {ReynoldsDefinition::kInterstitialDiameter, "interstitial_diameter"},
     {ReynoldsDefinition::kSuperficialRadius, "superficial_radius"}};
-const std::pair<TfmModel, const char*> kTfmModels[] = {{TfmModel::kNotApplicable, "none"},
-                                                       {TfmModel::kModelA, "A"},
-                                                       {TfmModel::kModelB, "B"}};
+const std::pair<TfmModel, const char*> kTfmModels[] = {
+    {TfmModel::kNotApplicable, "none"}, {TfmModel::kModelA, "A"}, {TfmModel::kModelB, "B"}};
 const std::pair<LawStatus, const char*> kStatuses[] = {{LawStatus::kDraft, "draft"},
                                                        {LawStatus::kPublished, "published"},
                                                        {LawStatus::kRetracted, "retracted"}};
@@ -53,7 +82,6 @@ std::string exact(double x) {
   std::snprintf(buf, sizeof buf, "%.17g", x);
   return buf;
 }
-
 
 }  // namespace
 
@@ -109,8 +137,7 @@ std::string content_hash_of(const LawRecord& r) {
                      {"tfm_model", to_string(r.convention.tfm_model)}};
   nlohmann::ordered_json extra = nlohmann::ordered_json::array();
   for (const ExtraInputSpec& e : r.validity.extra) {
-    extra.push_back(
-        {{"name", e.name}, {"min", exact(e.range.min)}, {"max", exact(e.range.max)}});
+    extra.push_back({{"name", e.name}, {"min", exact(e.range.min)}, {"max", exact(e.range.max)}});
   }
   j["validity"] = {{"phi", {exact(r.validity.phi.min), exact(r.validity.phi.max)}},
                    {"re", {exact(r.validity.re.min), exact(r.validity.re.max)}},

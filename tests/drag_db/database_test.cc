@@ -237,6 +237,35 @@ TEST(DatabaseBasics, ContentHashFollowsContentNotMetadata) {
   EXPECT_EQ(v1.content_hash.size(), 64u);
 }
 
+// LawReference: the one parser and writer of "name@version" (Database::resolve, the command
+// line's publish and retract, every result that names the law it ran).
+TEST(LawReference, ParsesEveryFormAndWritesOneVersion) {
+  const LawReference plain = LawReference::Parse("bvk2007");
+  EXPECT_EQ(plain.name, "bvk2007");
+  EXPECT_EQ(plain.selector, "latest");
+  EXPECT_EQ(plain.version_number(), -1);
+  const LawReference numbered = LawReference::Parse("eq6_quick@12");
+  EXPECT_EQ(numbered.name, "eq6_quick");
+  EXPECT_EQ(numbered.version_number(), 12);
+  EXPECT_EQ(LawReference::Parse("r@latest").version_number(), -1);
+  EXPECT_EQ(LawReference::Parse("r@0a1b2c").version_number(), -1);      // a hash prefix
+  EXPECT_EQ(LawReference::Parse("r@1234567890").version_number(), -1);  // too long
+  EXPECT_EQ(LawReference::Parse("r@2@3").selector, "2@3");              // split at the first
+  for (const char* bad : {"", "@1", "r@", "@"}) {
+    EXPECT_EQ(code_of([&] { LawReference::Parse(bad); }), ErrorCode::kInvalidArgument) << bad;
+    LawReference out;
+    EXPECT_FALSE(LawReference::TryParse(bad, &out)) << bad;
+  }
+  EXPECT_NE(message_of([] { LawReference::Parse("r@"); }).find("name@<version>"),
+            std::string::npos);
+  EXPECT_EQ(LawReference::Format("eq6_standard", 1), "eq6_standard@1");
+  LawRecord record;
+  record.name = "x";
+  record.version = 7;
+  EXPECT_EQ(record.reference(), "x@7");
+  EXPECT_EQ(LawReference::Parse(record.reference()).version_number(), 7);
+}
+
 TEST(DatabaseResolve, NameLatestNumberAndHashPrefix) {
   TempDir dir;
   Database db(dir.file("resolve.db"), unseeded());

@@ -192,7 +192,7 @@ class DbmBedModel : public BedModel {
     mo.eps_mf = scene.eps_mf;
     const MinFluidizationResult umf =
         minimum_fluidization(*law, scene.particles, scene.gas, mo);  // kOutOfValidity: stop here
-    const std::string law_ref = law->record().name + "@" + std::to_string(law->record().version);
+    const std::string law_ref = law->record().reference();
     if (!(sd.superficial_velocity_m_s > umf.umf_m_s))
       Bad("[dbm] superficial_velocity_m_s = " + Num(sd.superficial_velocity_m_s) +
           " m/s is not above U_mf = " + Num(umf.umf_m_s) + " m/s of " + law_ref +

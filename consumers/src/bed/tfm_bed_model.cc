@@ -152,7 +152,7 @@ class TfmBedModel : public BedModel {
 
     BedResult out;
     out.model = key();
-    out.law = law->record().name + "@" + std::to_string(law->record().version);
+    out.law = law->record().reference();
     out.scene = scene.name;
     out.scene_hash = scene.hash();
     out.eps_mf = scene.eps_mf;

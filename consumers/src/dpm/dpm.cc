@@ -183,7 +183,7 @@ void DpmSimulation::Start(Particles settled) {
   const SceneDerived derived = derive_scene(s, *law_);
   result_ = DpmResult{};
   result_.settle_wall_s = settle_wall_s;
-  result_.law = law_->record().name + "@" + std::to_string(law_->record().version);
+  result_.law = law_->record().reference();
   result_.scene = s.name;
   result_.scene_hash = s.hash();
   result_.umf_m_s = derived.umf.umf_m_s;

@@ -828,14 +828,9 @@ std::vector<LawRecord> Database::list(const std::string& name, bool include_draf
 }
 
 LawRecord Database::resolve(const std::string& reference) const {
-  const std::size_t at = reference.find('@');
-  const std::string name = reference.substr(0, at);
-  const std::string selector = at == std::string::npos ? "latest" : reference.substr(at + 1);
-  if (name.empty() || selector.empty()) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "law reference " + in_quotes(reference) +
-                    " is malformed: use name, name@latest, name@<version> or name@<hash prefix>");
-  }
+  const LawReference parsed = LawReference::Parse(reference);
+  const std::string& name = parsed.name;
+  const std::string& selector = parsed.selector;
 
   Transaction t(db_, Transaction::Kind::kRead);
   require_schema(db_, 1, "resolving a law reference");
@@ -1027,7 +1022,7 @@ LawRecord Database::retract(const std::string& name, int version, const std::str
                                  [](unsigned char c) { return std::isspace(c) != 0; });
   if (blank) {
     throw Error(ErrorCode::kInvalidArgument,
-                "retracting " + name + "@" + std::to_string(version) +
+                "retracting " + LawReference::Format(name, version) +
                     " needs a reason (it is shown to everyone who loads this version)");
   }
   Transaction t(db_, Transaction::Kind::kWrite);

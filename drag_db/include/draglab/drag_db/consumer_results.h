@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include "draglab/drag_db/law.h"
+
 namespace draglab {
 class Database;
 
@@ -63,7 +65,7 @@ struct ConsumerResult {
   std::string created_at;        ///< Set when stored if empty (ISO 8601 UTC).
   ConsumerMetrics metrics;
   std::string result_json = "{}";  ///< The full result (consumer specific JSON object).
-  std::string law_reference() const { return law_name + "@" + std::to_string(law_version); }
+  std::string law_reference() const { return LawReference::Format(law_name, law_version); }
 };
 
 /// Tolerances of a regression comparison. A prediction has moved when

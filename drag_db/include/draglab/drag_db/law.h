@@ -42,6 +42,24 @@ struct Provenance {
   std::string code_version;         ///< draglab version (git describe) that wrote the record.
 };
 
+/// A law as users name it: NAME (its latest published version), NAME@latest, NAME@<version> or
+/// NAME@<hash prefix>; one version is written "name@version" (Format, LawRecord::reference).
+struct LawReference {
+  std::string name;
+  std::string selector = "latest";  ///< "latest", a version number or a content-hash prefix.
+
+  /// Splits `text` at its first '@'. Throws Error(kInvalidArgument) naming the text and the
+  /// forms it may take when the name or the selector is empty.
+  static LawReference Parse(const std::string& text);
+  /// The same without throwing: false when malformed (`out->name` still holds the part before
+  /// the '@', for a message).
+  static bool TryParse(const std::string& text, LawReference* out);
+  /// "name@version".
+  static std::string Format(const std::string& name, int version);
+  /// The selector as a version number when it is one (decimal digits, at most 9), else -1.
+  int version_number() const;
+};
+
 /// One stored law version. Content hash: SHA-256 over form, parameters, convention and validity
 /// (content_hash_of); name, version, status, provenance and notes are not part of it.
 struct LawRecord {
@@ -60,7 +78,7 @@ struct LawRecord {
   std::string retraction_reason;  ///< Set when status == kRetracted.
 
   /// "name@version".
-  std::string reference() const { return name + "@" + std::to_string(version); }
+  std::string reference() const { return LawReference::Format(name, version); }
   std::vector<double> parameter_values() const;
 };
 
