@@ -5,7 +5,8 @@
 # list, AA pattern, partial vectorization, TRT, double) on its `blocks-8` geometry (100^3), and
 # `draglab lbm bench` measures, on the same geometry and in the same repetition, the engine's
 # interpolated-wall path (link pass included) and halfway bounce-back, besides its phi = 0.4
-# sphere packing and all-fluid box. Repetitions are interleaved (peer, engine, peer, ...) so
+# sphere packing and all-fluid box, and the regularized operator (rr) on the packing (with TRT's
+# wall correction) and the all-fluid box. Repetitions are interleaved (peer, engine, peer, ...) so
 # that a slow phase of this shared machine hits both alike; medians are reported.
 # Usage: bench/lbm_peer/run_peer.sh --peer PATH/lbmbenchk-linux-gcc-release-dp [--threads T]
 #        [--repeat N] [--iterations I] [--draglab BIN] [--out FILE]
@@ -54,6 +55,8 @@ rows = [
     ("engine, phi 0.4 packing d 16, interpolated path", med("mflups_fluid_packing"), max(r["mflups_fluid_packing"] for r in runs)),
     ("engine, phi 0.4 packing d 16, halfway bounce-back", med("mflups_fluid_packing_bb"), max(r["mflups_fluid_packing_bb"] for r in runs)),
     ("engine, all-fluid box", med("mflups"), max(r["mflups"] for r in runs)),
+    ("engine rr, phi 0.4 packing d 16, TRT's wall", med("mflups_fluid_packing_rr"), max(r["mflups_fluid_packing_rr"] for r in runs)),
+    ("engine rr, all-fluid box", med("mflups_rr"), max(r["mflups_rr"] for r in runs)),
 ]
 print(f"# {len(peer)} interleaved repetitions, {runs[0]['threads']} threads; bandwidth (in-place update) median {med('bandwidth_gbs'):.1f} GB/s")
 print("# kernel / geometry                                   MFLUPS median  best  ratio to peer (medians)")

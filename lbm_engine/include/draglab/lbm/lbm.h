@@ -360,6 +360,11 @@ struct BenchResult {
   /// interpolated path (q = 1/2 links) and with halfway bounce-back.
   double mflups_blocks = 0.0;
   double mflups_blocks_bb = 0.0;
+  /// The regularized operator (rr) beside TRT, on the same all-fluid box and packing (there with
+  /// interpolated walls and TRT's wall correction, as --collision auto runs it at high Re).
+  double mflups_rr = 0.0;
+  double mflups_fluid_packing_rr = 0.0;
+  double roofline_fraction_rr = 0.0;  ///< mflups_rr / (bandwidth / 304 bytes).
   std::int64_t blocks_fluid_nodes = 0;
   double bandwidth_gbs = 0.0;      ///< STREAM-like in-place update kernel.
   double roofline_fraction = 0.0;  ///< mflups / (bandwidth / 304 bytes).
