@@ -136,14 +136,22 @@ class Reader {
     if (!file_) {
       throw Error(ErrorCode::kIo, field + " '" + path + "': cannot open: " + std::strerror(errno));
     }
+    if (std::fseek(file_.get(), 0, SEEK_END) == 0) {
+      const long size = std::ftell(file_.get());
+      left_ = size > 0 ? static_cast<std::uint64_t>(size) : 0;
+    }
+    std::rewind(file_.get());
   }
   void read(void* data, std::size_t bytes, const char* what) {
-    if (bytes > 0 && std::fread(data, 1, bytes, file_.get()) != bytes) {
+    // A damaged length is caught against what the file holds, before any allocation or read.
+    if (bytes > left_ || (bytes > 0 && std::fread(data, 1, bytes, file_.get()) != bytes)) {
       refuse(field_, path_,
              std::string("not a complete draglab checkpoint (it ends in the ") + what + ")");
     }
     checksum_.add(data, bytes);
+    left_ -= bytes;
   }
+  std::uint64_t left() const { return left_; }
   std::uint64_t read_u64(const char* what) {
     std::uint64_t x = 0;
     read(&x, sizeof x, what);
@@ -151,7 +159,7 @@ class Reader {
   }
   std::string read_text(std::uint64_t limit, const char* what) {
     const std::uint64_t bytes = read_u64(what);
-    if (bytes > limit) refuse(field_, path_, std::string("a damaged ") + what);
+    if (bytes > limit || bytes > left_) refuse(field_, path_, std::string("a damaged ") + what);
     std::string text(static_cast<std::size_t>(bytes), '\0');
     read(text.data(), text.size(), what);
     return text;
@@ -159,11 +167,12 @@ class Reader {
   /// The header, after checking the format line.
   std::string header() {
     char magic[kMagicBytes];
-    if (std::fread(magic, 1, kMagicBytes, file_.get()) != kMagicBytes ||
+    if (left_ < kMagicBytes || std::fread(magic, 1, kMagicBytes, file_.get()) != kMagicBytes ||
         std::memcmp(magic, kMagic, kMagicBytes) != 0) {
       refuse(field_, path_, "not a draglab checkpoint (format 1)");
     }
     checksum_.add(magic, kMagicBytes);
+    left_ -= kMagicBytes;
     return read_text(kMaxHeaderBytes, "header");
   }
   std::uint64_t checksum() const { return checksum_.state; }
@@ -176,6 +185,7 @@ class Reader {
   std::unique_ptr<std::FILE, Close> file_;
   std::string path_, field_;
   Fnv1a checksum_;
+  std::uint64_t left_ = 0;  ///< Bytes of the file not read yet.
 };
 
 }  // namespace
