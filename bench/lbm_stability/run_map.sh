@@ -91,7 +91,7 @@ for phi in phis:
                 else:
                     outcome = "unfinished"
                 F = j.get("F")
-                se = j.get("F_time_error") if j.get("unsteady") else j.get("error_estimate", 0) * (F or 0)
+                se = j.get("F_time_error") if j.get("unsteady") else (j.get("error_estimate") or 0) * (F or 0)
                 fmt = lambda v, f: (f % v) if isinstance(v, (int, float)) else "-"
                 print(f"{phi} {re} {d} {c} {outcome} {fmt(j.get('cell_reynolds'), '%.1f')} "
                       f"{fmt(j.get('tau'), '%.5f')} {j.get('wall', '-')} {fmt(F, '%.4f')} "
