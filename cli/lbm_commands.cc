@@ -23,6 +23,7 @@
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/lbm/calibration.h"
+#include "draglab/lbm/case_run.h"
 #include "draglab/lbm/convergence.h"
 #include "draglab/lbm/fields_io.h"
 #include "draglab/lbm/lbm.h"
@@ -305,55 +306,20 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     check_finite_re_plan(the_case.packing.phi(), c.d, options, c.solver);
   });
 
+  lbm::CaseOptions co;
+  co.run = options;
+  co.run.throw_on_failure = false;  // report a failed run with its diagnosis, then exit 1
+  co.resolution = c.d;
+  co.calibrate = c.calibrate;
+  co.hydrodynamic_diameter = c.d_hydro_given ? c.d_hydro : 0.0;
+  co.fields = c.fields;
+  co.description = the_case.description;
   ProgressLine progress(!ctx.quiet && root);
-  auto report = [&progress](const std::string& stage) {
-    return [&progress, stage](double f, const std::string&) { progress.update(f, stage); };
-  };
-  nlohmann::json calibration_json;
-  if (c.calibrate) {
-    // On the ranks together, like the run: every rank gets the same d_h.
-    lbm::CalibrationOptions co;
-    co.diameter = c.d;
-    co.run = options;
-    co.run.checkpoint.clear();  // the run itself keeps it
-    // The run's own operator (auto chooses it from the run's phi, Re and d).
-    co.run.collision =
-        lbm::choose_collision(the_case.packing.phi(), options.re, c.d, options.collision).collision;
-    const lbm::CalibrationResult cal = calibrate(co, report("lbm calibrate"));
-    progress.finish();
-    if (root)
-      ctx.info(fmt::format("calibration: d_h/d = {:.5f} ({} at d = {:.4g}, {:.1f} s)", cal.ratio,
-                           lbm::Scheme{co.run.collision, options.boundary}.name(), cal.diameter,
-                           cal.wall_s));
-    calibration_json = {{"d_h_over_d", cal.ratio},
-                        {"phi", cal.calibration.phi},
-                        {"F_input", cal.calibration.F_input},
-                        {"F_series", cal.calibration.F_reference},
-                        {"positions", cal.calibration.positions},
-                        {"wall_s", cal.wall_s}};
-    options.use_hydrodynamic_diameter = true;
-    options.hydrodynamic_diameter = cal.ratio * c.d;
-  } else if (c.d_hydro_given) {
-    options.use_hydrodynamic_diameter = true;
-    options.hydrodynamic_diameter = c.d_hydro;
-  }
-
-  arrays::VoxelizationOptions vo;
-  vo.resolution = c.d;
-  const arrays::VoxelGrid grid = arrays::voxelize(
-      the_case.packing, vo,
-      [&progress](double f, const std::string& stage) { progress.update(f, stage); });
-  if (options.use_hydrodynamic_diameter && c.calibrate) {
-    options.hydrodynamic_diameter *= grid.resolution() / c.d;  // the realised d
-  }
-  options.throw_on_failure = false;  // report a failed run with its diagnosis, then exit 1
-  lbm::Fields fields;
-  const double phi_exact = the_case.packing.phi();
-  lbm::RunResult r;
+  lbm::CaseResult result;
   try {
-    r = c.fields.empty()
-            ? lbm::run(grid, phi_exact, options, report("lbm run"))
-            : lbm::run_with_fields(grid, phi_exact, options, &fields, report("lbm run"));
+    result = lbm::run_case(the_case.packing, co, [&progress](double f, const std::string& stage) {
+      progress.update(f, stage);
+    });
   } catch (const std::exception& e) {
     // The engine agrees on bad input (too many ranks for the box, memory) across the ranks
     // before any of them goes on: rank 0 reports it. Anything else may be this rank's alone
@@ -368,63 +334,28 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
     mpi::abort(code);
   }
   progress.finish();
+  const lbm::RunResult& r = result.run;
   if (!root) {
     if (!r.converged) throw mpi::EndedByRank0(1);  // rank 0 prints the diagnosis
     return;
   }
-
-  nlohmann::json j = nlohmann::json::parse(r.ToJson(options));
-  j["re_target"] = c.solver.re;
-  j["resolution"] = grid.resolution();
-  j["dims"] = grid.dims;
-  j["spheres"] = the_case.packing.size();
-  j["case"] = the_case.description;
-  if (!calibration_json.is_null()) j["calibration"] = calibration_json;
-  // The exact answer where one is known: the run's true error beside its own estimate. With a
-  // hydrodynamic diameter the spheres are taken to be of diameter d_h, so the array's solids
-  // fraction is (d_h/d)^3 phi and the series is evaluated there (drag_laws: vdH 2005 procedure).
-  double reference = lbm::analytical_reference_F(the_case.packing, options.re);
-  if (options.use_hydrodynamic_diameter) {
-    const double ratio = options.hydrodynamic_diameter / grid.resolution();
-    const double phi_h = r.phi * ratio * ratio * ratio;
-    j["phi_hydrodynamic"] = phi_h;
-    if (std::isfinite(reference)) {
-      reference = phi_h <= lbm::kSanganiAcrivosMaxPhi ? lbm::sangani_acrivos_sc_F(phi_h) : kNaN;
-    }
+  if (result.calibration) {
+    ctx.info(fmt::format("calibration: d_h/d = {:.5f} ({} at d = {:.4g}, {:.1f} s)",
+                         result.calibration->ratio,
+                         lbm::Scheme{r.collision, options.boundary}.name(),
+                         result.calibration->diameter, result.calibration->wall_s));
   }
-  if (std::isfinite(reference)) {
-    j["reference_F"] = reference;
-    j["reference"] = options.use_hydrodynamic_diameter
-                         ? "Sangani-Acrivos series (SC, Stokes) at phi_hydrodynamic"
-                         : "Sangani-Acrivos series (SC, Stokes)";
-    j["error"] = number_or_null(r.F / reference - 1.0);
-  }
-  // A field file that fails after the run (disk full) must not cost the drag: the result is
-  // printed all the same, and the command then fails (exit 1) with the file error.
-  std::string fields_error;
-  if (!c.fields.empty()) {
-    lbm::FieldsWriteOptions fo;
-    fo.dx = grid.dx;
-    fo.run_json = j.dump();
-    try {
-      lbm::write_fields(c.fields, fields, fo);
-      j["fields"] = c.fields;
-      j["fields_xdmf"] = lbm::xdmf_path_for(c.fields);
-    } catch (const std::exception& e) {
-      fields_error = e.what();
-      j["fields"] = nullptr;
-      j["fields_error"] = fields_error;
-    }
-  }
-
+  const nlohmann::json j = nlohmann::json::parse(result.ToJson(co));
+  const double reference = result.reference_F;
+  const std::string& fields_error = result.fields_error;
   if (ctx.json) {
     ctx.print_json(j);
   } else {
     std::cout << fmt::format("case             {}\n", the_case.description);
     std::cout << fmt::format("lattice          {} x {} x {} nodes, d = {:.4g} lattice units{}\n",
-                             grid.dims[0], grid.dims[1], grid.dims[2], grid.resolution(),
-                             options.use_hydrodynamic_diameter
-                                 ? fmt::format(" (d_h = {:.4g})", options.hydrodynamic_diameter)
+                             result.dims[0], result.dims[1], result.dims[2], result.resolution,
+                             result.hydrodynamic_diameter > 0.0
+                                 ? fmt::format(" (d_h = {:.4g})", result.hydrodynamic_diameter)
                                  : "");
     std::cout << fmt::format("scheme           {} + {}, {}, tau = {:.4g}{}\n",
                              lbm::to_string(r.collision), r.wall, lbm::to_string(options.precision),

@@ -29,6 +29,7 @@
 #include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/lbm/case_run.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/mpi/world.h"
 #include "runner_internal.h"
@@ -185,7 +186,8 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
     arrays::GenerationSummary summary;
     const arrays::Packing packing = arrays::generate_random_packing(po, &summary);
     out.packing_hash = internal::packing_hash(packing);
-    lbm::RunOptions ro;
+    lbm::CaseOptions co;
+    lbm::RunOptions& ro = co.run;
     ro.collision = lbm::collision_from_string(spec.collision);
     ro.boundary = lbm::boundary_from_string(spec.boundary);
     ro.re = unit.re_target;
@@ -196,12 +198,14 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
     ro.checkpoint = checkpoint;
     ro.checkpoint_interval = checkpoint_interval;
     ro.throw_on_failure = false;  // a failed unit is a result: recorded with its diagnosis
-    const lbm::ProgressCallback progress = [fraction](double f, const std::string&) {
-      fraction->store(std::clamp(f, 0.0, 1.0));
+    co.resolution = unit.resolution;
+    const lbm::ProgressCallback progress = [fraction](double f, const std::string& stage) {
+      if (stage == "lbm run") fraction->store(std::clamp(f, 0.0, 1.0));
     };
     std::string stale;
+    lbm::CaseResult result;
     try {
-      out.run = lbm::run(packing, unit.resolution, ro, progress);
+      result = lbm::run_case(packing, co, progress);
     } catch (const Error& e) {
       // A checkpoint another run wrote (an earlier code version that planned the unit
       // differently, or a damaged file): the unit starts afresh.
@@ -211,15 +215,17 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
       }
       stale = e.what();
       std::remove(checkpoint.c_str());
-      out.run = lbm::run(packing, unit.resolution, ro, progress);
+      result = lbm::run_case(packing, co, progress);
     }
+    out.run = result.run;
     if (!stale.empty()) out.run.warnings.push_back("started afresh: " + stale);
     out.done = out.run.converged && std::isfinite(out.run.F);
     out.diagnosis = out.run.converged ? "" : out.run.diagnosis;
     if (out.run.converged && !std::isfinite(out.run.F)) out.diagnosis = "non-finite drag";
-    // The run's own record (every scalar, the scheme), with where the unit's packing came from.
-    out.result = nlohmann::json::parse(out.run.ToJson(ro));
-    out.result["spheres"] = packing.size();
+    // The run's own record (every scalar, the scheme, the lattice), with where the unit's
+    // packing came from.
+    result.run = out.run;
+    out.result = nlohmann::json::parse(result.ToJson(co));
     out.result["box_length"] = packing.box_length;
     out.result["packing_seed"] = unit.seed;
     out.result["packing_wall_s"] = summary.wall_s;
