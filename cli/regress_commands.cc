@@ -1,5 +1,5 @@
 // `draglab regress`: consumer predictions of changed law versions against stored baselines
-// (consumers/regress.h, docs/scenes.md "Regression checks").
+// (workflows/regress.h, docs/scenes.md "Regression checks").
 //   draglab regress [--law NAME@V] [--include-drafts] [--json]
 //   draglab regress register SCENE.toml --law NAME@V [--tol-diameter-rel X]
 //                   [--tol-diameter-abs M] [--tol-umf-rel X] [--replace]
@@ -18,11 +18,11 @@
 #include "cli/cli_context.h"
 #include "cli/progress.h"
 #include "cli/regress_report.h"
-#include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/workflows/bed_results.h"
+#include "draglab/workflows/regress.h"
 
 namespace draglab {
 namespace cli {
@@ -41,7 +41,7 @@ struct RegressArgs {
   bool all = false;
 };
 
-void print_summary(const CliContext& ctx, const consumers::RegressSummary& summary) {
+void print_summary(const CliContext& ctx, const workflows::RegressSummary& summary) {
   if (ctx.json) {
     ctx.print_json(workflows::regress_json(summary));
   } else {
@@ -50,13 +50,13 @@ void print_summary(const CliContext& ctx, const consumers::RegressSummary& summa
 }
 
 void run_check(const CliContext& ctx, const RegressArgs& args) {
-  consumers::RegressOptions options;
+  workflows::RegressOptions options;
   options.law = args.law;
   options.include_drafts = args.include_drafts;
   auto db = ctx.open_database();
   ProgressLine line(!ctx.quiet);
-  const consumers::RegressSummary summary =
-      consumers::run_regression(*db, options, regress_progress(line));
+  const workflows::RegressSummary summary =
+      workflows::run_regression(*db, options, regress_progress(line));
   line.finish();
   db.reset();
   print_summary(ctx, summary);
@@ -65,7 +65,7 @@ void run_check(const CliContext& ctx, const RegressArgs& args) {
 
 void run_register(const CliContext& ctx, const RegressArgs& args) {
   const consumers::Scene scene = consumers::load_scene(args.scene_path);  // kNotFound: exit 2
-  consumers::RegressOptions options;
+  workflows::RegressOptions options;
   options.law = args.law;
   options.tol_diameter_abs_m = args.tol_diameter_abs_m;
   options.tol_diameter_rel = args.tol_diameter_rel;
@@ -73,8 +73,8 @@ void run_register(const CliContext& ctx, const RegressArgs& args) {
   options.replace_baseline = args.replace;
   auto db = ctx.open_database();
   ProgressLine line(!ctx.quiet);
-  const consumers::RegressSummary summary =
-      consumers::register_regression_baseline(*db, scene, options, regress_progress(line));
+  const workflows::RegressSummary summary =
+      workflows::register_regression_baseline(*db, scene, options, regress_progress(line));
   line.finish();
   print_summary(ctx, summary);
 }
@@ -142,14 +142,14 @@ void run_list(const CliContext& ctx, const RegressArgs& args) {
 
 }  // namespace
 
-consumers::RegressProgress regress_progress(ProgressLine& line) {
+workflows::RegressProgress regress_progress(ProgressLine& line) {
   return [&line](int run, int runs, double fraction, const std::string& stage) {
     line.update(fraction, fmt::format("run {}/{} {}", run + 1, runs, stage));
   };
 }
 
-void finish_regress(const CliContext& ctx, const consumers::RegressSummary& summary) {
-  using consumers::RegressOutcome;
+void finish_regress(const CliContext& ctx, const workflows::RegressSummary& summary) {
+  using workflows::RegressOutcome;
   const int failed = summary.count(RegressOutcome::kFailed);
   if (failed > 0) {
     ctx.warn(fmt::format(
@@ -165,10 +165,10 @@ void finish_regress(const CliContext& ctx, const consumers::RegressSummary& summ
   }
   if (!summary.any_moved()) return;
   std::string moved;
-  for (const consumers::RegressEntry& e : summary.entries) {
+  for (const workflows::RegressEntry& e : summary.entries) {
     if (e.outcome != RegressOutcome::kMoved) continue;
     std::string metrics;
-    for (const consumers::MetricComparison& c : e.comparisons) {
+    for (const workflows::MetricComparison& c : e.comparisons) {
       if (c.moved) metrics += (metrics.empty() ? "" : ", ") + c.metric;
     }
     moved += fmt::format("{}{} on {} vs {} ({})", moved.empty() ? "" : "; ", e.law, e.scene_name,

@@ -16,12 +16,12 @@
 #include "cli/progress.h"
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
-#include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/workflows/bed_results.h"
+#include "draglab/workflows/regress.h"
 
 namespace draglab {
 namespace cli {

@@ -42,11 +42,11 @@
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
-#include "draglab/consumers/sensitivity.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/workflows/bed_results.h"
+#include "draglab/workflows/sensitivity.h"
 #include "draglab/workflows/studies.h"
 
 namespace draglab {
@@ -89,7 +89,7 @@ std::string cm(double metres) { return fmt::format("{:.2f}", 100.0 * metres); }
 
 /// The law table of a model with headline numbers: per law, one line per number with its value
 /// +- total uncertainty and the runs' values.
-void print_headline_table(const consumers::SensitivitySummary& s) {
+void print_headline_table(const workflows::SensitivitySummary& s) {
   std::size_t name_width = 6, per_run_width = 12;
   std::vector<std::vector<std::string>> per_run(s.laws.size());
   for (std::size_t i = 0; i < s.laws.size(); ++i) {
@@ -105,7 +105,7 @@ void print_headline_table(const consumers::SensitivitySummary& s) {
     }
   }
   std::cout << fmt::format("Headline numbers per law, scene {} ({} uncertainty)\n", s.scene,
-                           consumers::to_string(s.method));
+                           workflows::to_string(s.method));
   std::cout << fmt::format("{:<22} {:>8} {:<{}} {:>22}  {:<{}} {:>8}\n", "law", "U_mf m/s",
                            "number", name_width, "value +- u", "per run", per_run_width, "wall s");
   for (std::size_t i = 0; i < s.laws.size(); ++i) {
@@ -125,11 +125,11 @@ void print_headline_table(const consumers::SensitivitySummary& s) {
   for (const auto& r : s.laws.front().runs)
     runs += fmt::format("{}{} {}", runs.empty() ? "" : ", ",
                         s.realization_kind.empty() ? "run" : "seed " + std::to_string(r.seed),
-                        consumers::to_string(consumers::GridSize{r.cells_x, r.cells_y, r.cells_z}));
+                        workflows::to_string(workflows::GridSize{r.cells_x, r.cells_y, r.cells_z}));
   std::cout << "  per run: " << runs << "\n";
 }
 
-void print_sensitivity_table(const consumers::SensitivitySummary& s) {
+void print_sensitivity_table(const workflows::SensitivitySummary& s) {
   if (s.has_headline()) {
     print_headline_table(s);
     return;
@@ -165,7 +165,7 @@ void print_sensitivity_table(const consumers::SensitivitySummary& s) {
 
 /// Work-precision of a model with headline numbers: each number and its difference to the
 /// reference (the finest configuration) against the wall time.
-void print_headline_work_precision_table(const consumers::WorkPrecisionResult& w) {
+void print_headline_work_precision_table(const workflows::WorkPrecisionResult& w) {
   std::cout << w.BriefReport();
   std::string head = fmt::format("{:>10} {:>13}", "grid", w.time_resolution_name);
   for (const auto& [name, value] : w.reference_headline)
@@ -173,7 +173,7 @@ void print_headline_work_precision_table(const consumers::WorkPrecisionResult& w
   std::cout << head << fmt::format(" {:>9} {:>8}\n", "steps", "wall s");
   for (const auto& r : w.rows) {
     std::string line = fmt::format(
-        "{:>10} {:>13}", consumers::to_string(consumers::GridSize{r.cells_x, r.cells_y, r.cells_z}),
+        "{:>10} {:>13}", workflows::to_string(workflows::GridSize{r.cells_x, r.cells_y, r.cells_z}),
         format_number(r.time_resolution, 4));
     for (std::size_t n = 0; n < r.headline.size(); ++n) {
       const double diff = n < r.headline_difference.size() ? r.headline_difference[n] : 0.0;
@@ -187,7 +187,7 @@ void print_headline_work_precision_table(const consumers::WorkPrecisionResult& w
                "finest step)\n";
 }
 
-void print_work_precision_table(const consumers::WorkPrecisionResult& w) {
+void print_work_precision_table(const workflows::WorkPrecisionResult& w) {
   if (w.has_headline()) {
     print_headline_work_precision_table(w);
     return;
@@ -246,12 +246,12 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   consumers::BedRunOptions run;
   run.duration_s = args.duration_given ? args.duration_s : 0.0;  // 0: the scene's
 
-  consumers::SensitivityOptions sens;
-  consumers::WorkPrecisionOptions wp;
+  workflows::SensitivityOptions sens;
+  workflows::WorkPrecisionOptions wp;
   std::string why;
   if (args.work_precision) {
     wp.law = args.law;
-    if (!args.grids.empty()) wp.grids = consumers::parse_grid_list(args.grids, "--grids");
+    if (!args.grids.empty()) wp.grids = workflows::parse_grid_list(args.grids, "--grids");
     // Each model names the value that sets its time step; the option of another model is a
     // usage error rather than silently ignored.
     const consumers::TimeResolution step =
@@ -283,10 +283,10 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (!wp.IsValid(&why)) throw UsageError(why);
   } else {
     if (!args.laws.empty()) sens.laws = core::split_list(args.laws, "--laws", "gidaspow@1,ergun@1");
-    sens.uncertainty = consumers::uncertainty_method_from_string(args.uncertainty);
+    sens.uncertainty = workflows::uncertainty_method_from_string(args.uncertainty);
     if (args.realizations < 2 || args.realizations > 32)
       throw UsageError(fmt::format("--realizations must be in [2, 32], got {}", args.realizations));
-    if (sens.uncertainty == consumers::UncertaintyMethod::kGrids && args.realizations != 2)
+    if (sens.uncertainty == workflows::UncertaintyMethod::kGrids && args.realizations != 2)
       throw UsageError("--realizations applies to --uncertainty realizations or both only");
     if (args.realizations != 2 &&
         consumers::find_bed_model(scene.solver).realization_kind().empty())

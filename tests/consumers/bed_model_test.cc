@@ -16,7 +16,6 @@
 
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
-#include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law_form.h"

@@ -64,19 +64,19 @@ TEST(SceneRunJson, TheModelsOwnEstimateWins) {
 }
 
 TEST(RegressJson, CountsNullsAndFailedEntries) {
-  consumers::RegressSummary s;
-  consumers::RegressEntry moved;
+  workflows::RegressSummary s;
+  workflows::RegressEntry moved;
   moved.scene_name = "tiny";
   moved.law = "x@2";
   moved.baseline_law = "x@1";
-  moved.outcome = consumers::RegressOutcome::kMoved;
+  moved.outcome = workflows::RegressOutcome::kMoved;
   moved.result_id = 5;
   moved.metrics.umf_m_s = 0.9;
   moved.headline = {{"holdup", kNaN}};
   moved.comparisons.push_back({"bubble_diameter_m", 0.03, kNaN, kNaN, 0.002, true});
-  consumers::RegressEntry failed;
+  workflows::RegressEntry failed;
   failed.law = "x@3";
-  failed.outcome = consumers::RegressOutcome::kFailed;
+  failed.outcome = workflows::RegressOutcome::kFailed;
   failed.error = "diverged";
   failed.result_id = 9;  // ignored: nothing stored for a failed run
   s.entries = {moved, failed};
@@ -103,14 +103,14 @@ TEST(RegressJson, CountsNullsAndFailedEntries) {
 
 TEST(SensitivityBundle, FormatLawsRunsAndSnapshotsOnRequest) {
   const consumers::Scene scene = scene_10cm_by_40cm();
-  consumers::SensitivitySummary s;
+  workflows::SensitivitySummary s;
   s.scene = "tiny";
   s.t_ref_s = 0.2;
-  consumers::SensitivityLawResult law;
+  workflows::SensitivityLawResult law;
   law.law = "gidaspow@1";
   law.diameter.mean_m = 0.03;
   law.diameter.total_m = 0.004;
-  consumers::SensitivityRun run;
+  workflows::SensitivityRun run;
   run.seed = 3;
   run.bubble_diameter_m = 0.03;
   law.runs = {run};
@@ -130,12 +130,12 @@ TEST(SensitivityBundle, FormatLawsRunsAndSnapshotsOnRequest) {
 }
 
 TEST(WorkPrecisionBundle, ObservedOrderOnlyWithRichardson) {
-  consumers::WorkPrecisionResult w;
+  workflows::WorkPrecisionResult w;
   w.law = "ergun@1";
   w.time_resolution_name = "contact_steps";
   w.reference_method = "finest as reference";
   w.observed_order = 1.7;
-  consumers::WorkPrecisionRow row;
+  workflows::WorkPrecisionRow row;
   row.cells_x = 8;
   row.cells_y = 24;
   row.time_resolution = 20;

@@ -30,7 +30,7 @@ TEST(SensitivityStudy, TwoPackingsOneLawSavedAsRun) {
   test::TempDir dir;
   Database db(dir.file("s.db"));
   const consumers::Scene scene = consumers::load_scene(kTinyScene);
-  consumers::SensitivityOptions options;
+  workflows::SensitivityOptions options;
   options.laws = {"ergun@1"};
   options.realizations = 2;
   workflows::StudyOutput output;
@@ -46,7 +46,7 @@ TEST(SensitivityStudy, TwoPackingsOneLawSavedAsRun) {
   EXPECT_GT(progress_calls, 0);
   EXPECT_LE(last_fraction, 1.0);
   ASSERT_EQ(study.summary.laws.size(), 1u);
-  const consumers::SensitivityLawResult& law = study.summary.laws[0];
+  const workflows::SensitivityLawResult& law = study.summary.laws[0];
   ASSERT_EQ(law.runs.size(), 2u);
   EXPECT_NE(law.runs[0].seed, law.runs[1].seed);  // two packings
   const double d1 = law.runs[0].bubble_diameter_m, d2 = law.runs[1].bubble_diameter_m;
@@ -70,7 +70,7 @@ TEST(SensitivityStudy, BadInputLeavesNoFolder) {
   test::TempDir dir;
   Database db(dir.file("s.db"));
   const consumers::Scene scene = consumers::load_scene(kTinyScene);
-  consumers::SensitivityOptions options;
+  workflows::SensitivityOptions options;
   options.laws = {"nosuch@1"};
   workflows::StudyOutput output;
   output.out_dir = dir.file("out");
@@ -86,7 +86,7 @@ TEST(SensitivityStudy, BadInputLeavesNoFolder) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("--beside"), std::string::npos) << e.what();
   }
-  consumers::WorkPrecisionOptions wp;
+  workflows::WorkPrecisionOptions wp;
   wp.law = "ergun@1";
   EXPECT_THROW(workflows::run_work_precision_study(db, scene, wp, output), Error);  // --beside
   EXPECT_FALSE(core::directory_exists(output.out_dir));

@@ -52,7 +52,7 @@ nlohmann::json number_or_null(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
 }
 
-nlohmann::json headline_json(const consumers::HeadlineNumbers& numbers) {
+nlohmann::json headline_json(const workflows::HeadlineNumbers& numbers) {
   nlohmann::json j = nlohmann::json::object();
   for (const auto& [name, value] : numbers) j[name] = number_or_null(value);
   return j;
@@ -99,12 +99,12 @@ nlohmann::json metrics_json(const ConsumerMetrics& m) {
           {"wall_s", m.wall_s}};
 }
 
-nlohmann::json regress_json(const consumers::RegressSummary& summary) {
-  using consumers::RegressOutcome;
+nlohmann::json regress_json(const workflows::RegressSummary& summary) {
+  using workflows::RegressOutcome;
   nlohmann::json entries = nlohmann::json::array();
-  for (const consumers::RegressEntry& e : summary.entries) {
+  for (const workflows::RegressEntry& e : summary.entries) {
     nlohmann::json comparisons = nlohmann::json::array();
-    for (const consumers::MetricComparison& c : e.comparisons) {
+    for (const workflows::MetricComparison& c : e.comparisons) {
       comparisons.push_back({{"metric", c.metric},
                              {"baseline", number_or_null(c.baseline)},
                              {"new", number_or_null(c.value)},
@@ -120,7 +120,7 @@ nlohmann::json regress_json(const consumers::RegressSummary& summary) {
          {"law", e.law},
          {"baseline",
           e.baseline_law.empty() ? nlohmann::json(nullptr) : nlohmann::json(e.baseline_law)},
-         {"outcome", consumers::to_string(e.outcome)},
+         {"outcome", workflows::to_string(e.outcome)},
          {"ran", e.ran},
          {"result_id", failed ? nlohmann::json(nullptr) : nlohmann::json(e.result_id)},
          {"baseline_result_id", e.baseline_result_id > 0 ? nlohmann::json(e.baseline_result_id)
@@ -145,7 +145,7 @@ nlohmann::json regress_json(const consumers::RegressSummary& summary) {
 }
 
 nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
-                                       const consumers::SensitivitySummary& s,
+                                       const workflows::SensitivitySummary& s,
                                        bool with_snapshots) {
   nlohmann::json grids = nlohmann::json::array();
   for (const auto& g : s.grids) grids.push_back(grid_json(g.cells_x, g.cells_y, g.cells_z));
@@ -243,7 +243,7 @@ nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
             {"height_m", scene.geometry.height_m},
             {"depth_m", scene.geometry.depth_m}}},
           {"uncertainty",
-           {{"method", consumers::to_string(s.method)},
+           {{"method", workflows::to_string(s.method)},
             {"description", s.method_description},
             {"grids", grids}}},
           {"realization_kind", s.realization_kind},
@@ -253,7 +253,7 @@ nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
           {"wall_s", s.wall_s}};
 }
 
-nlohmann::json work_precision_bundle_json(const consumers::WorkPrecisionResult& w) {
+nlohmann::json work_precision_bundle_json(const workflows::WorkPrecisionResult& w) {
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& r : w.rows) {
     nlohmann::json difference = nlohmann::json::object();

@@ -102,9 +102,9 @@ std::vector<PipelineComparison> compare_over_grid(const Database& db, const Law&
 /// quick scene if there is none. Returns false (with a warning) if there is nothing to run on.
 bool run_check(const std::string& db_path, const LawRecord& record, const consumers::Scene* scene,
                const Messages& messages, const PipelineProgress& progress,
-               consumers::RegressSummary* summary) {
+               workflows::RegressSummary* summary) {
   Database db(db_path);
-  consumers::RegressOptions options;
+  workflows::RegressOptions options;
   options.law = record.reference();
   if (scene) {
     register_consumer_scene(db, scene->name, scene->source_text);
@@ -123,7 +123,7 @@ bool run_check(const std::string& db_path, const LawRecord& record, const consum
   }
   messages.info("pipeline: regression check of " + record.reference() +
                 " on the registered scenes");
-  *summary = consumers::run_regression(db, options, progress.regression);
+  *summary = workflows::run_regression(db, options, progress.regression);
   if (progress.stage_done) progress.stage_done();
   return true;
 }

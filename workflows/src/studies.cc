@@ -22,7 +22,7 @@ namespace {
 const char* const kFigureScript = "draglab_fig4.py";
 
 /// Loads laws with the scene's range policy, each warning (draft, retracted) said once.
-consumers::LawLoader law_loader(const Database& db, const consumers::Scene& scene,
+workflows::LawLoader law_loader(const Database& db, const consumers::Scene& scene,
                                 const Messages& messages) {
   const RangePolicy policy = range_policy_from_string(scene.range_policy);
   auto warned = std::make_shared<std::set<std::string>>();
@@ -78,7 +78,7 @@ nlohmann::json WorkPrecisionStudy::ToJson(const std::string& out_dir) const {
 }
 
 SensitivityStudy run_sensitivity_study(const Database& db, const consumers::Scene& scene,
-                                       const consumers::SensitivityOptions& options,
+                                       const workflows::SensitivityOptions& options,
                                        const StudyOutput& output, const Messages& messages,
                                        const StudyProgress& progress) {
   if (!output.beside.empty()) {
@@ -92,9 +92,9 @@ SensitivityStudy run_sensitivity_study(const Database& db, const consumers::Scen
     }
   }
   SensitivityStudy study;
-  study.summary = consumers::run_sensitivity(scene, law_loader(db, scene, messages), options,
+  study.summary = workflows::run_sensitivity(scene, law_loader(db, scene, messages), options,
                                              making_folder(output.out_dir, progress));
-  const consumers::SensitivitySummary& s = study.summary;
+  const workflows::SensitivitySummary& s = study.summary;
   // A model with headline numbers has no bubble at t_ref (no snapshot, nothing for the figure
   // script to draw): its numbers are the result.
   const bool headline = s.has_headline();
@@ -144,16 +144,16 @@ SensitivityStudy run_sensitivity_study(const Database& db, const consumers::Scen
 }
 
 WorkPrecisionStudy run_work_precision_study(const Database& db, const consumers::Scene& scene,
-                                            const consumers::WorkPrecisionOptions& options,
+                                            const workflows::WorkPrecisionOptions& options,
                                             const StudyOutput& output, const Messages& messages,
                                             const StudyProgress& progress) {
   if (!output.beside.empty()) {
     throw Error(ErrorCode::kInvalidArgument, "--beside is for the law study, not --work-precision");
   }
   WorkPrecisionStudy study;
-  study.result = consumers::run_work_precision(scene, law_loader(db, scene, messages), options,
+  study.result = workflows::run_work_precision(scene, law_loader(db, scene, messages), options,
                                                making_folder(output.out_dir, progress));
-  const consumers::WorkPrecisionResult& w = study.result;
+  const workflows::WorkPrecisionResult& w = study.result;
   // A model with headline numbers has no bubble at t_ref and no figure of this study.
   const bool headline = w.has_headline();
   for (const auto& r : w.rows) {

@@ -85,6 +85,26 @@ bool BedRunOptions::IsValid(std::string* error) const {
   return true;
 }
 
+RegressionTolerances BedModel::default_tolerances(const Scene& scene) const {
+  RegressionTolerances t;
+  // Bubble diameter: bubble.h measures D from the cells above the threshold, so each run's D is
+  // off by up to one cell size h (the boundary of the region is resolved to a cell); two runs
+  // can differ by 2 h with no change in the physics. On top, 10 % of D: a single run of a DPM
+  // bubble scatters with the packing and the chaotic particle motion (several % between
+  // realizations of the same bed), and a drag law change smaller than that is not a change a
+  // bubble prediction can show.
+  const double dx = scene.geometry.width_m / std::max(scene.grid.cells_x, 1);
+  const double dy = scene.geometry.height_m / std::max(scene.grid.cells_y, 1);
+  t.diameter_abs_m = 2.0 * std::max(dx, dy);
+  t.diameter_rel = 0.10;
+  // U_mf comes from the law's force balance at eps_mf solved to 1e-12 (scene.h), with no
+  // run-to-run scatter: 1 % is a real change of the law at incipient fluidization (the five
+  // literature laws differ by 10-25 % there), small enough to catch a coefficient change that a
+  // noisy bubble metric would hide.
+  t.umf_rel = 0.01;
+  return t;
+}
+
 void register_bed_model(std::unique_ptr<BedModel> model) {
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);

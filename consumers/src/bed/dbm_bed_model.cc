@@ -153,6 +153,20 @@ class DbmBedModel : public BedModel {
     return s;
   }
 
+  RegressionTolerances default_tolerances(const Scene&) const override {
+    // The DBM's "bubble diameter" is the mean size of its Lagrangian bubbles over the run: each
+    // bubble carries its volume exactly, none is traced on the grid, so there is no cell part.
+    // The 10 % covers the run-to-run scatter that coalescence brings (which bubbles meet
+    // depends on the injection phases and the flow: docs/scenes.md), and like the DPM's it is the
+    // smallest change of a bubble size a reactor prediction can use. Without coalescence every
+    // bubble keeps its injected size, so D moves only when that size does.
+    RegressionTolerances t;
+    t.diameter_abs_m = 0.0;
+    t.diameter_rel = 0.10;
+    t.umf_rel = 0.01;  // as every model's (BedModel::default_tolerances)
+    return t;
+  }
+
   std::string realization_kind() const override { return "injection seed"; }
   std::shared_ptr<const BedRealization> Realize(const Scene& scene, std::shared_ptr<const Law>,
                                                 const BedProgress&) const override {

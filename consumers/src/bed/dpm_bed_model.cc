@@ -8,9 +8,10 @@
 #include <string>
 #include <utility>
 
+#include <nlohmann/json.hpp>
+
 #include "bed/builtin_models.h"
 #include "draglab/consumers/dpm.h"
-#include "draglab/consumers/regress.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
@@ -134,6 +135,78 @@ class DpmBedModel : public BedModel {
 };
 
 }  // namespace
+
+ConsumerMetrics consumer_metrics_of(const DpmResult& r) {
+  ConsumerMetrics m;
+  m.umf_m_s = r.umf_m_s;
+  m.background_m_s = r.background_m_s;
+  m.t_ref_s = r.t_ref_s;
+  m.bubble_present = r.bubble_at_t_ref;
+  m.bubble_diameter_m = r.bubble_at_t_ref ? r.bubble_diameter_m : 0.0;
+  // The centroid of the same sample as the diameter (nearest to t_ref).
+  const DpmSample* at_ref = nullptr;
+  for (const DpmSample& s : r.series) {
+    if (!at_ref || std::abs(s.t_s - r.t_ref_s) < std::abs(at_ref->t_s - r.t_ref_s)) at_ref = &s;
+    m.max_bed_height_m = std::max(m.max_bed_height_m, s.bed_height_m);
+  }
+  m.bubble_centroid_m = r.bubble_at_t_ref && at_ref ? at_ref->bubble_centroid_m : 0.0;
+  m.wall_s = r.wall_s;
+  return m;
+}
+
+std::string dpm_result_json(const DpmResult& r) {
+  nlohmann::json series = nlohmann::json::array();
+  for (const DpmSample& s : r.series) {
+    series.push_back({{"t_s", s.t_s},
+                      {"bubble_diameter_m", s.bubble_diameter_m},
+                      {"bubble_centroid_m", s.bubble_centroid_m},
+                      {"bed_height_m", s.bed_height_m},
+                      {"pressure_drop_pa", s.pressure_drop_pa}});
+  }
+  nlohmann::json j = {{"solver", "dpm"},
+                      {"scene", r.scene},
+                      {"scene_hash", r.scene_hash},
+                      {"law", r.law},
+                      {"umf_m_s", r.umf_m_s},
+                      {"background_m_s", r.background_m_s},
+                      {"background", r.background_mode},
+                      {"eps_mf", r.eps_mf},
+                      {"t_ref_s", r.t_ref_s},
+                      {"bubble_at_t_ref", r.bubble_at_t_ref},
+                      {"bubble_diameter_m", r.bubble_at_t_ref ? nlohmann::json(r.bubble_diameter_m)
+                                                              : nlohmann::json(nullptr)},
+                      {"series", series},
+                      {"particles", r.particles},
+                      {"settled_bed_height_m", r.settled_bed_height_m},
+                      {"gas_dt_s", r.gas_dt_s},
+                      {"dem_dt_s", r.dem_dt_s},
+                      {"threads", r.threads},
+                      {"gas_steps", r.gas_steps},
+                      {"dem_steps", r.dem_steps},
+                      {"settle_wall_s", r.settle_wall_s},
+                      {"wall_s", r.wall_s},
+                      {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
+                      {"momentum_mismatch", r.momentum_mismatch},
+                      {"max_action_reaction_mismatch_n", r.max_action_reaction_mismatch_n},
+                      {"void_fraction_clamps", r.void_fraction_clamps},
+                      {"drag_out_of_range", r.law_out_of_range},
+                      {"eps_packing", r.eps_packing},
+                      {"umf_packing_m_s", r.umf_packing_m_s},
+                      {"output_files", r.output_files}};
+  if (r.has_snapshot) {
+    const BubbleMetrics& b = r.snapshot.bubble;
+    j["snapshot"] = {{"t_s", r.snapshot.t_s},
+                     {"bubble_found", b.found},
+                     {"bubble_diameter_m", b.diameter_m},
+                     {"bubble_centroid_x_m", b.centroid_x_m},
+                     {"bubble_centroid_y_m", b.centroid_y_m},
+                     {"bubble_top_m", b.top_m},
+                     {"bubble_bottom_m", b.bottom_m},
+                     {"bubble_erupting", b.touches_surface},
+                     {"bed_height_m", b.bed_height_m}};
+  }
+  return j.dump();
+}
 
 namespace internal {
 std::unique_ptr<BedModel> make_dpm_bed_model() { return std::make_unique<DpmBedModel>(); }

@@ -7,7 +7,7 @@
 // run`, `sensitivity`, work-precision and `regress` dispatch through the registry, so a new model
 // (DBM) plugs in by registering, and scene validation accepts exactly the registered keys.
 //
-// Two hooks say what the studies (sensitivity.h) vary for a model:
+// Two hooks say what the studies (workflows/sensitivity.h) vary for a model:
 //  - a realization is the random state every law and grid of one seed starts from, prepared once
 //    per seed (DPM: a packing settled with scene.seed). A deterministic model has none
 //    (realization_kind() empty) and its uncertainty comes from grids only;
@@ -133,6 +133,12 @@ class BedModel {
   virtual double time_resolution_of(const Scene& scene) const = 0;
   /// The scene with that value set (and whatever else must follow it); the caller validates.
   virtual Scene WithTimeResolution(const Scene& scene, double value) const = 0;
+
+  /// The tolerances a regression baseline of `scene` gets unless given (`draglab regress`):
+  /// how far a later law version may move this model's predictions before it counts as a
+  /// change. Default: the bubble diameter within 2 gas cells (the larger cell side) + 10 % of
+  /// the baseline's, U_mf within 1 % (bed_model.cc says why).
+  virtual RegressionTolerances default_tolerances(const Scene& scene) const;
 
   /// One run. `start`: a realization of this model made by Realize with scene.seed (reused
   /// across laws and grids); null: the run prepares its own. Throws Error(kInvalidArgument) for

@@ -25,6 +25,7 @@
 #include "draglab/consumers/dem.h"
 #include "draglab/consumers/gas_phase.h"
 #include "draglab/consumers/scene.h"
+#include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/law.h"
 
 namespace draglab {
@@ -159,6 +160,14 @@ class DpmSimulation {
   std::vector<int> layer_by_id_;
   std::unique_ptr<Impl> impl_;
 };
+
+// The DPM's result in the forms its bed model stores (bed/dpm_bed_model.cc).
+/// What a regression compares, from a DPM result: U_mf, background, the bubble at t_ref (its
+/// diameter and centroid height), the highest bed surface over the samples, wall time.
+ConsumerMetrics consumer_metrics_of(const DpmResult& result);
+/// The full DPM result as JSON text (the fields of `draglab scene run --json`, without the
+/// snapshot's particle arrays).
+std::string dpm_result_json(const DpmResult& result);
 
 }  // namespace consumers
 }  // namespace draglab

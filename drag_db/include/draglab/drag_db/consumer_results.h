@@ -15,7 +15,7 @@
 // Immutability is enforced by SQL triggers for every client (UPDATE, DELETE and REPLACE are
 // refused with Error(kImmutable) through this API). Every function is one transaction: nothing is
 // half-written. Storage: drag_db/src/db/consumer_store.cc. The consumers module runs the scenes
-// and decides what moved (draglab/consumers/regress.h); this header only stores and reads.
+// and decides what moved (draglab/workflows/regress.h); this header only stores and reads.
 #pragma once
 
 #include <cstdint>

@@ -14,10 +14,10 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/regress.h"
 #include "draglab/consumers/scene.h"
-#include "draglab/consumers/sensitivity.h"
 #include "draglab/drag_db/consumer_results.h"
+#include "draglab/workflows/regress.h"
+#include "draglab/workflows/sensitivity.h"
 
 namespace draglab {
 namespace workflows {
@@ -34,7 +34,7 @@ nlohmann::json tolerances_json(const RegressionTolerances& t);
 ///  (null without a bubble), max_bed_height_m, wall_s}.
 nlohmann::json metrics_json(const ConsumerMetrics& m);
 /// Headline numbers as an object by name (null for a value that is not finite).
-nlohmann::json headline_json(const consumers::HeadlineNumbers& numbers);
+nlohmann::json headline_json(const workflows::HeadlineNumbers& numbers);
 
 /// The numerical uncertainty of one run and how it was estimated: the model's own estimate
 /// where it has one (the DBM's batch means of the hold-up), else one gas cell (the larger side)
@@ -54,17 +54,17 @@ nlohmann::json scene_run_json(const consumers::Scene& scene, const consumers::Be
 ///  "wall_s", "entries": [{scene, scene_hash, law, baseline, outcome, ran, result_id,
 ///  baseline_result_id, tolerances, metrics, headline, comparisons: [{metric, baseline, new,
 ///  delta, tolerance, moved}], error, warnings, wall_s}]}.
-nlohmann::json regress_json(const consumers::RegressSummary& summary);
+nlohmann::json regress_json(const workflows::RegressSummary& summary);
 
 /// The sensitivity bundle: scene, t_ref, uncertainty method and grids, packings, per law the
 /// bubble diameter (mean, estimate, uncertainty and its parts), the runs with their series and
 /// headline numbers, and (with_snapshots) the bed at t_ref for the figure.
 nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
-                                       const consumers::SensitivitySummary& s, bool with_snapshots);
+                                       const workflows::SensitivitySummary& s, bool with_snapshots);
 
 /// The work-precision bundle: per configuration (grid, time resolution) the bubble diameter or
 /// headline numbers, the difference to the reference and the wall time.
-nlohmann::json work_precision_bundle_json(const consumers::WorkPrecisionResult& w);
+nlohmann::json work_precision_bundle_json(const workflows::WorkPrecisionResult& w);
 
 }  // namespace workflows
 }  // namespace draglab

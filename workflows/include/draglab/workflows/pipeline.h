@@ -3,7 +3,7 @@
 //
 //   campaign spec -> LBM units (campaign/) -> dataset (drag_db/) -> Ceres fit of Eq. 6 with the
 //   NLopt check (fitter/) -> new law version, published -> report -> regression check of the
-//   published version on the registered consumer scenes (consumers/regress.h).
+//   published version on the registered consumer scenes (workflows/regress.h).
 //
 // Re-running is cheap and safe: the campaign resumes (finished units are kept), the dataset is
 // identified by its content hash, and a fit that gives a law identical to the latest published
@@ -20,11 +20,11 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/campaign/campaign.h"
-#include "draglab/consumers/regress.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/fitter/fit.h"
 #include "draglab/workflows/messages.h"
+#include "draglab/workflows/regress.h"
 
 namespace draglab {
 namespace workflows {
@@ -52,7 +52,7 @@ std::string preset_spec_path(const std::string& preset);
 struct PipelineProgress {
   std::function<void(std::int64_t finished, std::int64_t total, const std::string& line)>
       campaign;                           ///< Per LBM unit (campaign::RunCampaignOptions).
-  consumers::RegressProgress regression;  ///< Per consumer run of the check.
+  workflows::RegressProgress regression;  ///< Per consumer run of the check.
   std::function<void()> stage_done;       ///< After each of the two (ends a progress line).
 };
 
@@ -77,7 +77,7 @@ struct PipelineSummary {
   std::string db_path;
   bool checked = false;          ///< The regression check ran.
   bool regress_skipped = false;  ///< It was not asked for.
-  consumers::RegressSummary check;
+  workflows::RegressSummary check;
   double campaign_s = 0.0, wall_s = 0.0;
 
   /// The command line's --json object.

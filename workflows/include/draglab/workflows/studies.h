@@ -3,7 +3,7 @@
 // Fig. 4, and Fig. 5 beside another study), and the work-precision study of one law (bubble
 // diameter, or a model's headline numbers, against grid and time step, with run times).
 //
-// The runs are consumers::run_sensitivity / run_work_precision; this layer loads the laws from
+// The runs are workflows::run_sensitivity / run_work_precision; this layer loads the laws from
 // the database (warning once per retracted or draft version), creates the output folder only
 // once every input has been checked, warns about runs that ended before t_ref or found no
 // bubble, writes the bundle (bed_results.h) atomically and draws the figure from it
@@ -15,9 +15,9 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/consumers/scene.h"
-#include "draglab/consumers/sensitivity.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/workflows/messages.h"
+#include "draglab/workflows/sensitivity.h"
 
 namespace draglab {
 namespace workflows {
@@ -33,7 +33,7 @@ struct StudyOutput {
 
 /// A law study as written.
 struct SensitivityStudy {
-  consumers::SensitivitySummary summary;
+  workflows::SensitivitySummary summary;
   std::string bundle_path;  ///< out_dir/sensitivity.json
   std::string figure_path;  ///< out_dir/fig4.png; "" when not drawn
   std::string beside_path;  ///< out_dir/fig5.png; "" when not drawn
@@ -43,7 +43,7 @@ struct SensitivityStudy {
 
 /// A work-precision study as written.
 struct WorkPrecisionStudy {
-  consumers::WorkPrecisionResult result;
+  workflows::WorkPrecisionResult result;
   std::string bundle_path;  ///< out_dir/work_precision.json
   std::string figure_path;  ///< out_dir/work_precision.png; "" when not drawn
   /// The bundle with out_dir, data and figure.
@@ -51,19 +51,19 @@ struct WorkPrecisionStudy {
 };
 
 /// Progress of a study: its fraction done and the stage now running (a settling, a run).
-using StudyProgress = consumers::SensitivityProgress;
+using StudyProgress = workflows::SensitivityProgress;
 
 /// Runs, writes and draws a law study. Bad input (draglab::Error, bad input) is found before the
 /// first run and leaves no folder; a figure that cannot be drawn is a runtime failure
 /// (std::runtime_error) after the bundle is written.
 SensitivityStudy run_sensitivity_study(const Database& db, const consumers::Scene& scene,
-                                       const consumers::SensitivityOptions& options,
+                                       const workflows::SensitivityOptions& options,
                                        const StudyOutput& output, const Messages& messages = {},
                                        const StudyProgress& progress = nullptr);
 
 /// The same for a work-precision study (`beside` does not apply).
 WorkPrecisionStudy run_work_precision_study(const Database& db, const consumers::Scene& scene,
-                                            const consumers::WorkPrecisionOptions& options,
+                                            const workflows::WorkPrecisionOptions& options,
                                             const StudyOutput& output,
                                             const Messages& messages = {},
                                             const StudyProgress& progress = nullptr);

@@ -1,6 +1,6 @@
 // Bubble diameter per drag law with its numerical uncertainty, and the work-precision study
-// (draglab/consumers/sensitivity.h, docs/scenes.md "Sensitivity and work-precision").
-#include "draglab/consumers/sensitivity.h"
+// (draglab/workflows/sensitivity.h, docs/scenes.md "Sensitivity and work-precision").
+#include "draglab/workflows/sensitivity.h"
 
 #include "draglab/consumers/bed_model.h"
 
@@ -18,7 +18,16 @@
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
-namespace consumers {
+namespace workflows {
+using consumers::BedModel;
+using consumers::BedProgress;
+using consumers::BedRealization;
+using consumers::BedResult;
+using consumers::check_run_options;
+using consumers::derive_scene;
+using consumers::find_bed_model;
+using consumers::run_bed_model;
+using consumers::TimeResolution;
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -940,5 +949,5 @@ std::string WorkPrecisionResult::FullReport() const {
   return s.str();
 }
 
-}  // namespace consumers
+}  // namespace workflows
 }  // namespace draglab

@@ -1,4 +1,4 @@
-// draglab/consumers/regress.h: regression checks of consumer predictions against stored
+// draglab/workflows/regress.h: regression checks of consumer predictions against stored
 // baselines (`draglab regress`, docs/scenes.md "Regression checks").
 //
 // A baseline (drag_db/consumer_results.h) fixes, for one registered scene and one law name, the
@@ -35,13 +35,14 @@
 #include <vector>
 
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/consumer_results.h"
 
 namespace draglab {
 class Database;
-namespace consumers {
+namespace workflows {
+using consumers::BedRunOptions;
+using consumers::Scene;
 
 /// Default tolerances of a baseline of `scene`: bubble diameter 2 gas cells (the larger cell
 /// side) + 10 % of the baseline diameter, U_mf 1 %; a DBM scene: bubble diameter 10 % without a
@@ -60,13 +61,6 @@ double headline_tolerance(const std::string& name, double baseline,
 /// The "headline" object of a stored result JSON (name, value; a null value is NaN), in the
 /// object's (alphabetical) order; empty without one or for text that is not a JSON object.
 std::vector<std::pair<std::string, double>> headline_of_result_json(const std::string& json);
-
-/// What a regression compares, from a DPM result: U_mf, background, the bubble at t_ref (its
-/// diameter and centroid height), the highest bed surface over the samples, wall time.
-ConsumerMetrics consumer_metrics_of(const DpmResult& result);
-/// The full DPM result as JSON text (the fields of `draglab scene run --json`, without the
-/// snapshot's particle arrays).
-std::string dpm_result_json(const DpmResult& result);
 
 /// One metric of a comparison.
 struct MetricComparison {
@@ -179,5 +173,5 @@ RegressSummary register_regression_baseline(Database& db, const Scene& scene,
                                             const RegressOptions& options,
                                             const RegressProgress& progress = nullptr);
 
-}  // namespace consumers
+}  // namespace workflows
 }  // namespace draglab

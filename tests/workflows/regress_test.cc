@@ -1,4 +1,4 @@
-// Regression-check logic (consumers/regress.h) without consumer runs.
+// Regression-check logic (workflows/regress.h) without consumer runs.
 //
 // Set-up: a fresh database per test (literature laws seeded: ergun@1), the tiny DPM scene
 // data/scenes/dpm_tiny.toml registered, and hand-written stored results (the DPM itself is
@@ -25,7 +25,7 @@
 //    0 exactly); one with every coefficient scaled by 1.1 (the Ergun branch at eps_mf 0.45: 10 %
 //    more drag) moves U_mf (measured -7 %, 0.0369 to 0.0343 m/s) and with it the hold-up
 //    (+36 %: the bubble gas flow u0 - U_mf grows by half) and the circulation (+27 %).
-#include "draglab/consumers/regress.h"
+#include "draglab/workflows/regress.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -41,8 +41,10 @@
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
-namespace consumers {
+namespace workflows {
 namespace {
+
+using namespace consumers;  // the bed models and scenes the studies run
 
 Scene TinyScene() { return load_scene(std::string(DRAGLAB_DATA_DIR) + "/scenes/dpm_tiny.toml"); }
 
@@ -399,5 +401,5 @@ TEST_F(RegressDbm, RunsOnADbmSceneAndComparesItsHeadlineNumbers) {
 }
 
 }  // namespace
-}  // namespace consumers
+}  // namespace workflows
 }  // namespace draglab

@@ -1,5 +1,5 @@
 // Regression checks of consumer predictions against stored baselines (regress.h).
-#include "draglab/consumers/regress.h"
+#include "draglab/workflows/regress.h"
 
 #include <algorithm>
 #include <chrono>
@@ -14,16 +14,28 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/consumers/bed_model.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
-#include "scene/scene_util.h"
 
 namespace draglab {
-namespace consumers {
+namespace workflows {
+using consumers::BedProgress;
+using consumers::consumer_result;
+using consumers::find_bed_model;
+using consumers::load_scene;
+using consumers::parse_scene;
+using consumers::run_bed_model;
 namespace {
 
-using scene_util::fail;
-using scene_util::fmt;
+/// A value for a message, with `digits` significant digits.
+std::string fmt(double x, int digits = 6) { return core::format_number(x, digits); }
+
+/// IsValid() helper: stores `message` in *error (if given) and returns false.
+bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -80,107 +92,7 @@ std::string pad(const std::string& s, std::size_t width) {
 }  // namespace
 
 RegressionTolerances default_regression_tolerances(const Scene& scene) {
-  RegressionTolerances t;
-  if (scene.solver == "dbm") {
-    // The DBM's "bubble diameter" is the mean size of its Lagrangian bubbles over the run: each
-    // bubble carries its volume exactly, none is traced on the grid, so there is no cell part.
-    // The 10 % covers the run-to-run scatter that coalescence brings (which bubbles meet
-    // depends on the injection phases and the flow; measured below: 0.04 %), and like the DPM's
-    // it is the smallest change of a bubble size a reactor prediction can use. Without
-    // coalescence every bubble keeps its injected size, so D moves only when that size does.
-    t.diameter_abs_m = 0.0;
-    t.diameter_rel = 0.10;
-    t.umf_rel = 0.01;  // as below
-    return t;
-  }
-  // Bubble diameter: bubble.h measures D from the cells above the threshold, so each run's D is
-  // off by up to one cell size h (the boundary of the region is resolved to a cell); two runs
-  // can differ by 2 h with no change in the physics. On top, 10 % of D: a single run of a DPM
-  // bubble scatters with the packing and the chaotic particle motion (several % between
-  // realizations of the same bed), and a drag law change smaller than that is not a change a
-  // bubble prediction can show.
-  const double dx = scene.geometry.width_m / std::max(scene.grid.cells_x, 1);
-  const double dy = scene.geometry.height_m / std::max(scene.grid.cells_y, 1);
-  t.diameter_abs_m = 2.0 * std::max(dx, dy);
-  t.diameter_rel = 0.10;
-  // U_mf comes from the law's force balance at eps_mf solved to 1e-12 (scene.h), with no
-  // run-to-run scatter: 1 % is a real change of the law at incipient fluidization (the five
-  // literature laws differ by 10-25 % there), small enough to catch a coefficient change that a
-  // noisy bubble metric would hide.
-  t.umf_rel = 0.01;
-  return t;
-}
-
-ConsumerMetrics consumer_metrics_of(const DpmResult& r) {
-  ConsumerMetrics m;
-  m.umf_m_s = r.umf_m_s;
-  m.background_m_s = r.background_m_s;
-  m.t_ref_s = r.t_ref_s;
-  m.bubble_present = r.bubble_at_t_ref;
-  m.bubble_diameter_m = r.bubble_at_t_ref ? r.bubble_diameter_m : 0.0;
-  // The centroid of the same sample as the diameter (nearest to t_ref).
-  const DpmSample* at_ref = nullptr;
-  for (const DpmSample& s : r.series) {
-    if (!at_ref || std::abs(s.t_s - r.t_ref_s) < std::abs(at_ref->t_s - r.t_ref_s)) at_ref = &s;
-    m.max_bed_height_m = std::max(m.max_bed_height_m, s.bed_height_m);
-  }
-  m.bubble_centroid_m = r.bubble_at_t_ref && at_ref ? at_ref->bubble_centroid_m : 0.0;
-  m.wall_s = r.wall_s;
-  return m;
-}
-
-std::string dpm_result_json(const DpmResult& r) {
-  nlohmann::json series = nlohmann::json::array();
-  for (const DpmSample& s : r.series) {
-    series.push_back({{"t_s", s.t_s},
-                      {"bubble_diameter_m", s.bubble_diameter_m},
-                      {"bubble_centroid_m", s.bubble_centroid_m},
-                      {"bed_height_m", s.bed_height_m},
-                      {"pressure_drop_pa", s.pressure_drop_pa}});
-  }
-  nlohmann::json j = {{"solver", "dpm"},
-                      {"scene", r.scene},
-                      {"scene_hash", r.scene_hash},
-                      {"law", r.law},
-                      {"umf_m_s", r.umf_m_s},
-                      {"background_m_s", r.background_m_s},
-                      {"background", r.background_mode},
-                      {"eps_mf", r.eps_mf},
-                      {"t_ref_s", r.t_ref_s},
-                      {"bubble_at_t_ref", r.bubble_at_t_ref},
-                      {"bubble_diameter_m", r.bubble_at_t_ref ? nlohmann::json(r.bubble_diameter_m)
-                                                              : nlohmann::json(nullptr)},
-                      {"series", series},
-                      {"particles", r.particles},
-                      {"settled_bed_height_m", r.settled_bed_height_m},
-                      {"gas_dt_s", r.gas_dt_s},
-                      {"dem_dt_s", r.dem_dt_s},
-                      {"threads", r.threads},
-                      {"gas_steps", r.gas_steps},
-                      {"dem_steps", r.dem_steps},
-                      {"settle_wall_s", r.settle_wall_s},
-                      {"wall_s", r.wall_s},
-                      {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
-                      {"momentum_mismatch", r.momentum_mismatch},
-                      {"max_action_reaction_mismatch_n", r.max_action_reaction_mismatch_n},
-                      {"void_fraction_clamps", r.void_fraction_clamps},
-                      {"drag_out_of_range", r.law_out_of_range},
-                      {"eps_packing", r.eps_packing},
-                      {"umf_packing_m_s", r.umf_packing_m_s},
-                      {"output_files", r.output_files}};
-  if (r.has_snapshot) {
-    const BubbleMetrics& b = r.snapshot.bubble;
-    j["snapshot"] = {{"t_s", r.snapshot.t_s},
-                     {"bubble_found", b.found},
-                     {"bubble_diameter_m", b.diameter_m},
-                     {"bubble_centroid_x_m", b.centroid_x_m},
-                     {"bubble_centroid_y_m", b.centroid_y_m},
-                     {"bubble_top_m", b.top_m},
-                     {"bubble_bottom_m", b.bottom_m},
-                     {"bubble_erupting", b.touches_surface},
-                     {"bed_height_m", b.bed_height_m}};
-  }
-  return j.dump();
+  return find_bed_model(scene.solver).default_tolerances(scene);
 }
 
 // Headline numbers (the DBM's hold-up and circulation; its bubble sizes use the diameter
@@ -608,5 +520,5 @@ RegressSummary register_regression_baseline(Database& db, const Scene& scene,
   return summary;
 }
 
-}  // namespace consumers
+}  // namespace workflows
 }  // namespace draglab

@@ -1,4 +1,4 @@
-// draglab/consumers/sensitivity.h: how much a bed model's bubble depends on the drag law, each
+// draglab/workflows/sensitivity.h: how much a bed model's bubble depends on the drag law, each
 // law's bubble diameter with its numerical uncertainty (the seed's Fig. 4 and 5 studies), and the
 // work-precision study of one law (bubble diameter against grid size and time step, with run
 // times). Every registered bed model (bed_model.h) runs through the same code: its realization
@@ -58,7 +58,11 @@
 #include "draglab/drag_db/law.h"
 
 namespace draglab {
-namespace consumers {
+namespace workflows {
+using consumers::BedRunOptions;
+using consumers::BedSample;
+using consumers::BedSnapshot;
+using consumers::Scene;
 
 /// Loads a law by "name@version" (the CLI passes Database::load with the scene's range policy,
 /// so consumers need not know the database). Called once per run, so each run gets a fresh
@@ -325,5 +329,5 @@ WorkPrecisionResult run_work_precision(const Scene& scene, const LawLoader& load
                                        const WorkPrecisionOptions& options,
                                        const SensitivityProgress& progress = nullptr);
 
-}  // namespace consumers
+}  // namespace workflows
 }  // namespace draglab

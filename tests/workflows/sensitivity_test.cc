@@ -1,4 +1,4 @@
-// The arithmetic and the input checks of draglab/consumers/sensitivity.h (no DPM run: the runs
+// The arithmetic and the input checks of draglab/workflows/sensitivity.h (no DPM run: the runs
 // themselves are tested end to end by tests/cli/sensitivity_test.sh), and the studies of a model
 // with headline numbers on data/scenes/dbm_tiny.toml (the DBM runs a 6 s bed in about a second).
 //
@@ -34,13 +34,15 @@
 #include <utility>
 #include <vector>
 
-#include "draglab/consumers/sensitivity.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
+#include "draglab/workflows/sensitivity.h"
 
 namespace draglab {
-namespace consumers {
+namespace workflows {
 namespace {
+
+using namespace consumers;  // the bed models and scenes the studies run
 
 TEST(SensitivityArithmetic, TwoRealizationsGiveHalfTheDifferenceInQuadratureWithTheCell) {
   const DiameterUncertainty u = realization_uncertainty({0.030, 0.026}, 0.0075);
@@ -439,5 +441,5 @@ TEST_F(SensitivityDbm, WorkPrecisionKeepsTheDepthAndComparesWithTheFinestConfigu
 }
 
 }  // namespace
-}  // namespace consumers
+}  // namespace workflows
 }  // namespace draglab
