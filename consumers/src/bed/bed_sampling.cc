@@ -83,6 +83,26 @@ std::string scene_output_directory(const Scene& scene, const std::string& overri
   return "out/" + scene.name;
 }
 
+BedResult result_header(const std::string& model, const Scene& scene,
+                        const std::string& law_reference, const std::string& background_mode) {
+  BedResult out;
+  out.model = model;
+  out.law = law_reference;
+  out.scene = scene.name;
+  out.scene_hash = scene.hash();
+  out.eps_mf = scene.eps_mf;
+  out.background_mode = background_mode;
+  return out;
+}
+
+std::vector<double> sample_times(double duration_s, double interval_s) {
+  const int samples = static_cast<int>(std::floor(duration_s / interval_s + 1e-9));
+  std::vector<double> times;
+  times.reserve(static_cast<std::size_t>(std::max(samples, 0)));
+  for (int n = 1; n <= samples; ++n) times.push_back(std::min(n * interval_s, duration_s));
+  return times;
+}
+
 }  // namespace internal
 }  // namespace consumers
 }  // namespace draglab

@@ -6,7 +6,9 @@
 #include <Eigen/Core>
 
 #include <string>
+#include <vector>
 
+#include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/bubble.h"
 #include "draglab/consumers/gas_phase.h"
 #include "draglab/consumers/scene.h"
@@ -27,6 +29,16 @@ BubbleOptions scene_bubble_options(const Scene& scene, double initial_bed_height
 /// Where a run writes the files its scene asks for: `override` (BedRunOptions), else the
 /// scene's [outputs] directory, else out/<scene name>.
 std::string scene_output_directory(const Scene& scene, const std::string& override_directory);
+
+/// A result with the header every model fills the same way: the model's key, the law
+/// (name@version), the scene, its hash and eps_mf, and how the background flow is set.
+BedResult result_header(const std::string& model, const Scene& scene,
+                        const std::string& law_reference, const std::string& background_mode);
+
+/// The sample times of a run of `duration_s` [s]: every `interval_s` [s] from the first
+/// interval on (a time within 1e-9 of an interval past the end still counts; the last time is
+/// cut to the duration).
+std::vector<double> sample_times(double duration_s, double interval_s);
 
 /// A cell field (nx x nz, Eigen index (i, j)) on the scene's grid as a GridField2D.
 GridField2D scene_grid_field(const Scene& scene, const Eigen::ArrayXXd& values);

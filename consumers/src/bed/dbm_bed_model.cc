@@ -236,20 +236,12 @@ class DbmBedModel : public BedModel {
     const double column_volume = o.width_m * o.depth_m * o.height_m;
     const double u_br = davies_taylor_rise_velocity(o.bubble_diameter_m, o.gravity_m_s2);
 
-    BedResult out;
-    out.model = key();
-    out.law = law_ref;
-    out.scene = scene.name;
-    out.scene_hash = scene.hash();
-    out.eps_mf = scene.eps_mf;
-    out.background_mode = "two_phase";
+    BedResult out = internal::result_header(key(), scene, law_ref, "two_phase");
     nlohmann::json series = nlohmann::json::array();
     std::vector<double> holdup_samples;  // after average_from_s, for the batch means
-    const double interval = sd.sample_interval_s;
-    const int samples = static_cast<int>(std::floor(duration / interval + 1e-9));
     try {
-      for (int n = 1; n <= samples; ++n) {
-        dbm.AdvanceTo(std::min(n * interval, duration));
+      for (const double t : internal::sample_times(duration, sd.sample_interval_s)) {
+        dbm.AdvanceTo(t);
         const auto& bubbles = dbm.bubbles();
         double d_sum = 0.0, z_sum = 0.0;
         for (const DbmBubble& b : bubbles) {

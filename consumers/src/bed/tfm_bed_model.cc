@@ -150,13 +150,8 @@ class TfmBedModel : public BedModel {
     internal::BedSampler sampler(scene, scene.bed_height_mf_m());
     const double dz = tfm.dz();
 
-    BedResult out;
-    out.model = key();
-    out.law = law->record().reference();
-    out.scene = scene.name;
-    out.scene_hash = scene.hash();
-    out.eps_mf = scene.eps_mf;
-    out.background_mode = to_string(scene.distributor.mode);
+    BedResult out = internal::result_header(key(), scene, law->record().reference(),
+                                            to_string(scene.distributor.mode));
     ConsumerMetrics& m = out.metrics;
     m.umf_m_s = derived.umf.umf_m_s;
     m.background_m_s = background;
@@ -165,12 +160,11 @@ class TfmBedModel : public BedModel {
     BedSample at_ref;
     bool have_ref = false;
     BubbleMetrics ref_bubble;
-    const int samples = static_cast<int>(std::floor(duration / interval + 1e-9));
     // Where the run stops: every sample, and every field output (each outputs.interval_s, or
     // once at t_ref when it is 0), in time order.
     std::unique_ptr<DpmOutputWriter> writer;
     std::vector<std::pair<double, bool>> stops;  // (time, is a field output)
-    for (int n = 1; n <= samples; ++n) stops.push_back({std::min(n * interval, duration), false});
+    for (const double t : internal::sample_times(duration, interval)) stops.push_back({t, false});
     if (scene.outputs.fields) {
       const std::string dir = internal::scene_output_directory(scene, options.output_directory);
       writer = std::make_unique<DpmOutputWriter>(scene, out.law, dir, true, false);
