@@ -388,6 +388,13 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
                                j.contains("error") ? fmt::format("; vs the series {:+.3f} %",
                                                                  100.0 * (r.F / reference - 1.0))
                                                    : "");
+      for (const lbm::SpeciesDrag& sd : result.species) {
+        std::cout << fmt::format(
+            "F_i              {} +- {} (d_i/<d> = {:.4g}, {:.3g} of the solids, {} spheres; "
+            "own diameter)\n",
+            format_number(sd.F), format_number(sd.F_standard_error, 2), sd.diameter,
+            sd.volume_fraction, sd.spheres);
+      }
       std::cout << fmt::format("K                {}\n", format_number(r.K));
       std::cout << fmt::format("beta d^2/mu      {}\n", format_number(r.beta_d2_over_mu));
       std::cout << fmt::format("Re               {} (target {})\n", format_number(r.re, 4),

@@ -669,6 +669,8 @@ VoxelGrid voxelize(const Packing& packing, const VoxelizationOptions& options,
   grid.solid.assign(static_cast<std::size_t>(grid.num_nodes()), 0);
   const std::int64_t num_spheres = static_cast<std::int64_t>(packing.size());
   grid.links.resize(packing.size());
+  grid.diameters.resize(packing.size());
+  for (std::size_t s = 0; s < packing.size(); ++s) grid.diameters[s] = 2.0 * packing.radii[s];
 
   std::vector<LatticeSphere> spheres(packing.size());
   for (std::size_t s = 0; s < packing.size(); ++s) {

@@ -1,6 +1,7 @@
 // case_run.cc: packing -> calibration -> voxelization -> run -> record (case_run.h).
 #include "draglab/lbm/case_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -80,6 +81,50 @@ void set_reference(const arrays::Packing& packing, const CaseOptions& options, C
                      : "Sangani-Acrivos series (SC, Stokes)";
 }
 
+/// The size classes of `packing` (distinct diameters, within a relative 1e-9) and each one's drag
+/// from the run's per-sphere drag (normalised with the packing's d_ref, the Sauter mean).
+std::vector<SpeciesDrag> species_drag(const arrays::Packing& packing, const RunResult& run) {
+  std::vector<SpeciesDrag> classes;
+  std::vector<int> class_of(packing.size());
+  for (std::size_t s = 0; s < packing.size(); ++s) {
+    const double y = 2.0 * packing.radii[s];
+    int c = 0;
+    while (c < static_cast<int>(classes.size()) &&
+           std::abs(classes[static_cast<std::size_t>(c)].diameter - y) > 1e-9 * y) {
+      ++c;
+    }
+    if (c == static_cast<int>(classes.size())) {
+      if (classes.size() == kMaxSpecies) return {};
+      SpeciesDrag sd;
+      sd.diameter = y;
+      classes.push_back(sd);
+    }
+    class_of[s] = c;
+  }
+  if (classes.size() < 2 || !run.converged || run.body_F.size() != packing.size()) return {};
+  double solids = 0.0;
+  for (double r : packing.radii) solids += r * r * r;
+  std::vector<double> sum(classes.size(), 0.0), sum2(classes.size(), 0.0);
+  for (std::size_t s = 0; s < packing.size(); ++s) {
+    SpeciesDrag& sd = classes[static_cast<std::size_t>(class_of[s])];
+    const double F_i = run.body_F[s] / sd.diameter;
+    ++sd.spheres;
+    sd.volume_fraction += packing.radii[s] * packing.radii[s] * packing.radii[s] / solids;
+    sum[static_cast<std::size_t>(class_of[s])] += F_i;
+    sum2[static_cast<std::size_t>(class_of[s])] += F_i * F_i;
+  }
+  for (std::size_t c = 0; c < classes.size(); ++c) {
+    SpeciesDrag& sd = classes[c];
+    const double n = static_cast<double>(sd.spheres);
+    sd.F = sum[c] / n;
+    const double var = n > 1.0 ? std::max(0.0, (sum2[c] - n * sd.F * sd.F) / (n - 1.0)) : 0.0;
+    sd.F_standard_error = std::sqrt(var / n);
+  }
+  std::sort(classes.begin(), classes.end(),
+            [](const SpeciesDrag& a, const SpeciesDrag& b) { return a.diameter < b.diameter; });
+  return classes;
+}
+
 /// The record without the field file's entries (it is stored in the field file itself).
 nlohmann::json record(const CaseResult& r, const CaseOptions& options) {
   RunOptions used = options.run;  // as run: with the hydrodynamic diameter it normalised with
@@ -99,6 +144,17 @@ nlohmann::json record(const CaseResult& r, const CaseOptions& options) {
                         {"F_series", cal.calibration.F_reference},
                         {"positions", cal.calibration.positions},
                         {"wall_s", cal.wall_s}};
+  }
+  if (!r.species.empty()) {
+    nlohmann::json species = nlohmann::json::array();
+    for (const SpeciesDrag& sd : r.species) {
+      species.push_back({{"diameter_over_sauter", sd.diameter},
+                         {"volume_fraction", sd.volume_fraction},
+                         {"spheres", sd.spheres},
+                         {"F", sd.F},
+                         {"F_standard_error", sd.F_standard_error}});
+    }
+    j["species"] = species;
   }
   if (r.hydrodynamic_diameter > 0.0) j["phi_hydrodynamic"] = r.phi_hydrodynamic;
   if (std::isfinite(r.reference_F)) {
@@ -206,6 +262,7 @@ CaseResult run_case(const arrays::Packing& packing, const CaseOptions& options,
   r.spheres = static_cast<std::int64_t>(packing.size());
   r.hydrodynamic_diameter = run.use_hydrodynamic_diameter ? run.hydrodynamic_diameter : 0.0;
   set_reference(packing, options, &r);
+  r.species = species_drag(packing, r.run);
   if (!options.fields.empty()) write_field_file(fields, grid, options, &r);
   return r;
 }

@@ -389,14 +389,9 @@ double force_for_velocity(double u, double nu, double d, double phi, double re) 
   return 18.0 * nu * u * f * phi / ((1.0 - phi) * d * d);
 }
 
-/// One run. `plan`: the velocity plan of a finite-Re run (null at Re = 0).
-RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
-                   Fields* fields, const ProgressCallback& progress, const VelocityPlan* plan) {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  auto seconds_since = [](Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-  };
+/// What run_impl needs of its inputs before any work: valid options, a well-formed grid with
+/// bodies, and an operator already chosen (run_planned resolves auto).
+void check_run_inputs(const arrays::VoxelGrid& grid, const RunOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, "lbm run: " + error);
   if (grid.dims[0] <= 0 || grid.dims[1] <= 0 || grid.dims[2] <= 0 ||
@@ -411,32 +406,23 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   if (options.collision == Collision::kAuto) {
     throw Error(ErrorCode::kInternal, "lbm run: the collision must be chosen before the run");
   }
-  RunResult result;
-  result.collision = options.collision;
-  result.phi_lattice = grid.phi_lattice();
-  result.phi = phi_exact > 0.0 ? phi_exact : result.phi_lattice;
-  result.d = options.use_hydrodynamic_diameter ? options.hydrodynamic_diameter : grid.resolution();
-  const double phi = result.phi;
-  const double d = result.d;
-  if (!(phi > 0.0 && phi < 1.0)) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "lbm run: solids fraction must be in (0, 1), got " + fmt("%g", phi));
-  }
-  const bool stokes = options.stokes_mode == RunOptions::StokesMode::kOn ||
-                      (options.stokes_mode == RunOptions::StokesMode::kAuto && options.re == 0.0);
-  result.stokes_mode = stokes;
-  const double target_re = options.re;
+}
 
-  // Relaxation times and the velocity scale. Finite Re: the plan (resolution.h). Re = 0 asks for
-  // creeping flow: a small velocity also with the full equilibrium (so that its u.u terms are
-  // negligible, not merely its Re undefined).
-  if (target_re > 0.0 && plan == nullptr) {
+/// The relaxation times of a run: a finite-Re run's from its velocity plan (resolution.h,
+/// recorded in the result with the plan's kappa, Mach target and cell Reynolds number), a Stokes
+/// run's given or the operator's default.
+struct Relaxation {
+  double tau = 0.0, tau_minus = 0.0, nu = 0.0;
+};
+Relaxation plan_relaxation(const RunOptions& options, const VelocityPlan* plan,
+                           RunResult* result_out) {
+  RunResult& result = *result_out;
+  if (options.re > 0.0 && plan == nullptr) {
     throw Error(ErrorCode::kInternal, "lbm run: a finite-Re run needs its velocity plan");
   }
-  const double budget_u = kStokesMaxSpeed * (1.0 - phi) / kPoreSpeedFactor;
   const double stokes_tau = options.collision == Collision::kTrt ? 1.5 : 1.0;
   double tau = options.tau;
-  if (target_re > 0.0) {
+  if (options.re > 0.0) {
     tau = plan->tau;
     result.pore_speed_ratio = plan->kappa;
     result.pore_speed_ratio_measured = plan->kappa_measured;
@@ -452,58 +438,37 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   result.tau = tau;
   result.tau_minus = tau_minus;
   result.nu = nu;
-  const double target_u = target_re > 0.0 ? target_re * nu / d : budget_u;
-  // Everything the run loop carries from check to check, kept together for a checkpoint.
-  LoopState loop;
-  double& force = loop.force;
-  force = force_for_velocity(target_u, nu, d, phi, target_re);
-  result.body_force = force;
-  // RunOptions::checkpoint: removed at the end by the run that resumed from it or wrote it,
-  // unless max_steps stopped the run (it can go on from there).
-  std::string checkpoint_path;
-  bool checkpoint_owned = false, keep_checkpoint = false;
+  return {tau, tau_minus, nu};
+}
 
-  auto fail = [&](const std::string& diagnosis) {
-    if (checkpoint_owned && !keep_checkpoint) std::remove(checkpoint_path.c_str());
-    result.converged = false;
-    result.diagnosis = diagnosis;
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    result.F = result.K = result.beta_d2_over_mu = result.F_standard_error = nan;
-    result.error_estimate = nan;
-    result.body_F.clear();
-    // The last Re the run reached (not a measurement: it says how far the run got).
-    if (!result.history.empty() && !(stokes && target_re == 0.0)) {
-      result.re = result.history.back().re;
-    }
-    result.wall_s = seconds_since(start);
-    if (options.throw_on_failure) throw Error(ErrorCode::kOutOfValidity, "lbm run: " + diagnosis);
-    return result;
-  };
-
+/// The diagnosis of relaxation times too close to 1/2 for the operator to hold ("" if they are
+/// not): a run that fails before its first step.
+std::string relaxation_too_close_to_half(const RunOptions& options, const Relaxation& r, double d) {
   const double min_gap =
       options.collision == Collision::kRegularized ? kMinTauGapRegularized : kMinTauGap;
-  if (tau - 0.5 < min_gap) {
-    return fail("tau = " + fmt("%.6g", tau) + " is within " + fmt("%g", min_gap) +
-                " of 1/2, the stability limit of " + to_string(options.collision) +
-                (options.tau == 0.0 ? " (tau = 1/2 + 3 U d / Re from the Mach budget at Re = " +
-                                          fmt("%g", target_re) + ", d = " + fmt("%g", d) + ")"
-                                    : std::string()) +
-                "; remedy: raise the resolution d (tau grows with d at fixed Re), lower Re, or "
-                "use the regularized collision (rr)");
+  if (r.tau - 0.5 < min_gap) {
+    return "tau = " + fmt("%.6g", r.tau) + " is within " + fmt("%g", min_gap) +
+           " of 1/2, the stability limit of " + to_string(options.collision) +
+           (options.tau == 0.0 ? " (tau = 1/2 + 3 U d / Re from the Mach budget at Re = " +
+                                     fmt("%g", options.re) + ", d = " + fmt("%g", d) + ")"
+                               : std::string()) +
+           "; remedy: raise the resolution d (tau grows with d at fixed Re), lower Re, or "
+           "use the regularized collision (rr)";
   }
-  if (options.collision == Collision::kTrt && tau_minus - 0.5 < kMinTauGap) {
-    return fail("TRT tau- = " + fmt("%.6g", tau_minus) + " (Lambda = " + fmt("%g", options.magic) +
-                ", tau+ = " + fmt("%g", tau) +
-                ") is within 1e-3 of 1/2; remedy: lower tau or raise Lambda");
+  if (options.collision == Collision::kTrt && r.tau_minus - 0.5 < kMinTauGap) {
+    return "TRT tau- = " + fmt("%.6g", r.tau_minus) + " (Lambda = " + fmt("%g", options.magic) +
+           ", tau+ = " + fmt("%g", r.tau) +
+           ") is within 1e-3 of 1/2; remedy: lower tau or raise Lambda";
   }
+  return "";
+}
 
-  // Lattice, links, solver. Several ranks share the box in slabs of z-planes (lattice.h); what
-  // one rank cannot build (memory), none goes on with.
-  const mpi::Communicator& group = options.ranks;
-  const int threads = resolve_threads(options.threads, group);
-  const std::size_t element = options.precision == Precision::kFloat ? 4 : 8;
+/// The solver's settings for the run's operator, relaxation and force; with rr and interpolated
+/// walls, the correction that gives the reflected values TRT's wall (recorded in the result).
+SolverSettings solver_settings(const RunOptions& options, const Relaxation& r, bool stokes,
+                               double force, RunResult* result) {
+  const double tau = r.tau, tau_minus = r.tau_minus;
   const bool interpolated = options.boundary == Boundary::kInterpolated;
-  const WallScheme wall = choose_wall(options, tau, stokes, &result);
   SolverSettings settings;
   settings.kernel = options.collision == Collision::kRegularized ? CollisionKernel::kRegularized
                                                                  : CollisionKernel::kTrt;
@@ -518,14 +483,29 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   if (options.collision == Collision::kRegularized && interpolated && options.rr_wall_correction &&
       wall_correction > 0.0) {
     settings.wall_correction = wall_correction;
-    result.wall_corrected = true;
-    result.wall_reason +=
-        std::string(result.wall_reason.empty() ? "" : "; ") +
+    result->wall_corrected = true;
+    result->wall_reason +=
+        std::string(result->wall_reason.empty() ? "" : "; ") +
         "rr: reflected values corrected to TRT's wall at Lambda = " + fmt("%g", options.magic);
   }
-  std::unique_ptr<SparseLattice> lattice_storage;
-  std::unique_ptr<LinkTable> links_storage;
+  return settings;
+}
+
+/// The lattice, its boundary links and the solver, built on every rank of the run's box (slabs
+/// of z-planes, lattice.h); what one rank cannot build (memory), none goes on with.
+struct Engine {
+  std::unique_ptr<SparseLattice> lattice;
+  std::unique_ptr<LinkTable> links;
   std::unique_ptr<SolverBase> solver;
+};
+Engine build_engine(const arrays::VoxelGrid& grid, const RunOptions& options, WallScheme wall,
+                    const SolverSettings& settings, int threads) {
+  const mpi::Communicator& group = options.ranks;
+  const std::size_t element = options.precision == Precision::kFloat ? 4 : 8;
+  Engine e;
+  std::unique_ptr<SparseLattice>& lattice_storage = e.lattice;
+  std::unique_ptr<LinkTable>& links_storage = e.links;
+  std::unique_ptr<SolverBase>& solver = e.solver;
   on_all_ranks(group, [&] {
     PlaneRange planes;
     if (group.size() > 1) {
@@ -561,23 +541,28 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     links_storage = std::make_unique<LinkTable>(lattice.build_links(grid, wall));
     solver = make_solver(options.precision, lattice, *links_storage, settings, threads, group);
   });
-  const SparseLattice& lattice = *lattice_storage;
-  const LinkTable& links = *links_storage;
-  // Counts over the whole box (every rank's share).
-  const std::int64_t fluid = group.sum(lattice.num_fluid());
-  const double total_nodes = static_cast<double>(grid.num_nodes());
-  const std::size_t bodies = links.num_bodies();
-  result.fluid_nodes = fluid;
-  result.ranks = group.size();
-  result.boundary_links = group.sum(static_cast<std::int64_t>(links.size()));
-  result.fallback_links = group.sum(links.fallback_links);
-  result.memory_bytes = static_cast<std::size_t>(group.sum(
+  return e;
+}
+
+/// What the result says of the lattice (node and link counts over every rank, memory, the
+/// sub-node gaps) and the warnings that go with it.
+void record_lattice(const arrays::VoxelGrid& grid, const Engine& engine,
+                    const mpi::Communicator& group, RunResult* result) {
+  RunResult& r = *result;
+  const SparseLattice& lattice = *engine.lattice;
+  const LinkTable& links = *engine.links;
+  const SolverBase* solver = engine.solver.get();
+  r.fluid_nodes = group.sum(lattice.num_fluid());
+  r.ranks = group.size();
+  r.boundary_links = group.sum(static_cast<std::int64_t>(links.size()));
+  r.fallback_links = group.sum(links.fallback_links);
+  r.memory_bytes = static_cast<std::size_t>(group.sum(
       static_cast<std::int64_t>(solver->bytes() + lattice.memory_bytes() + links.memory_bytes())));
-  result.narrow_gap_pairs = grid.gaps.narrow_pairs;
-  result.smallest_gap_nodes = grid.gaps.smallest_gap_nodes;
-  result.narrow_gap_fluid_fraction = grid.gaps.narrow_fluid_fraction();
+  r.narrow_gap_pairs = grid.gaps.narrow_pairs;
+  r.smallest_gap_nodes = grid.gaps.smallest_gap_nodes;
+  r.narrow_gap_fluid_fraction = grid.gaps.narrow_fluid_fraction();
   if (grid.gaps.narrow_pairs > 0 || grid.gaps.narrow_fluid_nodes > 0) {
-    result.warnings.push_back(
+    r.warnings.push_back(
         std::to_string(grid.gaps.narrow_pairs) +
         " sphere pairs have gaps below one lattice spacing (smallest " +
         fmt("%.3g", grid.gaps.smallest_gap_nodes) + " lattice units) and " +
@@ -585,12 +570,186 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
         " % of the fluid nodes lie in gaps one node wide: under-resolved gaps, run as the "
         "literature does (first-order bounce-back there); extrapolate in d for the error");
   }
-  if (result.fallback_links > 0) {
-    result.warnings.push_back(
-        std::to_string(result.fallback_links) + " of " + std::to_string(result.boundary_links) +
+  if (r.fallback_links > 0) {
+    r.warnings.push_back(
+        std::to_string(r.fallback_links) + " of " + std::to_string(r.boundary_links) +
         " interpolated links fell back to halfway bounce-back (the node behind them is solid: "
         "one-node gaps); the wall is first order there");
   }
+}
+
+/// The factor that turns the mean per-sphere drag F_d/(3 pi mu d_ref U) into the mixture drag of
+/// a polydisperse packing in the convention of van der Hoef et al. (2005), F = f d_ref^2 /
+/// (18 mu phi U) with f the drag force per unit volume (so that beta = 18 mu phi (1 - phi) F /
+/// d_ref^2 holds as for one size; d_ref is the Sauter mean diameter): N / sum (d_s/d_ref)^3. 1
+/// for a monodisperse packing (or a grid without diameters), whose F is the drag per sphere.
+double mixture_factor(const arrays::VoxelGrid& grid) {
+  const std::vector<double>& y = grid.diameters;
+  if (y.size() != grid.links.size() || y.empty()) return 1.0;
+  if (std::all_of(y.begin(), y.end(), [&y](double x) { return x == y.front(); })) return 1.0;
+  double cubes = 0.0;
+  for (double x : y) cubes += x * x * x;
+  return static_cast<double>(y.size()) / cubes;
+}
+
+/// The scales of a run that its result is normalised with.
+struct RunScales {
+  double phi = 0.0, d = 0.0, nu = 0.0, tau = 0.0;
+  bool stokes = false;
+  std::int64_t interval = 0;  ///< Steps between checks.
+  std::int64_t fluid = 0;     ///< Fluid nodes over every rank.
+  std::size_t bodies = 0;
+  double mixture = 1.0;  ///< mixture_factor of the grid.
+};
+
+/// The result of a converged run: F, K, beta, the achieved Re and the per-body drag (time means
+/// from the end of the start-up on for unsteady flow), the spread over bodies, the convergence
+/// residual and the error estimate.
+void normalise_converged(const LoopState& loop, const TimeAverage& average_F,
+                         const TimeAverage& average_re, const MomentSummary& m,
+                         const std::vector<double>& body_force, const RunScales& sc,
+                         const RunOptions& options, const arrays::VoxelGrid& grid,
+                         RunResult* result_out) {
+  RunResult& result = *result_out;
+  double relative_change = loop.relative_change;
+  result.converged = true;
+  result.body_force = loop.force;
+  result.superficial_velocity = loop.U;
+  result.re = sc.stokes && options.re == 0.0 ? 0.0 : loop.re_lattice;
+  result.body_F.resize(sc.bodies);
+  for (std::size_t s = 0; s < sc.bodies; ++s) {
+    result.body_F[s] = body_force[3 * s] / (3.0 * kPi * sc.nu * sc.d * loop.U);
+  }
+  result.momentum_balance_rel = loop.balance;
+  result.final_pore_speed_ratio = loop.U > 0.0 ? std::sqrt(m.max_speed2) / loop.U : 0.0;
+  result.final_cell_reynolds = std::sqrt(m.max_speed2) / sc.nu;
+  result.mass_change_rel = m.sum_drho / static_cast<double>(sc.fluid);
+  result.F = loop.F_mean;
+  if (loop.averaging) {
+    // The time means from the end of the start-up on (the same samples for every quantity).
+    result.unsteady = true;
+    result.F = average_F.mean;
+    result.F_time_error = average_F.standard_error;
+    result.re = average_re.mean;
+    result.re_standard_error = average_re.standard_error;
+    result.averaging_steps = static_cast<std::int64_t>(average_F.used) * sc.interval;
+    result.averaging_time =
+        static_cast<double>(result.averaging_steps) * (options.re * sc.nu / sc.d) / sc.d;
+    result.startup_steps =
+        loop.averaging_start + static_cast<std::int64_t>(average_F.truncated) * sc.interval;
+    result.averaging_restarts = loop.averaging_restarts;
+    for (std::size_t s = 0; s < sc.bodies; ++s) {
+      result.body_F[s] = time_average(loop.series_body[s], average_F.truncated).mean;
+    }
+    relative_change = average_F.standard_error / std::abs(average_F.mean);
+  }
+  // The spread of the per-sphere drag (normalised with d_ref) around its mean, in the units of
+  // F (the mixture's, sc.mixture = 1 for one size).
+  const double body_mean = result.F / sc.mixture;
+  double var = 0.0;
+  for (double f : result.body_F) var += (f - body_mean) * (f - body_mean);
+  result.F_standard_error = sc.bodies > 1
+                                ? sc.mixture * std::sqrt(var / static_cast<double>(sc.bodies - 1) /
+                                                         static_cast<double>(sc.bodies))
+                                : 0.0;
+  result.K = result.F / (1.0 - sc.phi);
+  result.beta_d2_over_mu = 18.0 * sc.phi * (1.0 - sc.phi) * result.F;
+  result.convergence_residual = relative_change;
+  ErrorModelInput em;
+  em.boundary = options.boundary;
+  em.collision = options.collision;
+  em.tau = sc.tau;
+  em.wall_corrected = result.wall_corrected;
+  em.magic = options.collision == Collision::kTrt || result.wall_corrected ? options.magic
+             : options.collision == Collision::kBgk ? (sc.tau - 0.5) * (sc.tau - 0.5)
+                                                    : 0.5 * (sc.tau - 0.5);
+  em.d = grid.resolution();
+  em.phi = sc.phi;
+  em.re = result.re;
+  em.precision = options.precision;
+  result.discretisation_error = discretisation_error_estimate(em);
+  widen_for_resolution(options, grid.resolution(), &result);
+  result.error_estimate = result.discretisation_error + result.convergence_residual;
+}
+
+/// One run. `plan`: the velocity plan of a finite-Re run (null at Re = 0).
+RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
+                   Fields* fields, const ProgressCallback& progress, const VelocityPlan* plan) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  auto seconds_since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  check_run_inputs(grid, options);
+  RunResult result;
+  result.collision = options.collision;
+  result.phi_lattice = grid.phi_lattice();
+  result.phi = phi_exact > 0.0 ? phi_exact : result.phi_lattice;
+  result.d = options.use_hydrodynamic_diameter ? options.hydrodynamic_diameter : grid.resolution();
+  const double phi = result.phi;
+  const double d = result.d;
+  if (!(phi > 0.0 && phi < 1.0)) {
+    throw Error(ErrorCode::kInvalidArgument,
+                "lbm run: solids fraction must be in (0, 1), got " + fmt("%g", phi));
+  }
+  const bool stokes = options.stokes_mode == RunOptions::StokesMode::kOn ||
+                      (options.stokes_mode == RunOptions::StokesMode::kAuto && options.re == 0.0);
+  result.stokes_mode = stokes;
+  const double target_re = options.re;
+
+  // Relaxation times and the velocity scale. Finite Re: the plan (resolution.h). Re = 0 asks for
+  // creeping flow: a small velocity also with the full equilibrium (so that its u.u terms are
+  // negligible, not merely its Re undefined).
+  const Relaxation relaxation = plan_relaxation(options, plan, &result);
+  const double tau = relaxation.tau, nu = relaxation.nu;
+  const double budget_u = kStokesMaxSpeed * (1.0 - phi) / kPoreSpeedFactor;
+  const double target_u = target_re > 0.0 ? target_re * nu / d : budget_u;
+  // Everything the run loop carries from check to check, kept together for a checkpoint.
+  LoopState loop;
+  double& force = loop.force;
+  force = force_for_velocity(target_u, nu, d, phi, target_re);
+  result.body_force = force;
+  // RunOptions::checkpoint: removed at the end by the run that resumed from it or wrote it,
+  // unless max_steps stopped the run (it can go on from there).
+  std::string checkpoint_path;
+  bool checkpoint_owned = false, keep_checkpoint = false;
+
+  auto fail = [&](const std::string& diagnosis) {
+    if (checkpoint_owned && !keep_checkpoint) std::remove(checkpoint_path.c_str());
+    result.converged = false;
+    result.diagnosis = diagnosis;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    result.F = result.K = result.beta_d2_over_mu = result.F_standard_error = nan;
+    result.error_estimate = nan;
+    result.body_F.clear();
+    // The last Re the run reached (not a measurement: it says how far the run got).
+    if (!result.history.empty() && !(stokes && target_re == 0.0)) {
+      result.re = result.history.back().re;
+    }
+    result.wall_s = seconds_since(start);
+    if (options.throw_on_failure) throw Error(ErrorCode::kOutOfValidity, "lbm run: " + diagnosis);
+    return result;
+  };
+
+  const std::string too_close = relaxation_too_close_to_half(options, relaxation, d);
+  if (!too_close.empty()) return fail(too_close);
+
+  // Lattice, links, solver. Several ranks share the box in slabs of z-planes (lattice.h); what
+  // one rank cannot build (memory), none goes on with.
+  const mpi::Communicator& group = options.ranks;
+  const int threads = resolve_threads(options.threads, group);
+  const WallScheme wall = choose_wall(options, tau, stokes, &result);
+  const SolverSettings settings = solver_settings(options, relaxation, stokes, force, &result);
+  const Engine engine = build_engine(grid, options, wall, settings, threads);
+  const SparseLattice& lattice = *engine.lattice;
+  const LinkTable& links = *engine.links;
+  SolverBase* const solver = engine.solver.get();
+  record_lattice(grid, engine, group, &result);
+  // Counts over the whole box (every rank's share).
+  const std::int64_t fluid = result.fluid_nodes;
+  const double total_nodes = static_cast<double>(grid.num_nodes());
+  const std::size_t bodies = links.num_bodies();
+  const double mixture = mixture_factor(grid);
 
   // Characteristic time and check interval (even: the AA pattern advances in pairs).
   const double char_time = d * d / (nu * (1.0 + target_re));
@@ -653,7 +812,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
                       "then starts afresh)");
     }
     fingerprint = run_fingerprint(grid, lattice, links, options, settings, result, interval, group);
-    if (resume_from_checkpoint(checkpoint_path, fingerprint, group, solver.get(), &loop, &result)) {
+    if (resume_from_checkpoint(checkpoint_path, fingerprint, group, solver, &loop, &result)) {
       checkpoint_owned = true;
       saved_step = step;
     }
@@ -771,7 +930,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     re_lattice = U * d / nu;
     double sum_fx = 0.0;
     for (std::size_t s = 0; s < bodies; ++s) sum_fx += body_force[3 * s];
-    F_mean = sum_fx / static_cast<double>(bodies) / (3.0 * kPi * nu * d * U);
+    F_mean = sum_fx / static_cast<double>(bodies) / (3.0 * kPi * nu * d * U) * mixture;
     if (!std::isfinite(F_mean)) {
       if (fields != nullptr) solver->fill_fields(fields);
       return fail(instability("a non-finite drag (superficial velocity " + fmt("%.3g", U) + ")",
@@ -952,59 +1111,17 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   }
 
   // Converged: normalise.
-  result.converged = true;
-  result.body_force = force;
-  result.superficial_velocity = U;
-  result.re = stokes && target_re == 0.0 ? 0.0 : re_lattice;
-  result.body_F.resize(bodies);
-  for (std::size_t s = 0; s < bodies; ++s) {
-    result.body_F[s] = body_force[3 * s] / (3.0 * kPi * nu * d * U);
-  }
-  result.momentum_balance_rel = balance;
-  result.final_pore_speed_ratio = U > 0.0 ? std::sqrt(m.max_speed2) / U : 0.0;
-  result.final_cell_reynolds = std::sqrt(m.max_speed2) / nu;
-  result.mass_change_rel = m.sum_drho / static_cast<double>(fluid);
-  result.F = F_mean;
-  if (averaging) {
-    // The time means from the end of the start-up on (the same samples for every quantity).
-    result.unsteady = true;
-    result.F = average_F.mean;
-    result.F_time_error = average_F.standard_error;
-    result.re = average_re.mean;
-    result.re_standard_error = average_re.standard_error;
-    result.averaging_steps = static_cast<std::int64_t>(average_F.used) * interval;
-    result.averaging_time = static_cast<double>(result.averaging_steps) * (target_re * nu / d) / d;
-    result.startup_steps =
-        averaging_start + static_cast<std::int64_t>(average_F.truncated) * interval;
-    result.averaging_restarts = averaging_restarts;
-    for (std::size_t s = 0; s < bodies; ++s) {
-      result.body_F[s] = time_average(series_body[s], average_F.truncated).mean;
-    }
-    relative_change = average_F.standard_error / std::abs(average_F.mean);
-  }
-  double var = 0.0;
-  for (double f : result.body_F) var += (f - result.F) * (f - result.F);
-  result.F_standard_error =
-      bodies > 1 ? std::sqrt(var / static_cast<double>(bodies - 1) / static_cast<double>(bodies))
-                 : 0.0;
-  result.K = result.F / (1.0 - phi);
-  result.beta_d2_over_mu = 18.0 * phi * (1.0 - phi) * result.F;
-  result.convergence_residual = relative_change;
-  ErrorModelInput em;
-  em.boundary = options.boundary;
-  em.collision = options.collision;
-  em.tau = tau;
-  em.wall_corrected = result.wall_corrected;
-  em.magic = options.collision == Collision::kTrt || result.wall_corrected ? options.magic
-             : options.collision == Collision::kBgk ? (tau - 0.5) * (tau - 0.5)
-                                                    : 0.5 * (tau - 0.5);
-  em.d = grid.resolution();
-  em.phi = phi;
-  em.re = result.re;
-  em.precision = options.precision;
-  result.discretisation_error = discretisation_error_estimate(em);
-  widen_for_resolution(options, grid.resolution(), &result);
-  result.error_estimate = result.discretisation_error + result.convergence_residual;
+  RunScales scales;
+  scales.phi = phi;
+  scales.d = d;
+  scales.nu = nu;
+  scales.tau = tau;
+  scales.stokes = stokes;
+  scales.interval = interval;
+  scales.fluid = fluid;
+  scales.bodies = bodies;
+  scales.mixture = mixture;
+  normalise_converged(loop, average_F, average_re, m, body_force, scales, options, grid, &result);
   if (fields != nullptr) solver->fill_fields(fields);
   if (checkpoint_owned) std::remove(checkpoint_path.c_str());
   result.wall_s = seconds_since(start);

@@ -6,6 +6,9 @@
 // al. 2005's procedure). Checked: the record is the run's (the same F as lbm::run on the same
 // voxelization, to the bit), the lattice and the reference are named, a field file is written
 // and its failure kept beside a complete drag, and bad case options are refused before any work.
+// Bidisperse packings: each size class's drag with its own diameter, and the mixture's F in van
+// der Hoef et al. (2005)'s convention (drag force per unit volume, d_ref the Sauter mean), checked
+// against the per-sphere forces it is made of and against beta.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -110,6 +113,58 @@ TEST(CaseRun, WritesTheFieldFileOrKeepsItsFailureBesideTheDrag) {
   j = nlohmann::json::parse(failed.ToJson(co));
   EXPECT_TRUE(j.at("fields").is_null());
   EXPECT_EQ(j.at("fields_error"), failed.fields_error);
+}
+
+TEST(CaseRun, BidisperseGivesEachSizeClassAndTheMixtureInVanDerHoefsConvention) {
+  arrays::RandomPackingOptions po;
+  po.phi = 0.3;
+  po.n = 24;
+  po.distribution = arrays::SizeDistribution::kBidisperse;
+  po.size_ratio = 2.0;
+  po.large_volume_fraction = 0.5;
+  po.seed = 5;
+  const arrays::Packing packing = arrays::generate_random_packing(po);
+  const CaseResult r = run_case(packing, stokes_case(8.0));
+  ASSERT_TRUE(r.run.converged) << r.run.diagnosis;
+  ASSERT_EQ(r.species.size(), 2u);
+  const SpeciesDrag& small = r.species[0];
+  const SpeciesDrag& large = r.species[1];
+  EXPECT_NEAR(large.diameter / small.diameter, 2.0, 1e-12);
+  EXPECT_EQ(small.spheres + large.spheres, 24);
+  EXPECT_NEAR(small.volume_fraction + large.volume_fraction, 1.0, 1e-12);
+  EXPECT_NEAR(large.volume_fraction, 0.5, 0.5 / large.spheres);  // whole spheres
+
+  // The classes from the per-sphere forces (normalised with d_ref, the Sauter mean).
+  double sum_y3 = 0.0, sum_small = 0.0, sum_large = 0.0, sum_body = 0.0;
+  for (std::size_t s = 0; s < packing.size(); ++s) {
+    const double y = 2.0 * packing.radii[s];
+    sum_y3 += y * y * y;
+    sum_body += r.run.body_F[s];
+    (y < 1.0 ? sum_small : sum_large) += r.run.body_F[s] / y;
+  }
+  EXPECT_NEAR(small.F, sum_small / small.spheres, 1e-12 * small.F);
+  EXPECT_NEAR(large.F, sum_large / large.spheres, 1e-12 * large.F);
+  // The mixture: total drag per unit volume, f = sum_s F_d,s / V, as F = f d_ref^2/(18 mu phi U)
+  // = (sum_s F_d,s/(3 pi mu d_ref U)) / sum_s y_s^3 = sum_i x_i F_i / y_i^2; beta from it as for
+  // one size.
+  EXPECT_NEAR(r.run.F, sum_body / sum_y3, 1e-12 * r.run.F);
+  const double by_classes = small.volume_fraction * small.F / (small.diameter * small.diameter) +
+                            large.volume_fraction * large.F / (large.diameter * large.diameter);
+  EXPECT_NEAR(r.run.F, by_classes, 1e-12 * r.run.F);
+  EXPECT_NEAR(r.run.beta_d2_over_mu, 18.0 * r.run.phi * (1.0 - r.run.phi) * r.run.F,
+              1e-12 * r.run.beta_d2_over_mu);
+  // The large spheres carry more drag per own diameter (van der Hoef et al. 2005: F_i grows
+  // with y_i as (1 - phi) y_i + phi y_i^2; a ratio near 2.5 at phi 0.3).
+  EXPECT_GT(large.F / small.F, 1.5);
+  EXPECT_LT(large.F / small.F, 3.5);
+
+  const auto j = nlohmann::json::parse(r.ToJson(stokes_case(8.0)));
+  ASSERT_EQ(j.at("species").size(), 2u);
+  EXPECT_EQ(j.at("species")[1].at("F").get<double>(), large.F);
+
+  // One size: no classes, and F the mean over the spheres.
+  const CaseResult mono = run_case(sc_packing(0.125), stokes_case(8.0));
+  EXPECT_TRUE(mono.species.empty());
 }
 
 TEST(CaseRun, RefusesBadCaseOptionsBeforeAnyWork) {

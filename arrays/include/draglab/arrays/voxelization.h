@@ -90,7 +90,9 @@ struct VoxelGrid {
   double dx = 1.0;                               ///< Node spacing in d_ref.
   std::vector<std::uint8_t> solid;               ///< 1 = solid, 0 = fluid; size nx*ny*nz.
   std::vector<std::vector<BoundaryLink>> links;  ///< links[s]: boundary links of sphere s.
-  GapSummary gaps;                               ///< Filled by voxelize().
+  /// diameters[s]: the diameter of sphere s in d_ref (empty for a grid not made by voxelize).
+  std::vector<double> diameters;
+  GapSummary gaps;  ///< Filled by voxelize().
 
   std::int64_t num_nodes() const { return dims[0] * dims[1] * dims[2]; }
   std::int64_t index(std::int64_t i, std::int64_t j, std::int64_t k) const {

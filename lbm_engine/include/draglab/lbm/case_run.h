@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "draglab/arrays/packing.h"
 #include "draglab/lbm/calibration.h"
@@ -34,6 +35,25 @@ struct CaseOptions {
   bool IsValid(std::string* error) const;
 };
 
+/// The drag on one size class of a packing with a few distinct diameters (bidisperse, ...), in
+/// the polydisperse convention of van der Hoef et al. (2005): each sphere's drag force over
+/// 3 pi mu d_i U, with its own diameter d_i and the superficial velocity U; the mixture's F and
+/// Re use the Sauter mean diameter <d> (the packing's d_ref), and F = sum over classes of
+/// x_i F_i / y_i^2 (RunResult::F).
+struct SpeciesDrag {
+  double diameter = 0.0;         ///< y_i = d_i/<d>.
+  double volume_fraction = 0.0;  ///< x_i: the class's share of the solids volume.
+  std::int64_t spheres = 0;
+  double F = 0.0;  ///< Mean over the class's spheres (time means for unsteady flow).
+  /// Standard error of that mean over the spheres (0 with one sphere): the spread of the
+  /// sphere-to-sphere drag in one packing, not the discretisation error.
+  double F_standard_error = 0.0;
+};
+
+/// At most this many distinct diameters make size classes (a lognormal packing, whose every
+/// sphere differs, reports none).
+constexpr int kMaxSpecies = 8;
+
 struct CaseResult {
   RunResult run;
   std::array<std::int64_t, 3> dims{0, 0, 0};
@@ -44,6 +64,9 @@ struct CaseResult {
   double hydrodynamic_diameter = 0.0;
   double phi_hydrodynamic = 0.0;
   std::optional<CalibrationResult> calibration;
+  /// Per size class, smallest first, when the packing has 2 to kMaxSpecies distinct diameters
+  /// and the run converged; empty otherwise.
+  std::vector<SpeciesDrag> species;
   /// The exact F where one is known (Stokes flow through an SC array: the Sangani-Acrivos series,
   /// at phi_hydrodynamic with a hydrodynamic diameter), NaN otherwise; `reference` names it.
   double reference_F = 0.0;
@@ -52,7 +75,7 @@ struct CaseResult {
   /// not asked for.
   std::string fields_error;
   /// The run's JSON record (RunResult::ToJson) with the case's: re_target, resolution, dims,
-  /// spheres, case, calibration, phi_hydrodynamic, reference_F and error, fields.
+  /// spheres, case, calibration, species, phi_hydrodynamic, reference_F and error, fields.
   std::string ToJson(const CaseOptions& options) const;
 };
 

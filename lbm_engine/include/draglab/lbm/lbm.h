@@ -219,10 +219,14 @@ struct RunResult {
   std::int64_t steps = 0;
   double wall_s = 0.0;
   double mflups = 0.0;  ///< Million fluid-node updates per second.
-  // Drag (NaN unless converged).
+  // Drag (NaN unless converged). One sphere size: F = F_d/(3 pi mu d U), the mean over the
+  // spheres. Several sizes (d_ref the Sauter mean): the mixture's F = f d_ref^2/(18 mu phi U),
+  // f the drag force per unit volume (van der Hoef et al. 2005), so that K and beta follow from
+  // F as for one size.
   double F = 0.0, K = 0.0, beta_d2_over_mu = 0.0;
   double F_standard_error = 0.0;  ///< Over the bodies (spread of per-sphere drag / sqrt(N)).
-  std::vector<double> body_F;     ///< Per-body drag-only F along the flow (x) direction.
+  /// Per body (sphere s of the packing): F_d/(3 pi mu d_ref U) along the flow (x) direction.
+  std::vector<double> body_F;
   // State.
   /// Achieved Re = U d / nu; 0 for a Stokes-mode run with target 0 (the linear scheme solves
   /// the Re -> 0 limit; the lattice U d / nu is then only a scale, kept in the history).
