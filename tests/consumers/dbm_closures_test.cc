@@ -18,7 +18,7 @@
 
 #include <cmath>
 
-#include "draglab/consumers/dbm_closures.h"
+#include "dbm/dbm_closures.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {

@@ -31,13 +31,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dbm/dbm.h"
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/dbm.h"
-#include "draglab/consumers/mac_pressure.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
 #include "gas/mac_operators.h"
+#include "gas/mac_pressure.h"
 
 namespace draglab {
 namespace consumers {

@@ -29,8 +29,8 @@
 #include <string>
 #include <vector>
 
-#include "draglab/consumers/dpm_output.h"
 #include "draglab/drag_db/error.h"
+#include "io/dpm_output.h"
 
 namespace draglab {
 namespace consumers {

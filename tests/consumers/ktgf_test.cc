@@ -38,8 +38,8 @@
 #include <string>
 #include <vector>
 
-#include "draglab/consumers/ktgf.h"
 #include "draglab/drag_db/error.h"
+#include "tfm/ktgf.h"
 
 namespace draglab {
 namespace consumers {

@@ -17,11 +17,11 @@
 #include <unistd.h>
 
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/ktgf.h"
 #include "draglab/consumers/scene.h"
-#include "draglab/consumers/tfm.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
+#include "tfm/ktgf.h"
+#include "tfm/tfm.h"
 
 #include <nlohmann/json.hpp>
 

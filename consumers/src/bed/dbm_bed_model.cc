@@ -20,7 +20,7 @@
 
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
-#include "draglab/consumers/dbm.h"
+#include "dbm/dbm.h"
 #include "draglab/core/files.h"
 #include "draglab/drag_db/error.h"
 

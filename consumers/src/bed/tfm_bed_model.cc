@@ -14,10 +14,10 @@
 
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
-#include "draglab/consumers/dpm_output.h"
-#include "draglab/consumers/tfm.h"
 #include "draglab/drag_db/error.h"
+#include "io/dpm_output.h"
 #include "scene/scene_ktgf.h"
+#include "tfm/tfm.h"
 
 namespace draglab {
 namespace consumers {

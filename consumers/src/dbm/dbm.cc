@@ -1,6 +1,6 @@
-// The discrete bubble model (draglab/consumers/dbm.h): emulsion on the 3-D MAC grid, bubbles,
+// The discrete bubble model (consumers/src/dbm/dbm.h): emulsion on the 3-D MAC grid, bubbles,
 // injection, coalescence and the time averages.
-#include "draglab/consumers/dbm.h"
+#include "dbm/dbm.h"
 
 #include <Eigen/Geometry>
 
@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "draglab/consumers/mac_pressure.h"
 #include "draglab/drag_db/error.h"
 #include "gas/mac_operators.h"
+#include "gas/mac_pressure.h"
 #include "gas/particle_kernel.h"
 #include "scene/scene_util.h"
 

@@ -1,5 +1,5 @@
-// The discrete bubble model's bubble-scale closures (draglab/consumers/dbm_closures.h).
-#include "draglab/consumers/dbm_closures.h"
+// The discrete bubble model's bubble-scale closures (consumers/src/dbm/dbm_closures.h).
+#include "dbm/dbm_closures.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // DpmSimulation: the coupled CFD-DEM run (draglab/consumers/dpm.h, docs/dpm.md).
 #include "draglab/consumers/dpm.h"
 
-#include "draglab/consumers/dpm_output.h"
+#include "io/dpm_output.h"
 
 #include "bed/bed_sampling.h"
 

@@ -15,7 +15,7 @@
 // projected velocity satisfies the implicit momentum equation and continuity together.
 #include "draglab/consumers/gas_phase.h"
 
-#include "draglab/consumers/mac_pressure.h"
+#include "gas/mac_pressure.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
-// The pressure equation of the MAC-grid projections (draglab/consumers/mac_pressure.h).
-#include "draglab/consumers/mac_pressure.h"
+// The pressure equation of the MAC-grid projections (consumers/src/gas/mac_pressure.h).
+#include "gas/mac_pressure.h"
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>

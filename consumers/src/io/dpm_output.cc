@@ -1,6 +1,6 @@
 // Gas fields and particles of a DPM run to HDF5 (C API, Debian's libhdf5 1.10) with an XDMF 2
 // index for ParaView's XDMFReader. Layout and axis mapping: dpm_output.h and docs/dpm.md.
-#include "draglab/consumers/dpm_output.h"
+#include "io/dpm_output.h"
 
 #include <hdf5.h>
 #include <unistd.h>

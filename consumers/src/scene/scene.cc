@@ -18,11 +18,11 @@
 #include "draglab/core/toml_schema.h"
 
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/ktgf.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
 #include "scene/scene_ktgf.h"
 #include "scene/scene_util.h"
+#include "tfm/ktgf.h"
 
 namespace draglab {
 namespace consumers {

@@ -2,8 +2,8 @@
 // validation and the two-fluid model.
 #pragma once
 
-#include "draglab/consumers/ktgf.h"
 #include "draglab/consumers/scene.h"
+#include "tfm/ktgf.h"
 
 namespace draglab {
 namespace consumers {

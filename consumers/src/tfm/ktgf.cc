@@ -1,6 +1,6 @@
-// KTGF closures (draglab/consumers/ktgf.h): every coefficient of the solids stress, the
+// KTGF closures (consumers/src/tfm/ktgf.h): every coefficient of the solids stress, the
 // granular conductivity and the collisional dissipation, in one place.
-#include "draglab/consumers/ktgf.h"
+#include "tfm/ktgf.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// The two-fluid model (draglab/consumers/tfm.h, docs/tfm.md).
+// The two-fluid model (consumers/src/tfm/tfm.h, docs/tfm.md).
 //
 // Why partial elimination: the drag relaxation time of the gas, eps rho_g / beta, is ~1e-4 s in
 // a bed of 2.5 mm glass and ~1e-7 s for 100 um powders; solving the 2 x 2 drag system of a face
@@ -11,7 +11,7 @@
 // keeps phi <= packing_limit by itself (only the solids pressure does, and it is explicit here);
 // limiting the solids flux into a full cell, and letting the gas take the limited volume on the
 // same face, bounds phi without breaking either conservation law.
-#include "draglab/consumers/tfm.h"
+#include "tfm/tfm.h"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -23,9 +23,9 @@
 #include <sstream>
 #include <vector>
 
-#include "draglab/consumers/mac_pressure.h"
 #include "draglab/drag_db/error.h"
 #include "gas/mac_operators.h"
+#include "gas/mac_pressure.h"
 #include "scene/scene_util.h"
 
 namespace draglab {

@@ -1,4 +1,4 @@
-// draglab/consumers/dpm_output.h: the cell fields of any bed model (the DPM's gas, the
+// io/dpm_output.h: the cell fields of any bed model (the DPM's gas, the
 // two-fluid model's two phases) and the DPM's particles to HDF5 with an XDMF index that ParaView
 // opens (only when a scene's [outputs] asks for them).
 //

@@ -1,4 +1,4 @@
-// draglab/consumers/dbm.h: the discrete bubble model (seed Section 5, Eqs. 16-19): bubbles as
+// dbm/dbm.h: the discrete bubble model (seed Section 5, Eqs. 16-19): bubbles as
 // Lagrangian spheres in a continuous emulsion, for reactor-scale beds.
 //
 // Emulsion: the volume-averaged Navier-Stokes equations of an incompressible Newtonian fluid of
@@ -47,7 +47,7 @@
 #include <utility>
 #include <vector>
 
-#include "draglab/consumers/dbm_closures.h"
+#include "dbm/dbm_closures.h"
 #include "draglab/consumers/gas_phase.h"
 
 namespace draglab {

@@ -1,4 +1,4 @@
-// draglab/consumers/ktgf.h: closures of the kinetic theory of granular flow (KTGF) for the
+// tfm/ktgf.h: closures of the kinetic theory of granular flow (KTGF) for the
 // solids phase of the two-fluid model (tfm.h, seed Eqs. 14-15), and the frictional stresses
 // added near packing.
 //

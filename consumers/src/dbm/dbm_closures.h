@@ -1,4 +1,4 @@
-// draglab/consumers/dbm_closures.h: the bubble-scale closures of the discrete bubble model (seed
+// dbm/dbm_closures.h: the bubble-scale closures of the discrete bubble model (seed
 // Section 5, Eqs. 18-19): the force model of one bubble in the emulsion and the bubble-size and
 // hold-up relations the DBM is set up and checked with. Every coefficient is in
 // consumers/src/dbm/dbm_closures.cc.

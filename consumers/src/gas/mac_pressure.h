@@ -1,4 +1,4 @@
-// draglab/consumers/mac_pressure.h: the pressure equation of a projection on the staggered (MAC)
+// gas/mac_pressure.h: the pressure equation of a projection on the staggered (MAC)
 // grid of the bed models, shared by the gas phase of the DPM (gas_phase.h), the two-fluid model
 // (tfm.h) and the emulsion of the discrete bubble model (dbm.h). The grid is 3-D (x across the
 // width, y across the depth, z up); the pseudo-2D models use its 2-D mode, one cell across the

@@ -1,4 +1,4 @@
-// draglab/consumers/tfm.h: the two-fluid model (TFM) of a pseudo-2-D fluidized bed with the
+// tfm/tfm.h: the two-fluid model (TFM) of a pseudo-2-D fluidized bed with the
 // kinetic theory of granular flow, one loaded drag law coupling the phases.
 //
 // Equations (seed Eqs. 8-9 gas, 11-13 solids, 15 granular temperature), on the 2-D staggered
@@ -39,8 +39,8 @@
 #include <string>
 
 #include "draglab/consumers/gas_phase.h"
-#include "draglab/consumers/ktgf.h"
 #include "draglab/drag_db/law.h"
+#include "tfm/ktgf.h"
 
 namespace draglab {
 namespace consumers {
