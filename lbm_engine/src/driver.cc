@@ -663,7 +663,11 @@ void normalise_converged(const LoopState& loop, const TimeAverage& average_F,
   em.magic = options.collision == Collision::kTrt || result.wall_corrected ? options.magic
              : options.collision == Collision::kBgk ? (sc.tau - 0.5) * (sc.tau - 0.5)
                                                     : 0.5 * (sc.tau - 0.5);
-  em.d = grid.resolution();
+  // The smallest spheres carry the largest discretisation error: their diameter in lattice units
+  // (d itself for one size of diameter d_ref).
+  em.d = grid.resolution() *
+         (grid.diameters.empty() ? 1.0
+                                 : *std::min_element(grid.diameters.begin(), grid.diameters.end()));
   em.phi = sc.phi;
   em.re = result.re;
   em.precision = options.precision;
