@@ -38,6 +38,7 @@ struct RunCommand {
 struct ExportCommand {
   std::string id;
   bool csv = false;
+  bool species = false;
   std::string out;
 };
 
@@ -320,6 +321,18 @@ void run_export(const CliContext& ctx, const ExportCommand& c) {
   if (!c.out.empty()) core::check_output_file(c.out, "--out");
   std::unique_ptr<Database> db = ctx.open_database(true);
   const campaign::CampaignStatus st = campaign::campaign_status(*db, c.id);
+  if (c.species) {
+    std::size_t rows = 0;
+    const std::string text = campaign::export_species_csv(*db, st.id, &rows);
+    if (c.out.empty()) {
+      std::cout << text;
+    } else {
+      core::write_file_atomically(c.out, text, "--out");
+    }
+    ctx.info(fmt::format("{} size-class rows of campaign {}{}{}", rows, st.name,
+                         c.out.empty() ? "" : " to ", c.out));
+    return;
+  }
   const campaign::UnitsExport units = campaign::export_units(*db, st.id);
   const std::string text = c.csv ? units.csv
                                  : nlohmann::json({{"campaign", status_json(st)},
@@ -507,10 +520,14 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
     auto o = std::make_shared<ExportCommand>();
     cmd->add_option("campaign", o->id, "Campaign id or name")->required();
     cmd->add_flag("--csv", o->csv, "CSV instead of JSON");
+    cmd->add_flag("--species", o->species,
+                  "CSV of the drag of each size class of each finished unit (polydisperse "
+                  "packings): y, x, F_i with its own diameter, the mixture's F");
     cmd->add_option("--out", o->out, "Output file (default: stdout)");
     cmd->footer(
         "Examples:\n  draglab campaign export 1 > units.json\n"
-        "  draglab campaign export quick --csv --out units.csv");
+        "  draglab campaign export quick --csv --out units.csv\n"
+        "  draglab campaign export bidisperse --species --out species.csv");
     cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_export(ctx, *o); }; });
   }
 

@@ -87,5 +87,32 @@ UnitsExport export_units(const Database& db, std::int64_t campaign_id) {
   return out;
 }
 
+std::string export_species_csv(const Database& db, std::int64_t campaign_id, std::size_t* rows) {
+  const nlohmann::json units = nlohmann::json::parse(export_units(db, campaign_id).json);
+  std::ostringstream csv;
+  csv << "unit,phi,re_target,re,resolution,realization,y,x,spheres,F_i,F_i_standard_error,F\n";
+  std::size_t count = 0;
+  for (const auto& u : units) {
+    if (u.value("status", "") != "done") continue;
+    const auto& record = u.at("result_json");
+    if (!record.is_object() || !record.contains("species")) continue;
+    for (const auto& sp : record.at("species")) {
+      csv << u.at("id").get<std::int64_t>() << ',' << full_precision(u.at("phi").get<double>())
+          << ',' << full_precision(u.at("re_target").get<double>()) << ','
+          << full_precision(u.at("re").get<double>()) << ','
+          << full_precision(u.at("resolution").get<double>()) << ','
+          << u.at("realization").get<std::int64_t>() << ','
+          << full_precision(sp.at("diameter_over_sauter").get<double>()) << ','
+          << full_precision(sp.at("volume_fraction").get<double>()) << ','
+          << sp.at("spheres").get<std::int64_t>() << ',' << full_precision(sp.at("F").get<double>())
+          << ',' << full_precision(sp.at("F_standard_error").get<double>()) << ','
+          << full_precision(u.at("F").get<double>()) << '\n';
+      ++count;
+    }
+  }
+  if (rows != nullptr) *rows = count;
+  return csv.str();
+}
+
 }  // namespace campaign
 }  // namespace draglab

@@ -9,7 +9,9 @@
 #include <sys/file.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <map>
+#include <sstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -322,6 +324,60 @@ TEST(CampaignRunner, DivergingUnitIsRecordedFailedAndTheOthersComplete) {
   EXPECT_EQ(st2.units_done, 1);
   EXPECT_EQ(st2.units_failed, 1);
   EXPECT_EQ(RawDb(db_path).integer("SELECT sum(attempts) FROM campaign_units"), 2);
+}
+
+TEST(CampaignRunner, BidisperseUnitsRecordEachSizeClassForTheSpeciesExport) {
+  // Two Stokes units over bidisperse packings (size ratio 2, equal volumes): each unit's record
+  // holds the drag of both size classes (lbm::run_case), and `campaign export --species` lists
+  // them, one row per unit and class, with the unit's mixture F = sum x_i F_i / y_i^2.
+  TempDir dir;
+  const std::string db_path = dir.file("bi.db");
+  CampaignSpec spec;
+  spec.name = "bi";
+  spec.phi = {0.2};
+  spec.re = {0};
+  spec.realizations = 2;
+  spec.spheres = 12;
+  spec.distribution = "bi";
+  spec.size_ratio = 2.0;
+  spec.large_fraction = 0.5;
+  spec.resolutions = {8};
+  spec.extrapolation = "finest";
+  RunCampaignOptions options;
+  options.jobs = 1;
+  const CampaignStatus st = run_campaign(db_path, spec, options);
+  ASSERT_EQ(st.units_done, 2);
+  Database db(db_path);
+  std::size_t rows = 0;
+  const std::string csv = export_species_csv(db, st.id, &rows);
+  EXPECT_EQ(rows, 4u);
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line,
+            "unit,phi,re_target,re,resolution,realization,y,x,spheres,F_i,F_i_standard_error,F");
+  std::map<long, std::vector<std::vector<double>>> by_unit;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::istringstream fields(line);
+    for (std::string f; std::getline(fields, f, ',');) v.push_back(std::strtod(f.c_str(), nullptr));
+    ASSERT_EQ(v.size(), 12u) << line;
+    by_unit[static_cast<long>(v[0])].push_back(v);
+  }
+  ASSERT_EQ(by_unit.size(), 2u);
+  for (const auto& [unit, classes] : by_unit) {
+    ASSERT_EQ(classes.size(), 2u);
+    EXPECT_NEAR(classes[1][6] / classes[0][6], 2.0, 1e-12);  // y, smallest first
+    EXPECT_NEAR(classes[0][7] + classes[1][7], 1.0, 1e-12);  // x
+    double mixture = 0.0;
+    for (const auto& c : classes) mixture += c[7] * c[9] / (c[6] * c[6]);
+    EXPECT_NEAR(mixture, classes[0][11], 1e-9 * mixture) << "unit " << unit;
+    EXPECT_GT(classes[1][9], classes[0][9]);  // the large spheres: more drag per own diameter
+  }
+  // A campaign of one sphere size has no rows.
+  EXPECT_EQ(export_species_csv(db, st.id + 1, &rows),
+            "unit,phi,re_target,re,resolution,realization,y,x,spheres,F_i,F_i_standard_error,F\n");
+  EXPECT_EQ(rows, 0u);
 }
 
 TEST(CampaignRunner, SecondProcessOnTheSameCampaignIsRefused) {

@@ -221,6 +221,14 @@ struct UnitsExport {
   std::string json;  ///< A JSON array of objects, one per unit (result_json parsed).
 };
 UnitsExport export_units(const Database& db, std::int64_t campaign_id);
+/// The drag of each size class of each finished unit of a campaign over polydisperse packings
+/// (lbm::SpeciesDrag, from the unit's record): CSV with a header, one row per unit and class:
+/// unit id, phi, re_target, re (achieved, on the Sauter mean), resolution, realization, the class's
+/// y = d_i/<d> and x (solids volume share), its spheres, F_i (own diameter) and its standard error
+/// over those spheres, and the unit's mixture F (van der Hoef et al. 2005). Units without classes
+/// (one size, failed) give no rows; *rows (optional) receives the row count.
+std::string export_species_csv(const Database& db, std::int64_t campaign_id,
+                               std::size_t* rows = nullptr);
 
 /// Builds the dataset of a campaign from its finished units (per (phi, Re): realization mean and
 /// standard error at each resolution, then the spec's resolution extrapolation), stores it
