@@ -175,6 +175,152 @@ struct TfmSimulation::Impl {
 
   CellClosures Closures(const TfmOptions& o) const;
   double StableStep(const CellClosures& c, TfmStepLimit* limit, const TfmOptions& o) const;
+
+  // The stages of one step (TfmSimulation::StepCapped), in order; Step holds what they share.
+  struct Step;
+  void ChooseStep(Step& s, double dt_cap) const;
+  void DragCoefficients(Step& s, const Law& law);
+  void SolidsStress(Step& s) const;
+  void PredictXFaces(Step& s) const;
+  void PredictZFaces(Step& s) const;
+  void SolvePressure(Step& s);
+  void Project(const Step& s);
+  void SolidsFluxes(Step& s) const;
+  void ImplicitSolidsPressure(Step& s);
+  void LimitSolidsFluxes(Step& s) const;
+  void CorrectLimitedFaces(Step& s);
+  Array TransportedTheta(const Step& s);
+  Array EquilibriumTheta(const Step& s) const;
+  void Record(const Step& s, const Array& theta_new);
+
+  // Pieces of the face predictors.
+  double SolidsUAt(int i, int j, bool noslip) const;
+  double SolidsWAt(int i, int j, bool noslip) const;
+  double ImplicitViscosity(Step& s, int i0, int i1, int j0, int j1, double a_s) const;
+};
+
+namespace {
+
+/// A face after the partial elimination of the drag: the velocities without the new pressure
+/// gradient and their response to it (u = u_hat - c_g dp/dn, v = v_hat - c_s dp/dn).
+struct Face {
+  double u_hat = 0.0, v_hat = 0.0, c_g = 0.0, c_s = 0.0, eps = 1.0, phi = 0.0;
+  double phi_flux = 0.0;  // the donor cell's phi: the solids fraction the face transports
+  // Solids velocity per unit solids force [m/s per N/m^3] with the mixture flux held:
+  // a_s dv + beta (dv - du) = f with du = -(phi/eps) dv gives dv = f / (a_s + beta / eps).
+  double solids_response = 0.0;
+};
+
+double Upwind(double speed, double centre, double behind, double ahead, double h) {
+  return speed > 0.0 ? (centre - behind) / h : (ahead - centre) / h;
+}
+
+/// Partial elimination of the drag on one face (the 2 x 2 system of both momentum equations).
+Face Eliminate(const TfmOptions& o, double eps_f, double phi_f, double beta_f, double rhs_g,
+               double rhs_s, double a_g, double a_s) {
+  Face f;
+  f.eps = eps_f;
+  f.phi = phi_f;
+  if (o.freeze_solids) {
+    f.u_hat = rhs_g / (a_g + beta_f);
+    f.c_g = eps_f / (a_g + beta_f);
+    return f;
+  }
+  const double det = a_g * a_s + beta_f * (a_g + a_s);
+  f.u_hat = ((a_s + beta_f) * rhs_g + beta_f * rhs_s) / det;
+  f.v_hat = (beta_f * rhs_g + (a_g + beta_f) * rhs_s) / det;
+  f.c_g = ((a_s + beta_f) * eps_f + beta_f * phi_f) / det;
+  f.c_s = (beta_f * eps_f + (a_g + beta_f) * phi_f) / det;
+  return f;
+}
+
+/// The solids fraction a face carries. The volume fluxes carry the donor cell's fractions
+/// (upwind by the predicted solids velocity), in the pressure equation as in the transport: at
+/// the bed surface, particles that would fall out of an empty cell carry no volume, so the gas
+/// is not asked to take their place. With the van Leer scheme the donor value is corrected
+/// towards the acceptor by the harmonic mean of the two one-sided differences (zero at an
+/// extremum), which keeps the face value between the donor's and the acceptor's (TVD); a
+/// missing cell behind the donor (NaN: a wall) makes it upwind there.
+double Donor(bool van_leer, double v, double behind_lower, double lower, double upper,
+             double behind_upper, double central) {
+  if (v == 0.0) return central;
+  const double d = v > 0.0 ? lower : upper, a = v > 0.0 ? upper : lower;
+  const double behind = v > 0.0 ? behind_lower : behind_upper;
+  if (!van_leer || std::isnan(behind)) return d;
+  const double back = d - behind, ahead = a - d;
+  return back * ahead > 0.0 ? d + back * ahead / (back + ahead) : d;
+}
+
+/// Constraints on a face's solids (after the elimination, so the projection sees them):
+///  - between two empty cells there are no solids: they move with the gas, so the neighbours
+///    of a free surface see neither fictitious free-fall momentum nor slip;
+///  - solids that would flow into a cell at the packing limit, or out of an empty cell (the
+///    surface face of a bed at rest), are held (v = 0) as by a wall, the contact force of a
+///    packed bed or the absence of anything to move; the gas alone answers the pressure.
+///    Without the first, the projection would push solids volume into the full cell and the
+///    flux limiter would hand it to the gas, a velocity spike that feeds back; without the
+///    second, the surface face would carry the virtual particles' momentum into the bed.
+/// The direction of a face's solids: the prediction with the previous step's pressure gradient
+/// (v_hat alone lacks the whole pressure gradient, so in a dense bed it points down with
+/// gravity even where the gas lifts the solids).
+void Constrain(const TfmOptions& o, Face& f, double lower, double upper, double a_g, double beta_f,
+               double rhs_g, double old_gradient) {
+  if (o.freeze_solids) return;
+  if (std::max(lower, upper) < o.residual_solids) {
+    f.v_hat = f.u_hat;
+    f.c_s = f.c_g;
+    return;
+  }
+  const double packed = o.ktgf.packing_limit * (1.0 - 1e-3);
+  const double v = f.v_hat - f.c_s * old_gradient;
+  const double donor_phi = v > 0.0 ? lower : upper;
+  const double acceptor_phi = v > 0.0 ? upper : lower;
+  if (acceptor_phi < packed && donor_phi >= o.residual_solids) return;
+  f.v_hat = 0.0;
+  f.c_s = 0.0;
+  f.u_hat = rhs_g / (a_g + beta_f);
+  f.c_g = f.eps / (a_g + beta_f);
+}
+
+}  // namespace
+
+struct TfmSimulation::Impl::Step {
+  explicit Step(const TfmOptions& options, int nx, int nz, double time)
+      : o(options),
+        at("TFM stopped at t = " + fmt(time) + " s: "),
+        fx(static_cast<std::size_t>((nx + 1) * nz)),
+        fz(static_cast<std::size_t>(nx * (nz + 1))),
+        nx_(nx) {}
+  const TfmOptions& o;
+  const std::string at;  ///< Prefix of every diagnosis.
+  // ChooseStep
+  CellClosures c;
+  double dt = 0.0;
+  TfmStepLimit why = TfmStepLimit::kMaximum;
+  bool landing = false;
+  // DragCoefficients: the gas fraction and beta / eps
+  Array eps, resistance;
+  // SolidsStress: normal stresses at cell centres, shear at corners
+  Array sxx, szz, sxz;
+  // PredictXFaces, PredictZFaces
+  std::vector<Face> fx, fz;
+  long implicit_faces = 0;
+  // SolvePressure: the inflow of the new time
+  double t_new = 0.0;
+  std::vector<double> w_in;
+  // SolidsFluxes, ImplicitSolidsPressure, LimitSolidsFluxes
+  Array fs_x, fs_z, mix_x, mix_z, limited_x, limited_z;
+  Array phi_new;
+  double phi_new_max = 0.0;
+  long positivity_limited = 0, packing_limited = 0, limited = 0;
+
+  Face& fx_at(int i, int j) { return fx[static_cast<std::size_t>(i + (nx_ + 1) * j)]; }
+  const Face& fx_at(int i, int j) const { return fx[static_cast<std::size_t>(i + (nx_ + 1) * j)]; }
+  Face& fz_at(int i, int j) { return fz[static_cast<std::size_t>(i + nx_ * j)]; }
+  const Face& fz_at(int i, int j) const { return fz[static_cast<std::size_t>(i + nx_ * j)]; }
+
+ private:
+  int nx_;
 };
 
 TfmSimulation::TfmSimulation(const TfmOptions& options, std::shared_ptr<const Law> law)
@@ -405,19 +551,33 @@ void TfmSimulation::AdvanceTo(double t_end) {
 
 double TfmSimulation::StepCapped(double dt_cap) {
   Impl& m = *impl_;
-  const TfmOptions& o = opt_;
-  const int nx = m.nx, nz = m.nz;
-  const double dx = m.dx, dz = m.dz, volume = dx * dz;
-  const double rho_g = o.gas.rho_g, mu_g = o.gas.mu_g, rho_s = o.particle_density_kg_m3;
-  const double g_z = o.gas.gravity_z, phi_res = o.residual_solids;
-  const double phi_max = o.ktgf.packing_limit;
-  const bool noslip = o.gas.side_walls == WallSlip::kNoSlip;
-  const std::string at = "TFM stopped at t = " + fmt(m.time) + " s: ";
+  Impl::Step s(opt_, m.nx, m.nz, m.time);
+  m.ChooseStep(s, dt_cap);
+  m.DragCoefficients(s, *law_);
+  m.SolidsStress(s);
+  m.PredictXFaces(s);
+  m.PredictZFaces(s);
+  m.SolvePressure(s);
+  m.Project(s);
+  m.SolidsFluxes(s);
+  if (opt_.solids_pressure == SolidsPressure::kImplicit) m.ImplicitSolidsPressure(s);
+  m.LimitSolidsFluxes(s);
+  m.CorrectLimitedFaces(s);
+  const Array theta_new = opt_.granular_temperature == GranularTemperature::kAlgebraic
+                              ? m.EquilibriumTheta(s)
+                              : m.TransportedTheta(s);
+  m.Record(s, theta_new);
+  return s.dt;
+}
 
-  // ---- closures and the time step ----
-  const CellClosures c = m.Closures(o);
+/// The closures and the time step: the stable step (or the fixed one, checked against it),
+/// capped to land on an output time.
+void TfmSimulation::Impl::ChooseStep(Step& s, double dt_cap) const {
+  const TfmOptions& o = s.o;
+  const std::string& at = s.at;
+  s.c = Closures(o);
   TfmStepLimit why = TfmStepLimit::kMaximum;
-  const double stable = m.StableStep(c, &why, o);
+  const double stable = StableStep(s.c, &why, o);
   double dt = 0.0;
   if (o.fixed_dt_s > 0.0) {
     if (o.fixed_dt_s > stable * (1.0 + 1e-9))
@@ -437,52 +597,61 @@ double TfmSimulation::StepCapped(double dt_cap) {
   }
   if (!(dt > 0.0)) Bad(at + "time step " + fmt(dt) + " s must be > 0");
   // A step shortened to land on an output time says nothing about stability.
-  const bool landing = dt < (o.fixed_dt_s > 0.0 ? o.fixed_dt_s : stable);
-  if (landing) why = TfmStepLimit::kLanding;
+  s.landing = dt < (o.fixed_dt_s > 0.0 ? o.fixed_dt_s : stable);
+  if (s.landing) why = TfmStepLimit::kLanding;
+  s.dt = dt;
+  s.why = why;
+}
 
-  // ---- cell-centred velocities and the drag coefficient ----
-  const Array& phi = m.phi;
-  Array eps = 1.0 - phi;
+/// The drag coefficient of every cell from the law at the cell-centred slip.
+void TfmSimulation::Impl::DragCoefficients(Step& s, const Law& law) {
+  const TfmOptions& o = s.o;
+  s.eps = 1.0 - phi;
   Array dga = Array::Zero(nx, nz);
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
       if (!o.interphase_drag) continue;
-      const double sx = 0.5 * (m.ug(i, j) + m.ug(i + 1, j) - m.us(i, j) - m.us(i + 1, j));
-      const double sz = 0.5 * (m.wg(i, j) + m.wg(i, j + 1) - m.ws(i, j) - m.ws(i, j + 1));
+      const double sx = 0.5 * (ug(i, j) + ug(i + 1, j) - us(i, j) - us(i + 1, j));
+      const double sz = 0.5 * (wg(i, j) + wg(i, j + 1) - ws(i, j) - ws(i, j + 1));
       try {
-        dga(i, j) = law_->dga(eps(i, j), mu_g, rho_g, std::hypot(sx, sz), o.particle_diameter_m);
+        dga(i, j) = law.dga(s.eps(i, j), o.gas.mu_g, o.gas.rho_g, std::hypot(sx, sz),
+                            o.particle_diameter_m);
       } catch (const Error& e) {
-        throw Error(e.code(), at + "drag law in cell (" + std::to_string(i) + ", " +
-                                  std::to_string(j) + ") at eps = " + fmt(eps(i, j)) + ": " +
+        throw Error(e.code(), s.at + "drag law in cell (" + std::to_string(i) + ", " +
+                                  std::to_string(j) + ") at eps = " + fmt(s.eps(i, j)) + ": " +
                                   e.what());
       }
     }
   // Cells below residual_solids carry virtual particles of that fraction, so their solids
   // velocity stays a settling velocity instead of free fall; their drag on the gas is
   // negligible (residual_solids / phi of a real cell).
-  m.beta = dga * phi.max(phi_res);
+  beta = dga * phi.max(o.residual_solids);
   // A face's drag coefficient averages beta / eps, the resistance to the SUPERFICIAL velocity
   // (continuous across a face where eps jumps, as at the bed surface), times the face's eps:
   // a face half in the bed then gets the drag of its bed half, not half the bed's beta at the
   // mean of two very different interstitial velocities.
-  const Array resistance = m.beta / eps;
+  s.resistance = beta / s.eps;
+}
 
-  // ---- solids stress at cell centres (sigma = -P I + tau) and corners ----
-  Array sxx = Array::Zero(nx, nz), szz = Array::Zero(nx, nz);
+/// The solids stress sigma = -P I + tau: normal components at cell centres, shear at corners.
+void TfmSimulation::Impl::SolidsStress(Step& s) const {
+  const CellClosures& c = s.c;
+  s.sxx = Array::Zero(nx, nz);
+  s.szz = Array::Zero(nx, nz);
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
-      if (phi(i, j) < phi_res) continue;
-      const double uxx = (m.us(i + 1, j) - m.us(i, j)) / dx;
-      const double wzz = (m.ws(i, j + 1) - m.ws(i, j)) / dz;
+      if (phi(i, j) < s.o.residual_solids) continue;
+      const double uxx = (us(i + 1, j) - us(i, j)) / dx;
+      const double wzz = (ws(i, j + 1) - ws(i, j)) / dz;
       const double bulk = (c.lambda(i, j) - 2.0 / 3.0 * c.mu(i, j)) * (uxx + wzz);
-      sxx(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * uxx + bulk;
-      szz(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * wzz + bulk;
+      s.sxx(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * uxx + bulk;
+      s.szz(i, j) = -c.pressure(i, j) + 2.0 * c.mu(i, j) * wzz + bulk;
     }
   // Corners: the viscosity averages the cells around the corner (two on a wall).
-  Array sxz = Array::Zero(nx + 1, nz + 1);
+  s.sxz = Array::Zero(nx + 1, nz + 1);
   for (int j = 0; j <= nz; ++j)
     for (int i = 0; i <= nx; ++i) {
-      const double shear = CornerShear(m.us, m.ws, i, j, dx, dz, o.solids_walls);
+      const double shear = CornerShear(us, ws, i, j, dx, dz, s.o.solids_walls);
       if (shear == 0.0) continue;
       double mu_sum = 0.0;
       int cells = 0;
@@ -492,173 +661,107 @@ double TfmSimulation::StepCapped(double dt_cap) {
             mu_sum += c.mu(a, b);
             ++cells;
           }
-      sxz(i, j) = 2.0 * mu_sum / cells * shear;
+      s.sxz(i, j) = 2.0 * mu_sum / cells * shear;
     }
+}
 
-  // ---- the gas's advective and viscous terms; ghost values of the solids' tangential
-  // velocities ----
-  const internal::MacGasOperators gas_ops(m.ug, m.wg, eps, dx, dz, mu_g, noslip,
-                                          /*periodic=*/false);
-  const bool solids_noslip = o.solids_walls == WallSlip::kNoSlip;
-  auto us_at = [&](int i, int j) {
-    if (j < 0) return solids_noslip ? -m.us(i, 0) : m.us(i, 0);
-    if (j >= nz) return solids_noslip ? -m.us(i, nz - 1) : m.us(i, nz - 1);
-    return m.us(i, j);
-  };
-  auto ws_at = [&](int i, int j) {
-    if (i < 0) return solids_noslip ? -m.ws(0, j) : m.ws(0, j);
-    if (i >= nx) return solids_noslip ? -m.ws(nx - 1, j) : m.ws(nx - 1, j);
-    return m.ws(i, j);
-  };
-  auto upwind = [](double speed, double centre, double behind, double ahead, double h) {
-    return speed > 0.0 ? (centre - behind) / h : (ahead - centre) / h;
-  };
+/// The solids' tangential velocities with their ghost values beyond the walls.
+double TfmSimulation::Impl::SolidsUAt(int i, int j, bool noslip) const {
+  if (j < 0) return noslip ? -us(i, 0) : us(i, 0);
+  if (j >= nz) return noslip ? -us(i, nz - 1) : us(i, nz - 1);
+  return us(i, j);
+}
 
-  // Partial elimination of the drag on one face: returns the velocities without the new
-  // pressure gradient and their response to it (u = u_hat - c_g dp/dn, v = v_hat - c_s dp/dn).
-  struct Face {
-    double u_hat = 0.0, v_hat = 0.0, c_g = 0.0, c_s = 0.0, eps = 1.0, phi = 0.0;
-    double phi_flux = 0.0;  // the donor cell's phi: the solids fraction the face transports
-    // Solids velocity per unit solids force [m/s per N/m^3] with the mixture flux held:
-    // a_s dv + beta (dv - du) = f with du = -(phi/eps) dv gives dv = f / (a_s + beta / eps).
-    double solids_response = 0.0;
-  };
-  auto eliminate = [&](double eps_f, double phi_f, double beta_f, double rhs_g, double rhs_s,
-                       double a_g, double a_s) {
-    Face f;
-    f.eps = eps_f;
-    f.phi = phi_f;
-    if (o.freeze_solids) {
-      f.u_hat = rhs_g / (a_g + beta_f);
-      f.c_g = eps_f / (a_g + beta_f);
-      return f;
-    }
-    const double det = a_g * a_s + beta_f * (a_g + a_s);
-    f.u_hat = ((a_s + beta_f) * rhs_g + beta_f * rhs_s) / det;
-    f.v_hat = (beta_f * rhs_g + (a_g + beta_f) * rhs_s) / det;
-    f.c_g = ((a_s + beta_f) * eps_f + beta_f * phi_f) / det;
-    f.c_s = (beta_f * eps_f + (a_g + beta_f) * phi_f) / det;
-    return f;
-  };
+double TfmSimulation::Impl::SolidsWAt(int i, int j, bool noslip) const {
+  if (i < 0) return noslip ? -ws(0, j) : ws(0, j);
+  if (i >= nx) return noslip ? -ws(nx - 1, j) : ws(nx - 1, j);
+  return ws(i, j);
+}
 
-  // The volume fluxes carry the donor cell's fractions (upwind by the predicted solids velocity),
-  // in the pressure equation as in the transport: at the bed surface, particles that would fall
-  // out of an empty cell carry no volume, so the gas is not asked to take their place.
-  // With the van Leer scheme the donor value is corrected towards the acceptor by the harmonic
-  // mean of the two one-sided differences (zero at an extremum), which keeps the face value
-  // between the donor's and the acceptor's (TVD); a missing cell behind the donor (a wall) makes
-  // it upwind there.
-  const bool van_leer = o.fraction_scheme == FractionScheme::kVanLeer;
-  auto donor = [van_leer](double v, double behind_lower, double lower, double upper,
-                          double behind_upper, double central) {
-    if (v == 0.0) return central;
-    const double d = v > 0.0 ? lower : upper, a = v > 0.0 ? upper : lower;
-    const double behind = v > 0.0 ? behind_lower : behind_upper;
-    if (!van_leer || std::isnan(behind)) return d;
-    const double back = d - behind, ahead = a - d;
-    return back * ahead > 0.0 ? d + back * ahead / (back + ahead) : d;
-  };
-  const double none = std::numeric_limits<double>::quiet_NaN();
-
-  // Constraints on a face's solids (after the elimination, so the projection sees them):
-  //  - between two empty cells there are no solids: they move with the gas, so the neighbours
-  //    of a free surface see neither fictitious free-fall momentum nor slip;
-  //  - solids that would flow into a cell at the packing limit, or out of an empty cell (the
-  //    surface face of a bed at rest), are held (v = 0) as by a wall, the contact force of a
-  //    packed bed or the absence of anything to move; the gas alone answers the pressure.
-  //    Without the first, the projection would push solids volume into the full cell and the
-  //    flux limiter would hand it to the gas, a velocity spike that feeds back; without the
-  //    second, the surface face would carry the virtual particles' momentum into the bed.
-  const double packed = phi_max * (1.0 - 1e-3);
-  // The direction of a face's solids: the prediction with the previous step's pressure gradient
-  // (v_hat alone lacks the whole pressure gradient, so in a dense bed it points down with
-  // gravity even where the gas lifts the solids).
-  auto constrain = [&](Face& f, double lower, double upper, double a_g, double beta_f, double rhs_g,
-                       double old_gradient) {
-    if (o.freeze_solids) return;
-    if (std::max(lower, upper) < phi_res) {
-      f.v_hat = f.u_hat;
-      f.c_s = f.c_g;
-      return;
-    }
-    const double v = f.v_hat - f.c_s * old_gradient;
-    const double donor_phi = v > 0.0 ? lower : upper;
-    const double acceptor_phi = v > 0.0 ? upper : lower;
-    if (acceptor_phi < packed && donor_phi >= phi_res) return;
-    f.v_hat = 0.0;
-    f.c_s = 0.0;
-    f.u_hat = rhs_g / (a_g + beta_f);
-    f.c_g = f.eps / (a_g + beta_f);
-  };
-
-  // Point-implicit solids viscosity (SolidsViscosity): a face's self-coefficient in the explicit
-  // viscous term is at most 4 M (1/dx^2 + 1/dz^2), M the largest 2 mu + lambda of the cells its
-  // stencil touches. Where a_s is below that bound, (a_s + D) v_new = (a_s + D) v + S(v) with
-  // D = bound - a_s keeps the most oscillatory mode's amplification >= -1 (stable at any step);
-  // elsewhere D = 0 and the term is the explicit one.
-  const bool point_implicit = o.solids_viscosity == SolidsViscosity::kPointImplicit;
+/// Point-implicit solids viscosity (SolidsViscosity): a face's self-coefficient in the explicit
+/// viscous term is at most 4 M (1/dx^2 + 1/dz^2), M the largest 2 mu + lambda of the cells its
+/// stencil touches. Where a_s is below that bound, (a_s + D) v_new = (a_s + D) v + S(v) with
+/// D = bound - a_s keeps the most oscillatory mode's amplification >= -1 (stable at any step);
+/// elsewhere D = 0 and the term is the explicit one. Returns D.
+double TfmSimulation::Impl::ImplicitViscosity(Step& s, int i0, int i1, int j0, int j1,
+                                              double a_s) const {
+  if (s.o.solids_viscosity != SolidsViscosity::kPointImplicit) return 0.0;
   const double inv_h2 = 1.0 / (dx * dx) + 1.0 / (dz * dz);
-  long implicit_faces = 0;
-  auto implicit_viscosity = [&](int i0, int i1, int j0, int j1, double a_s) {
-    if (!point_implicit) return 0.0;
-    double largest = 0.0;
-    for (int b = std::max(j0, 0); b <= std::min(j1, nz - 1); ++b)
-      for (int a = std::max(i0, 0); a <= std::min(i1, nx - 1); ++a)
-        largest = std::max(largest, 2.0 * c.mu(a, b) + c.lambda(a, b));
-    const double d = std::max(0.0, 4.0 * largest * inv_h2 - a_s);
-    if (d > 0.0) ++implicit_faces;
-    return d;
-  };
+  double largest = 0.0;
+  for (int b = std::max(j0, 0); b <= std::min(j1, nz - 1); ++b)
+    for (int a = std::max(i0, 0); a <= std::min(i1, nx - 1); ++a)
+      largest = std::max(largest, 2.0 * s.c.mu(a, b) + s.c.lambda(a, b));
+  const double d = std::max(0.0, 4.0 * largest * inv_h2 - a_s);
+  if (d > 0.0) ++s.implicit_faces;
+  return d;
+}
 
-  // ---- momentum predictors on the x-faces ----
-  std::vector<Face> fx(static_cast<std::size_t>((nx + 1) * nz));
-  auto fx_at = [&](int i, int j) -> Face& {
-    return fx[static_cast<std::size_t>(i + (nx + 1) * j)];
-  };
+/// Momentum predictors on the x-faces, the drag eliminated.
+void TfmSimulation::Impl::PredictXFaces(Step& s) const {
+  const TfmOptions& o = s.o;
+  const double rho_g = o.gas.rho_g, rho_s = o.particle_density_kg_m3;
+  const bool van_leer = o.fraction_scheme == FractionScheme::kVanLeer;
+  const bool solids_noslip = o.solids_walls == WallSlip::kNoSlip;
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  const Array& eps = s.eps;
+  const internal::MacGasOperators gas_ops(ug, wg, eps, dx, dz, o.gas.mu_g,
+                                          o.gas.side_walls == WallSlip::kNoSlip,
+                                          /*periodic=*/false);
   for (int j = 0; j < nz; ++j)
     for (int i = 1; i < nx; ++i) {
       const double ef = 0.5 * (eps(i - 1, j) + eps(i, j));
       const double pf = 1.0 - ef;
-      const double pm = std::max(pf, phi_res);
-      const double bf = ef * 0.5 * (resistance(i - 1, j) + resistance(i, j));
+      const double pm = std::max(pf, o.residual_solids);
+      const double bf = ef * 0.5 * (s.resistance(i - 1, j) + s.resistance(i, j));
       // Gas: advective upwind, div(eps mu grad u) (the shared MAC operators).
-      const double uc = m.ug(i, j);
+      const double uc = ug(i, j);
       const internal::FaceMomentumTerms gas = gas_ops.XFace(i, j);
-      const double a_g = ef * rho_g / dt;
+      const double a_g = ef * rho_g / s.dt;
       const double rhs_g =
           a_g * uc - ef * rho_g * gas.advection + gas.viscous + ef * o.gas.body_force_x;
       // Solids: advective upwind, the stress divergence.
-      const double vc = m.us(i, j);
-      const double wsc = 0.25 * (m.ws(i - 1, j) + m.ws(i, j) + m.ws(i - 1, j + 1) + m.ws(i, j + 1));
-      const double adv_s = vc * upwind(vc, vc, m.us(i - 1, j), m.us(i + 1, j), dx) +
-                           wsc * upwind(wsc, vc, us_at(i, j - 1), us_at(i, j + 1), dz);
-      const double stress = (sxx(i, j) - sxx(i - 1, j)) / dx + (sxz(i, j + 1) - sxz(i, j)) / dz;
-      const double a_s0 = pm * rho_s / dt;
-      const double a_s = a_s0 + implicit_viscosity(i - 1, i, j - 1, j + 1, a_s0);
+      const double vc = us(i, j);
+      const double wsc = 0.25 * (ws(i - 1, j) + ws(i, j) + ws(i - 1, j + 1) + ws(i, j + 1));
+      const double adv_s = vc * Upwind(vc, vc, us(i - 1, j), us(i + 1, j), dx) +
+                           wsc * Upwind(wsc, vc, SolidsUAt(i, j - 1, solids_noslip),
+                                        SolidsUAt(i, j + 1, solids_noslip), dz);
+      const double stress =
+          (s.sxx(i, j) - s.sxx(i - 1, j)) / dx + (s.sxz(i, j + 1) - s.sxz(i, j)) / dz;
+      const double a_s0 = pm * rho_s / s.dt;
+      const double a_s = a_s0 + ImplicitViscosity(s, i - 1, i, j - 1, j + 1, a_s0);
       const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress;
-      Face& f = fx_at(i, j);
-      f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
-      const double old_gradient = (m.p(i, j) - m.p(i - 1, j)) / dx;
-      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, i >= 2 ? phi(i - 2, j) : none,
+      Face& f = s.fx_at(i, j);
+      f = Eliminate(o, ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
+      const double old_gradient = (p(i, j) - p(i - 1, j)) / dx;
+      f.phi_flux = Donor(van_leer, f.v_hat - f.c_s * old_gradient, i >= 2 ? phi(i - 2, j) : none,
                          phi(i - 1, j), phi(i, j), i + 1 < nx ? phi(i + 1, j) : none, pf);
-      constrain(f, phi(i - 1, j), phi(i, j), a_g, bf, rhs_g, old_gradient);
+      Constrain(o, f, phi(i - 1, j), phi(i, j), a_g, bf, rhs_g, old_gradient);
       f.solids_response = f.c_s != 0.0 ? 1.0 / (a_s + bf / ef) : 0.0;
     }
+}
 
-  // ---- momentum predictors on the z-faces (interior and the outlet) ----
-  std::vector<Face> fz(static_cast<std::size_t>(nx * (nz + 1)));
-  auto fz_at = [&](int i, int j) -> Face& { return fz[static_cast<std::size_t>(i + nx * j)]; };
+/// Momentum predictors on the z-faces (interior and the outlet), the drag eliminated.
+void TfmSimulation::Impl::PredictZFaces(Step& s) const {
+  const TfmOptions& o = s.o;
+  const double rho_g = o.gas.rho_g, rho_s = o.particle_density_kg_m3, g_z = o.gas.gravity_z;
+  const bool van_leer = o.fraction_scheme == FractionScheme::kVanLeer;
+  const bool solids_noslip = o.solids_walls == WallSlip::kNoSlip;
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  const Array& eps = s.eps;
+  const internal::MacGasOperators gas_ops(ug, wg, eps, dx, dz, o.gas.mu_g,
+                                          o.gas.side_walls == WallSlip::kNoSlip,
+                                          /*periodic=*/false);
   for (int j = 1; j <= nz; ++j)
     for (int i = 0; i < nx; ++i) {
       const bool top = j == nz;
       const double ef = top ? eps(i, nz - 1) : 0.5 * (eps(i, j - 1) + eps(i, j));
       const double pf = top ? 0.0 : 1.0 - ef;
-      const double pm = std::max(pf, phi_res);
+      const double pm = std::max(pf, o.residual_solids);
       const double bf =
-          top ? m.beta(i, nz - 1) : ef * 0.5 * (resistance(i, j - 1) + resistance(i, j));
-      const double wc = m.wg(i, j);
+          top ? beta(i, nz - 1) : ef * 0.5 * (s.resistance(i, j - 1) + s.resistance(i, j));
+      const double wc = wg(i, j);
       const internal::FaceMomentumTerms gas = gas_ops.ZFace(i, j);
-      const double a_g = ef * rho_g / dt;
+      const double a_g = ef * rho_g / s.dt;
       const double rhs_g = a_g * wc - ef * rho_g * gas.advection + gas.viscous + ef * rho_g * g_z +
                            ef * o.gas.body_force_z;
       if (top) {  // the outlet: gas only (the solids see a wall)
@@ -667,187 +770,215 @@ double TfmSimulation::StepCapped(double dt_cap) {
         f.phi_flux = 1.0 - ef;  // the mixture flux is the gas's alone: eps u
         f.u_hat = rhs_g / (a_g + bf);
         f.c_g = ef / (a_g + bf);
-        fz_at(i, j) = f;
+        s.fz_at(i, j) = f;
         continue;
       }
-      const double vc = m.ws(i, j);
-      const double usc = 0.25 * (m.us(i, j - 1) + m.us(i + 1, j - 1) + m.us(i, j) + m.us(i + 1, j));
-      const double adv_s = vc * upwind(vc, vc, m.ws(i, j - 1), m.ws(i, j + 1), dz) +
-                           usc * upwind(usc, vc, ws_at(i - 1, j), ws_at(i + 1, j), dx);
-      const double stress = (szz(i, j) - szz(i, j - 1)) / dz + (sxz(i + 1, j) - sxz(i, j)) / dx;
-      const double a_s0 = pm * rho_s / dt;
-      const double a_s = a_s0 + implicit_viscosity(i - 1, i + 1, j - 1, j, a_s0);
+      const double vc = ws(i, j);
+      const double usc = 0.25 * (us(i, j - 1) + us(i + 1, j - 1) + us(i, j) + us(i + 1, j));
+      const double adv_s = vc * Upwind(vc, vc, ws(i, j - 1), ws(i, j + 1), dz) +
+                           usc * Upwind(usc, vc, SolidsWAt(i - 1, j, solids_noslip),
+                                        SolidsWAt(i + 1, j, solids_noslip), dx);
+      const double stress =
+          (s.szz(i, j) - s.szz(i, j - 1)) / dz + (s.sxz(i + 1, j) - s.sxz(i, j)) / dx;
+      const double a_s0 = pm * rho_s / s.dt;
+      const double a_s = a_s0 + ImplicitViscosity(s, i - 1, i + 1, j - 1, j, a_s0);
       const double rhs_s = a_s * vc - pm * rho_s * adv_s + stress + pm * rho_s * g_z;
-      Face& f = fz_at(i, j);
-      f = eliminate(ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
-      const double old_gradient = (m.p(i, j) - m.p(i, j - 1)) / dz;
-      f.phi_flux = donor(f.v_hat - f.c_s * old_gradient, j >= 2 ? phi(i, j - 2) : none,
+      Face& f = s.fz_at(i, j);
+      f = Eliminate(o, ef, pf, bf, rhs_g, rhs_s, a_g, a_s);
+      const double old_gradient = (p(i, j) - p(i, j - 1)) / dz;
+      f.phi_flux = Donor(van_leer, f.v_hat - f.c_s * old_gradient, j >= 2 ? phi(i, j - 2) : none,
                          phi(i, j - 1), phi(i, j), j + 1 < nz ? phi(i, j + 1) : none, pf);
-      constrain(f, phi(i, j - 1), phi(i, j), a_g, bf, rhs_g, old_gradient);
+      Constrain(o, f, phi(i, j - 1), phi(i, j), a_g, bf, rhs_g, old_gradient);
       f.solids_response = f.c_s != 0.0 ? 1.0 / (a_s + bf / ef) : 0.0;
     }
+}
 
-  // ---- mixture pressure equation: div(eps u + phi v) = 0 ----
-  const double t_new = m.time + dt;
-  std::vector<double> w_in(static_cast<std::size_t>(nx));
+/// The mixture pressure equation div(eps u + phi v) = 0 with the predicted faces.
+void TfmSimulation::Impl::SolvePressure(Step& s) {
+  const TfmOptions& o = s.o;
+  s.t_new = time + s.dt;
+  s.w_in.assign(static_cast<std::size_t>(nx), 0.0);
   for (int i = 0; i < nx; ++i)
-    w_in[static_cast<std::size_t>(i)] = inflow_superficial_velocity(o.gas, dx, i, t_new);
+    s.w_in[static_cast<std::size_t>(i)] = inflow_superficial_velocity(o.gas, dx, i, s.t_new);
   Array c_u = Array::Zero(nx + 1, nz), c_w = Array::Zero(nx, nz + 1);
   Array flux_x = Array::Zero(nx + 1, nz), flux_z = Array::Zero(nx, nz + 1);  // predicted, m^2/s
   for (int j = 0; j < nz; ++j)
     for (int i = 1; i < nx; ++i) {
-      const Face& f = fx_at(i, j);
+      const Face& f = s.fx_at(i, j);
       c_u(i, j) = (1.0 - f.phi_flux) * f.c_g + f.phi_flux * f.c_s;
       flux_x(i, j) = ((1.0 - f.phi_flux) * f.u_hat + f.phi_flux * f.v_hat) * dz;
     }
   for (int j = 1; j <= nz; ++j)
     for (int i = 0; i < nx; ++i) {
-      const Face& f = fz_at(i, j);
+      const Face& f = s.fz_at(i, j);
       c_w(i, j) = (1.0 - f.phi_flux) * f.c_g + f.phi_flux * f.c_s;
       flux_z(i, j) = ((1.0 - f.phi_flux) * f.u_hat + f.phi_flux * f.v_hat) * dx;
     }
-  for (int i = 0; i < nx; ++i) flux_z(i, 0) = w_in[static_cast<std::size_t>(i)] * dx;
+  for (int i = 0; i < nx; ++i) flux_z(i, 0) = s.w_in[static_cast<std::size_t>(i)] * dx;
   Array continuity(nx, nz);
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i)
       continuity(i, j) = flux_x(i + 1, j) - flux_x(i, j) + flux_z(i, j + 1) - flux_z(i, j);
   try {
-    m.p = m.pressure->Solve(c_u, c_w, continuity, o.gas.outlet_pressure_pa, m.p);
+    p = pressure->Solve(c_u, c_w, continuity, o.gas.outlet_pressure_pa, p);
   } catch (const Error& e) {
-    throw Error(e.code(), at + e.what());
+    throw Error(e.code(), s.at + e.what());
   }
+}
 
-  // ---- projection ----
+/// Both phases' face velocities from the new pressure gradient.
+void TfmSimulation::Impl::Project(const Step& s) {
+  const TfmOptions& o = s.o;
   for (int j = 0; j < nz; ++j)
     for (int i = 1; i < nx; ++i) {
-      const Face& f = fx_at(i, j);
-      const double grad = (m.p(i, j) - m.p(i - 1, j)) / dx;
-      m.ug(i, j) = f.u_hat - f.c_g * grad;
-      m.us(i, j) = f.v_hat - f.c_s * grad;
+      const Face& f = s.fx_at(i, j);
+      const double grad = (p(i, j) - p(i - 1, j)) / dx;
+      ug(i, j) = f.u_hat - f.c_g * grad;
+      us(i, j) = f.v_hat - f.c_s * grad;
     }
   for (int j = 1; j <= nz; ++j)
     for (int i = 0; i < nx; ++i) {
-      const Face& f = fz_at(i, j);
-      const double grad = j == nz ? (o.gas.outlet_pressure_pa - m.p(i, nz - 1)) / (0.5 * dz)
-                                  : (m.p(i, j) - m.p(i, j - 1)) / dz;
-      m.wg(i, j) = f.u_hat - f.c_g * grad;
-      m.ws(i, j) = f.v_hat - f.c_s * grad;
+      const Face& f = s.fz_at(i, j);
+      const double grad = j == nz ? (o.gas.outlet_pressure_pa - p(i, nz - 1)) / (0.5 * dz)
+                                  : (p(i, j) - p(i, j - 1)) / dz;
+      wg(i, j) = f.u_hat - f.c_g * grad;
+      ws(i, j) = f.v_hat - f.c_s * grad;
     }
   for (int i = 0; i < nx; ++i) {
-    m.wg(i, 0) = w_in[static_cast<std::size_t>(i)] / eps(i, 0);
-    m.ws(i, 0) = 0.0;
-    m.ws(i, nz) = 0.0;
+    wg(i, 0) = s.w_in[static_cast<std::size_t>(i)] / s.eps(i, 0);
+    ws(i, 0) = 0.0;
+    ws(i, nz) = 0.0;
   }
-  if (!m.ug.allFinite() || !m.wg.allFinite() || !m.us.allFinite() || !m.ws.allFinite() ||
-      !m.p.allFinite())
-    Bad(at + "non-finite velocity or pressure after a step of " + fmt(dt) +
-        " s (limit: " + to_string(why) + "); remedy: lower cfl or dt_max_s");
+  if (!ug.allFinite() || !wg.allFinite() || !us.allFinite() || !ws.allFinite() || !p.allFinite())
+    Bad(s.at + "non-finite velocity or pressure after a step of " + fmt(s.dt) +
+        " s (limit: " + to_string(s.why) + "); remedy: lower cfl or dt_max_s");
+}
 
-  // ---- solids fluxes (upwind phi), the mixture flux, and the bounds ----
-  Array fs_x = Array::Zero(nx + 1, nz), fs_z = Array::Zero(nx, nz + 1);
-  Array mix_x = Array::Zero(nx + 1, nz), mix_z = Array::Zero(nx, nz + 1);
+/// The solids fluxes (the faces' phi) and the mixture fluxes.
+void TfmSimulation::Impl::SolidsFluxes(Step& s) const {
+  s.fs_x = Array::Zero(nx + 1, nz);
+  s.fs_z = Array::Zero(nx, nz + 1);
+  s.mix_x = Array::Zero(nx + 1, nz);
+  s.mix_z = Array::Zero(nx, nz + 1);
   for (int j = 0; j < nz; ++j)
     for (int i = 1; i < nx; ++i) {
-      const double v = m.us(i, j), pf = fx_at(i, j).phi_flux;
-      fs_x(i, j) = v * pf * dz;
-      mix_x(i, j) = ((1.0 - pf) * m.ug(i, j) + pf * v) * dz;
+      const double v = us(i, j), pf = s.fx_at(i, j).phi_flux;
+      s.fs_x(i, j) = v * pf * dz;
+      s.mix_x(i, j) = ((1.0 - pf) * ug(i, j) + pf * v) * dz;
     }
   for (int j = 1; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
-      const double v = m.ws(i, j), pf = fz_at(i, j).phi_flux;
-      fs_z(i, j) = v * pf * dx;
-      mix_z(i, j) = ((1.0 - pf) * m.wg(i, j) + pf * v) * dx;
+      const double v = ws(i, j), pf = s.fz_at(i, j).phi_flux;
+      s.fs_z(i, j) = v * pf * dx;
+      s.mix_z(i, j) = ((1.0 - pf) * wg(i, j) + pf * v) * dx;
     }
   for (int i = 0; i < nx; ++i) {
-    mix_z(i, 0) = w_in[static_cast<std::size_t>(i)] * dx;
-    mix_z(i, nz) = eps(i, nz - 1) * m.wg(i, nz) * dx;
+    s.mix_z(i, 0) = s.w_in[static_cast<std::size_t>(i)] * dx;
+    s.mix_z(i, nz) = s.eps(i, nz - 1) * wg(i, nz) * dx;
   }
-  if (o.solids_pressure == SolidsPressure::kImplicit) {
-    // Implicit granular pressure increment: with psi = P'(phi) (phi_new - phi) in the cells and
-    // the face flux correction dF = -g (psi_R - psi_L), g = phi_d R A_t / h_n (R the face's
-    // solids response), phi_new - phi = b - dt/V sum_out dF with b the explicit update, so
-    //   psi / P' + dt/V sum_nb g (psi - psi_nb) = b,
-    // symmetric positive definite. Cells without solids pressure (P' = 0 or below
-    // residual_solids) keep psi = 0 (their own update stays explicit); faces whose solids are
-    // held (g = 0) are walls to it.
-    const int cells = nx * nz;
-    auto id = [nx](int i, int j) { return i + nx * j; };
-    auto active = [&](int i, int j) {
-      return phi(i, j) >= phi_res && c.pressure_derivative(i, j) > 0.0;
-    };
-    Array g_x = Array::Zero(nx + 1, nz), g_z = Array::Zero(nx, nz + 1);
-    for (int j = 0; j < nz; ++j)
-      for (int i = 1; i < nx; ++i)
-        g_x(i, j) = fx_at(i, j).phi_flux * fx_at(i, j).solids_response * dz / dx;
-    for (int j = 1; j < nz; ++j)
-      for (int i = 0; i < nx; ++i)
-        g_z(i, j) = fz_at(i, j).phi_flux * fz_at(i, j).solids_response * dx / dz;
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(cells);
-    std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(static_cast<std::size_t>(5 * cells));
-    const double s = dt / volume;
-    for (int j = 0; j < nz; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const int k = id(i, j);
-        // Every coupling is entered (zero where inactive) so the pattern never changes.
-        const bool on = active(i, j);
-        const struct {
-          int ni, nj;
-          double g;
-        } nbs[4] = {{i + 1, j, i + 1 < nx ? g_x(i + 1, j) : 0.0},
-                    {i - 1, j, i > 0 ? g_x(i, j) : 0.0},
-                    {i, j + 1, j + 1 < nz ? g_z(i, j + 1) : 0.0},
-                    {i, j - 1, j > 0 ? g_z(i, j) : 0.0}};
-        double diag = on ? 1.0 / c.pressure_derivative(i, j) : 1.0;
-        for (const auto& nb : nbs) {
-          if (nb.ni < 0 || nb.ni >= nx || nb.nj < 0 || nb.nj >= nz) continue;
-          const bool couple = on && active(nb.ni, nb.nj);
-          triplets.emplace_back(k, id(nb.ni, nb.nj), couple ? -s * nb.g : 0.0);
-          if (on) diag += s * nb.g;  // an inactive neighbour holds psi = 0
-        }
-        triplets.emplace_back(k, k, diag);
-        if (on) {
-          b(k) = -dt * (fs_x(i + 1, j) - fs_x(i, j) + fs_z(i, j + 1) - fs_z(i, j)) / volume;
-        }
+}
+
+/// Implicit granular pressure increment (SolidsPressure::kImplicit): with psi = P'(phi)
+/// (phi_new - phi) in the cells and the face flux correction dF = -g (psi_R - psi_L),
+/// g = phi_d R A_t / h_n (R the face's solids response), phi_new - phi = b - dt/V sum_out dF
+/// with b the explicit update, so
+///   psi / P' + dt/V sum_nb g (psi - psi_nb) = b,
+/// symmetric positive definite. Cells without solids pressure (P' = 0 or below residual_solids)
+/// keep psi = 0 (their own update stays explicit); faces whose solids are held (g = 0) are
+/// walls to it. The gas takes the difference on each face (mixture flux held).
+void TfmSimulation::Impl::ImplicitSolidsPressure(Step& s) {
+  const CellClosures& c = s.c;
+  const double dt = s.dt, volume = dx * dz;
+  Array& fs_x = s.fs_x;
+  Array& fs_z = s.fs_z;
+  const int cells = nx * nz;
+  const int row = nx;
+  auto id = [row](int i, int j) { return i + row * j; };
+  auto active = [&](int i, int j) {
+    return phi(i, j) >= s.o.residual_solids && c.pressure_derivative(i, j) > 0.0;
+  };
+  Array g_x = Array::Zero(nx + 1, nz), g_z = Array::Zero(nx, nz + 1);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i)
+      g_x(i, j) = s.fx_at(i, j).phi_flux * s.fx_at(i, j).solids_response * dz / dx;
+  for (int j = 1; j < nz; ++j)
+    for (int i = 0; i < nx; ++i)
+      g_z(i, j) = s.fz_at(i, j).phi_flux * s.fz_at(i, j).solids_response * dx / dz;
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(cells);
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(5 * cells));
+  const double scale = dt / volume;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int k = id(i, j);
+      // Every coupling is entered (zero where inactive) so the pattern never changes.
+      const bool on = active(i, j);
+      const struct {
+        int ni, nj;
+        double g;
+      } nbs[4] = {{i + 1, j, i + 1 < nx ? g_x(i + 1, j) : 0.0},
+                  {i - 1, j, i > 0 ? g_x(i, j) : 0.0},
+                  {i, j + 1, j + 1 < nz ? g_z(i, j + 1) : 0.0},
+                  {i, j - 1, j > 0 ? g_z(i, j) : 0.0}};
+      double diag = on ? 1.0 / c.pressure_derivative(i, j) : 1.0;
+      for (const auto& nb : nbs) {
+        if (nb.ni < 0 || nb.ni >= nx || nb.nj < 0 || nb.nj >= nz) continue;
+        const bool couple = on && active(nb.ni, nb.nj);
+        triplets.emplace_back(k, id(nb.ni, nb.nj), couple ? -scale * nb.g : 0.0);
+        if (on) diag += scale * nb.g;  // an inactive neighbour holds psi = 0
       }
-    Eigen::SparseMatrix<double> a(cells, cells);
-    a.setFromTriplets(triplets.begin(), triplets.end());
-    if (!m.pressure_increment_solver.Factorize(a))
-      Bad(at +
-          "the implicit solids-pressure matrix could not be factorised; remedy: "
-          "solids_pressure = \"explicit\"");
-    const Eigen::VectorXd psi = m.pressure_increment_solver.ldlt.solve(b);
-    if (!psi.allFinite())
-      Bad(at + "the implicit solids-pressure increment is not finite; remedy: lower cfl");
-    auto psi_at = [&](int i, int j) { return active(i, j) ? psi(id(i, j)) : 0.0; };
-    double largest = 0.0;
-    for (int j = 0; j < nz; ++j)
-      for (int i = 0; i < nx; ++i)
-        if (active(i, j))
-          largest = std::max(largest,
-                             std::abs(psi(id(i, j)) / c.pressure_derivative(i, j) - b(id(i, j))));
-    m.diag.max_pressure_correction = std::max(m.diag.max_pressure_correction, largest);
-    // The corrected fluxes; the gas takes the difference on each face (mixture flux held).
-    for (int j = 0; j < nz; ++j)
-      for (int i = 1; i < nx; ++i) {
-        const double df = -g_x(i, j) * (psi_at(i, j) - psi_at(i - 1, j));
-        if (df == 0.0) continue;
-        const double up = fx_at(i, j).phi_flux;
-        fs_x(i, j) += df;
-        m.us(i, j) += df / (up * dz);
-        m.ug(i, j) -= df / ((1.0 - up) * dz);
+      triplets.emplace_back(k, k, diag);
+      if (on) {
+        b(k) = -dt * (fs_x(i + 1, j) - fs_x(i, j) + fs_z(i, j + 1) - fs_z(i, j)) / volume;
       }
-    for (int j = 1; j < nz; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const double df = -g_z(i, j) * (psi_at(i, j) - psi_at(i, j - 1));
-        if (df == 0.0) continue;
-        const double up = fz_at(i, j).phi_flux;
-        fs_z(i, j) += df;
-        m.ws(i, j) += df / (up * dx);
-        m.wg(i, j) -= df / ((1.0 - up) * dx);
-      }
-  }
-  Array limited_x = Array::Zero(nx + 1, nz), limited_z = Array::Zero(nx, nz + 1);
+    }
+  Eigen::SparseMatrix<double> a(cells, cells);
+  a.setFromTriplets(triplets.begin(), triplets.end());
+  if (!pressure_increment_solver.Factorize(a))
+    Bad(s.at +
+        "the implicit solids-pressure matrix could not be factorised; remedy: "
+        "solids_pressure = \"explicit\"");
+  const Eigen::VectorXd psi = pressure_increment_solver.ldlt.solve(b);
+  if (!psi.allFinite())
+    Bad(s.at + "the implicit solids-pressure increment is not finite; remedy: lower cfl");
+  auto psi_at = [&](int i, int j) { return active(i, j) ? psi(id(i, j)) : 0.0; };
+  double largest = 0.0;
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i)
+      if (active(i, j))
+        largest =
+            std::max(largest, std::abs(psi(id(i, j)) / c.pressure_derivative(i, j) - b(id(i, j))));
+  diag.max_pressure_correction = std::max(diag.max_pressure_correction, largest);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i) {
+      const double df = -g_x(i, j) * (psi_at(i, j) - psi_at(i - 1, j));
+      if (df == 0.0) continue;
+      const double up = s.fx_at(i, j).phi_flux;
+      fs_x(i, j) += df;
+      us(i, j) += df / (up * dz);
+      ug(i, j) -= df / ((1.0 - up) * dz);
+    }
+  for (int j = 1; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double df = -g_z(i, j) * (psi_at(i, j) - psi_at(i, j - 1));
+      if (df == 0.0) continue;
+      const double up = s.fz_at(i, j).phi_flux;
+      fs_z(i, j) += df;
+      ws(i, j) += df / (up * dx);
+      wg(i, j) -= df / ((1.0 - up) * dx);
+    }
+}
+
+/// The flux limiter: a cell gives at most what it holds (positivity), and a full cell takes
+/// only what it has room for (the packing limit); then the new solids fraction.
+void TfmSimulation::Impl::LimitSolidsFluxes(Step& s) const {
+  const double dt = s.dt, volume = dx * dz, phi_max = s.o.ktgf.packing_limit;
+  Array& fs_x = s.fs_x;
+  Array& fs_z = s.fs_z;
+  s.limited_x = Array::Zero(nx + 1, nz);
+  s.limited_z = Array::Zero(nx, nz + 1);
+  Array& limited_x = s.limited_x;
+  Array& limited_z = s.limited_z;
   // Net solids outflow of cell (i, j) over the step and its parts [m^2 per unit depth].
   auto outflow = [&](int i, int j) {
     return dt * (std::max(fs_x(i + 1, j), 0.0) + std::max(-fs_x(i, j), 0.0) +
@@ -858,13 +989,12 @@ double TfmSimulation::StepCapped(double dt_cap) {
                  std::max(-fs_z(i, j + 1), 0.0) + std::max(fs_z(i, j), 0.0));
   };
   // Positivity: a cell cannot give more than it holds.
-  long positivity_limited = 0, packing_limited = 0;
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
       const double out = outflow(i, j), holds = phi(i, j) * volume;
       if (out <= holds) continue;
       const double r = holds / out;
-      ++positivity_limited;
+      ++s.positivity_limited;
       if (fs_x(i + 1, j) > 0.0) fs_x(i + 1, j) *= r, limited_x(i + 1, j) = 1.0;
       if (fs_x(i, j) < 0.0) fs_x(i, j) *= r, limited_x(i, j) = 1.0;
       if (fs_z(i, j + 1) > 0.0) fs_z(i, j + 1) *= r, limited_z(i, j + 1) = 1.0;
@@ -872,7 +1002,8 @@ double TfmSimulation::StepCapped(double dt_cap) {
     }
   // Packing limit: a full cell takes only what it has room for (each pass only lowers fluxes,
   // so the passes converge; a donor that keeps more is checked in the next pass).
-  Array phi_new(nx, nz);
+  Array& phi_new = s.phi_new;
+  phi_new.resize(nx, nz);
   auto update_phi = [&]() {
     for (int j = 0; j < nz; ++j)
       for (int i = 0; i < nx; ++i)
@@ -887,7 +1018,7 @@ double TfmSimulation::StepCapped(double dt_cap) {
       for (int i = 0; i < nx; ++i) {
         if (phi_new(i, j) <= phi_max + bound_slack) continue;
         over = true;
-        ++packing_limited;
+        ++s.packing_limited;
         const double in = inflow(i, j);
         const double room = std::max((phi_max - phi(i, j)) * volume + outflow(i, j), 0.0);
         const double r = in > 0.0 ? std::min(room / in, 1.0) : 0.0;
@@ -900,162 +1031,173 @@ double TfmSimulation::StepCapped(double dt_cap) {
   }
   const double phi_new_max = phi_new.maxCoeff(), phi_new_min = phi_new.minCoeff();
   if (!(phi_new_max <= phi_max + bound_slack) || !(phi_new_min >= -bound_slack))
-    Bad(at + "the solids fraction left [0, packing_limit = " + fmt(phi_max) + "] (min " +
+    Bad(s.at + "the solids fraction left [0, packing_limit = " + fmt(phi_max) + "] (min " +
         fmt(phi_new_min) + ", max " + fmt(phi_new_max) +
         ") although the flux limiter ran; remedy: lower cfl");
   phi_new = phi_new.max(0.0).min(phi_max);  // round-off only (bound_slack)
-  // The limited faces: the solids velocity carries the limited flux, the gas the rest of the
-  // unchanged mixture flux.
-  long limited = 0;
+  s.phi_new_max = phi_new_max;
+}
+
+/// The limited faces: the solids velocity carries the limited flux, the gas the rest of the
+/// unchanged mixture flux.
+void TfmSimulation::Impl::CorrectLimitedFaces(Step& s) {
   for (int j = 0; j < nz; ++j)
     for (int i = 1; i < nx; ++i) {
-      if (limited_x(i, j) == 0.0) continue;
-      ++limited;
-      const double up = fx_at(i, j).phi_flux;
-      if (up > 0.0) m.us(i, j) = fs_x(i, j) / (up * dz);
-      m.ug(i, j) = (mix_x(i, j) / dz - up * m.us(i, j)) / (1.0 - up);
+      if (s.limited_x(i, j) == 0.0) continue;
+      ++s.limited;
+      const double up = s.fx_at(i, j).phi_flux;
+      if (up > 0.0) us(i, j) = s.fs_x(i, j) / (up * dz);
+      ug(i, j) = (s.mix_x(i, j) / dz - up * us(i, j)) / (1.0 - up);
     }
   for (int j = 1; j < nz; ++j)
     for (int i = 0; i < nx; ++i) {
-      if (limited_z(i, j) == 0.0) continue;
-      ++limited;
-      const double up = fz_at(i, j).phi_flux;
-      if (up > 0.0) m.ws(i, j) = fs_z(i, j) / (up * dx);
-      m.wg(i, j) = (mix_z(i, j) / dx - up * m.ws(i, j)) / (1.0 - up);
+      if (s.limited_z(i, j) == 0.0) continue;
+      ++s.limited;
+      const double up = s.fz_at(i, j).phi_flux;
+      if (up > 0.0) ws(i, j) = s.fs_z(i, j) / (up * dx);
+      wg(i, j) = (s.mix_z(i, j) / dx - up * ws(i, j)) / (1.0 - up);
     }
+}
 
-  // ---- granular temperature ----
-  auto transported_theta = [&]() -> Array {
-    // ---- granular temperature (Eq. 15): transport and production explicit; conduction and
-    // the sinks (dissipation, drag, expansion) implicit, an M-matrix, so theta >= 0 for any step.
-    // Cells below residual_solids hold theta = 0 and no conduction reaches them. ----
-    Array kappa_x = Array::Zero(nx + 1, nz), kappa_z = Array::Zero(nx, nz + 1);
-    auto active = [&](int i, int j) { return phi_new(i, j) >= phi_res && phi(i, j) >= phi_res; };
-    // Harmonic face mean: a dilute cell next to a dense one exchanges at its own, small rate.
-    auto harmonic = [](double a, double b) { return a + b > 0.0 ? 2.0 * a * b / (a + b) : 0.0; };
-    for (int j = 0; j < nz; ++j)
-      for (int i = 1; i < nx; ++i)
-        if (active(i - 1, j) && active(i, j))
-          kappa_x(i, j) = harmonic(c.kappa(i - 1, j), c.kappa(i, j));
-    for (int j = 1; j < nz; ++j)
-      for (int i = 0; i < nx; ++i)
-        if (active(i, j - 1) && active(i, j))
-          kappa_z(i, j) = harmonic(c.kappa(i, j - 1), c.kappa(i, j));
-    const Array& th = m.theta;
-    auto theta_c = [&](int i, int j) {
-      return th(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1));
-    };
-    const int cells = nx * nz;
-    auto id = [nx](int i, int j) { return i + nx * j; };
-    Eigen::VectorXd energy_rhs = Eigen::VectorXd::Zero(cells);
-    std::vector<Eigen::Triplet<double>> triplets;
-    triplets.reserve(static_cast<std::size_t>(5 * cells));
-    for (int j = 0; j < nz; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const int k = id(i, j);
-        // Every coupling is entered (zero where inactive) so the pattern never changes.
-        const double gx_e = i + 1 < nx ? kappa_x(i + 1, j) / (dx * dx) : 0.0;
-        const double gx_w = i > 0 ? kappa_x(i, j) / (dx * dx) : 0.0;
-        const double gz_n = j + 1 < nz ? kappa_z(i, j + 1) / (dz * dz) : 0.0;
-        const double gz_s = j > 0 ? kappa_z(i, j) / (dz * dz) : 0.0;
-        if (i + 1 < nx) triplets.emplace_back(k, id(i + 1, j), -gx_e);
-        if (i > 0) triplets.emplace_back(k, id(i - 1, j), -gx_w);
-        if (j + 1 < nz) triplets.emplace_back(k, id(i, j + 1), -gz_n);
-        if (j > 0) triplets.emplace_back(k, id(i, j - 1), -gz_s);
-        if (phi_new(i, j) < phi_res) {
-          triplets.emplace_back(k, k, 1.0);  // theta = 0
-          continue;
-        }
-        // Upwind transport of phi theta with the final solids fluxes (out: own theta, in: the
-        // donor's).
-        auto carried = [&](double flux_out, int ni, int nj) {
-          return flux_out * (flux_out > 0.0 ? th(i, j) : theta_c(ni, nj));
-        };
-        const double adv = carried(fs_x(i + 1, j), i + 1, j) + carried(-fs_x(i, j), i - 1, j) +
-                           carried(fs_z(i, j + 1), i, j + 1) + carried(-fs_z(i, j), i, j - 1);
-        const Strain st = StrainAt(m.us, m.ws, i, j, dx, dz, o.solids_walls);
-        const double production =
-            2.0 * c.mu_kinetic(i, j) * st.dev2 + c.lambda(i, j) * st.div * st.div;
-        const double expansion = c.kinetic_pressure_per_theta(i, j) * st.div;  // P_s div v / theta
-        const double dissipation = c.dissipation(i, j);
-        energy_rhs(k) = 1.5 * rho_s * (phi(i, j) * th(i, j) - dt * adv / volume) / dt + production +
-                        std::max(-expansion, 0.0) * th(i, j) +
-                        std::max(-dissipation, 0.0) * th(i, j);
-        const double diagonal = 1.5 * rho_s * phi_new(i, j) / dt + std::max(dissipation, 0.0) +
-                                std::max(expansion, 0.0) +
-                                (o.interphase_drag ? 3.0 * m.beta(i, j) : 0.0);
-        triplets.emplace_back(k, k, diagonal + gx_e + gx_w + gz_n + gz_s);
+/// The granular temperature (Eq. 15): transport and production explicit; conduction and the
+/// sinks (dissipation, drag, expansion) implicit, an M-matrix, so theta >= 0 for any step.
+/// Cells below residual_solids hold theta = 0 and no conduction reaches them.
+Array TfmSimulation::Impl::TransportedTheta(const Step& s) {
+  const TfmOptions& o = s.o;
+  const CellClosures& c = s.c;
+  const Array& phi_new = s.phi_new;
+  const Array& fs_x = s.fs_x;
+  const Array& fs_z = s.fs_z;
+  const double dt = s.dt, volume = dx * dz, rho_s = o.particle_density_kg_m3;
+  const double phi_res = o.residual_solids;
+  Array kappa_x = Array::Zero(nx + 1, nz), kappa_z = Array::Zero(nx, nz + 1);
+  auto active = [&](int i, int j) { return phi_new(i, j) >= phi_res && phi(i, j) >= phi_res; };
+  // Harmonic face mean: a dilute cell next to a dense one exchanges at its own, small rate.
+  auto harmonic = [](double a, double b) { return a + b > 0.0 ? 2.0 * a * b / (a + b) : 0.0; };
+  for (int j = 0; j < nz; ++j)
+    for (int i = 1; i < nx; ++i)
+      if (active(i - 1, j) && active(i, j))
+        kappa_x(i, j) = harmonic(c.kappa(i - 1, j), c.kappa(i, j));
+  for (int j = 1; j < nz; ++j)
+    for (int i = 0; i < nx; ++i)
+      if (active(i, j - 1) && active(i, j))
+        kappa_z(i, j) = harmonic(c.kappa(i, j - 1), c.kappa(i, j));
+  const Array& th = theta;
+  const int row = nx, last_i = nx - 1, last_j = nz - 1;
+  auto theta_c = [&](int i, int j) {
+    return th(std::clamp(i, 0, last_i), std::clamp(j, 0, last_j));
+  };
+  const int cells = nx * nz;
+  auto id = [row](int i, int j) { return i + row * j; };
+  Eigen::VectorXd energy_rhs = Eigen::VectorXd::Zero(cells);
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(5 * cells));
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int k = id(i, j);
+      // Every coupling is entered (zero where inactive) so the pattern never changes.
+      const double gx_e = i + 1 < nx ? kappa_x(i + 1, j) / (dx * dx) : 0.0;
+      const double gx_w = i > 0 ? kappa_x(i, j) / (dx * dx) : 0.0;
+      const double gz_n = j + 1 < nz ? kappa_z(i, j + 1) / (dz * dz) : 0.0;
+      const double gz_s = j > 0 ? kappa_z(i, j) / (dz * dz) : 0.0;
+      if (i + 1 < nx) triplets.emplace_back(k, id(i + 1, j), -gx_e);
+      if (i > 0) triplets.emplace_back(k, id(i - 1, j), -gx_w);
+      if (j + 1 < nz) triplets.emplace_back(k, id(i, j + 1), -gz_n);
+      if (j > 0) triplets.emplace_back(k, id(i, j - 1), -gz_s);
+      if (phi_new(i, j) < phi_res) {
+        triplets.emplace_back(k, k, 1.0);  // theta = 0
+        continue;
       }
-    Eigen::SparseMatrix<double> energy(cells, cells);
-    energy.setFromTriplets(triplets.begin(), triplets.end());
-    if (!m.energy_solver.Factorize(energy))
-      Bad(at + "the granular temperature equation could not be factorised; remedy: lower cfl");
-    const Eigen::VectorXd theta_vector = m.energy_solver.ldlt.solve(energy_rhs);
-    Array theta_new = Eigen::Map<const Array>(theta_vector.data(), nx, nz);
-    const double theta_min = theta_new.minCoeff();
-    if (!theta_new.allFinite()) Bad(at + "non-finite granular temperature; remedy: lower cfl");
-    if (theta_min < -1e-9 * std::max(theta_new.maxCoeff(), 1e-12)) {
-      // The explicit parts are non-negative under the CFL limit; a negative value means the
-      // transport outran it.
-      Bad(at + "the granular temperature became negative (" + fmt(theta_min) +
-          " m^2/s^2) with a step of " + fmt(dt) + " s (limit: " + to_string(why) +
-          "); remedy: lower cfl");
+      // Upwind transport of phi theta with the final solids fluxes (out: own theta, in: the
+      // donor's).
+      auto carried = [&](double flux_out, int ni, int nj) {
+        return flux_out * (flux_out > 0.0 ? th(i, j) : theta_c(ni, nj));
+      };
+      const double adv = carried(fs_x(i + 1, j), i + 1, j) + carried(-fs_x(i, j), i - 1, j) +
+                         carried(fs_z(i, j + 1), i, j + 1) + carried(-fs_z(i, j), i, j - 1);
+      const Strain st = StrainAt(us, ws, i, j, dx, dz, o.solids_walls);
+      const double production =
+          2.0 * c.mu_kinetic(i, j) * st.dev2 + c.lambda(i, j) * st.div * st.div;
+      const double expansion = c.kinetic_pressure_per_theta(i, j) * st.div;  // P_s div v / theta
+      const double dissipation = c.dissipation(i, j);
+      energy_rhs(k) = 1.5 * rho_s * (phi(i, j) * th(i, j) - dt * adv / volume) / dt + production +
+                      std::max(-expansion, 0.0) * th(i, j) + std::max(-dissipation, 0.0) * th(i, j);
+      const double diagonal = 1.5 * rho_s * phi_new(i, j) / dt + std::max(dissipation, 0.0) +
+                              std::max(expansion, 0.0) +
+                              (o.interphase_drag ? 3.0 * beta(i, j) : 0.0);
+      triplets.emplace_back(k, k, diagonal + gx_e + gx_w + gz_n + gz_s);
     }
-    return theta_new.max(0.0);
-  };
-  // Local equilibrium (the algebraic option): from the new velocities, nothing transported;
-  // theta = 0 below algebraic_theta_min_solids (TfmOptions says why).
-  auto equilibrium_theta = [&]() -> Array {
-    Array theta = Array::Zero(nx, nz);
-    for (int j = 0; j < nz; ++j)
-      for (int i = 0; i < nx; ++i) {
-        if (phi_new(i, j) < std::max(phi_res, o.algebraic_theta_min_solids)) continue;
-        const Strain st = StrainAt(m.us, m.ws, i, j, dx, dz, o.solids_walls);
-        try {
-          theta(i, j) = m.ktgf->EquilibriumTheta(phi_new(i, j), st.div, st.dev2,
-                                                 o.interphase_drag ? 3.0 * m.beta(i, j) : 0.0);
-        } catch (const Error& e) {
-          throw Error(e.code(), at + "cell (" + std::to_string(i) + ", " + std::to_string(j) +
-                                    "): " + e.what());
-        }
-      }
-    return theta;
-  };
-  const Array theta_new = o.granular_temperature == GranularTemperature::kAlgebraic
-                              ? equilibrium_theta()
-                              : transported_theta();
+  Eigen::SparseMatrix<double> energy(cells, cells);
+  energy.setFromTriplets(triplets.begin(), triplets.end());
+  if (!energy_solver.Factorize(energy))
+    Bad(s.at + "the granular temperature equation could not be factorised; remedy: lower cfl");
+  const Eigen::VectorXd theta_vector = energy_solver.ldlt.solve(energy_rhs);
+  Array theta_new = Eigen::Map<const Array>(theta_vector.data(), nx, nz);
+  const double theta_min = theta_new.minCoeff();
+  if (!theta_new.allFinite()) Bad(s.at + "non-finite granular temperature; remedy: lower cfl");
+  if (theta_min < -1e-9 * std::max(theta_new.maxCoeff(), 1e-12)) {
+    // The explicit parts are non-negative under the CFL limit; a negative value means the
+    // transport outran it.
+    Bad(s.at + "the granular temperature became negative (" + fmt(theta_min) +
+        " m^2/s^2) with a step of " + fmt(dt) + " s (limit: " + to_string(s.why) +
+        "); remedy: lower cfl");
+  }
+  return theta_new.max(0.0);
+}
 
-  // ---- diagnostics ----
+/// Local equilibrium (the algebraic option): from the new velocities, nothing transported;
+/// theta = 0 below algebraic_theta_min_solids (TfmOptions says why).
+Array TfmSimulation::Impl::EquilibriumTheta(const Step& s) const {
+  const TfmOptions& o = s.o;
+  Array equilibrium = Array::Zero(nx, nz);
+  for (int j = 0; j < nz; ++j)
+    for (int i = 0; i < nx; ++i) {
+      if (s.phi_new(i, j) < std::max(o.residual_solids, o.algebraic_theta_min_solids)) continue;
+      const Strain st = StrainAt(us, ws, i, j, dx, dz, o.solids_walls);
+      try {
+        equilibrium(i, j) = ktgf->EquilibriumTheta(s.phi_new(i, j), st.div, st.dev2,
+                                                   o.interphase_drag ? 3.0 * beta(i, j) : 0.0);
+      } catch (const Error& e) {
+        throw Error(e.code(), s.at + "cell (" + std::to_string(i) + ", " + std::to_string(j) +
+                                  "): " + e.what());
+      }
+    }
+  return equilibrium;
+}
+
+/// The new state and the step's diagnostics (gas mass balance, limits, extremes).
+void TfmSimulation::Impl::Record(const Step& s, const Array& theta_new) {
+  const TfmOptions& o = s.o;
+  const double dt = s.dt, volume = dx * dz, rho_s = o.particle_density_kg_m3;
   double gas_in = 0.0, gas_out = 0.0;
   for (int i = 0; i < nx; ++i) {
-    gas_in += mix_z(i, 0);
-    gas_out += mix_z(i, nz);
+    gas_in += s.mix_z(i, 0);
+    gas_out += s.mix_z(i, nz);
   }
-  const double storage = -(phi_new - phi).sum() * volume / dt;  // d/dt int eps
-  const double mass_scale = rho_g * m.depth * dt;
-  TfmDiagnostics& dg = m.diag;
+  const double storage = -(s.phi_new - phi).sum() * volume / dt;  // d/dt int eps
+  const double mass_scale = o.gas.rho_g * depth * dt;
+  TfmDiagnostics& dg = diag;
   dg.gas_mass_in_kg += mass_scale * gas_in;
   dg.gas_mass_imbalance_kg += mass_scale * (gas_in - gas_out - storage);
-  m.phi = phi_new;
-  m.theta = theta_new;
-  m.time = t_new;
+  phi = s.phi_new;
+  theta = theta_new;
+  time = s.t_new;
   ++dg.steps;
-  dg.time_s = m.time;
+  dg.time_s = time;
   dg.last_dt_s = dt;
-  if (!landing) dg.min_dt_s = dg.min_dt_s == 0.0 ? dt : std::min(dg.min_dt_s, dt);
-  dg.last_limit = why;
-  ++dg.steps_by_limit[static_cast<int>(why)];
-  dg.solids_mass_kg = m.phi.sum() * volume * m.depth * rho_s;
-  dg.max_solids_fraction = std::max(dg.max_solids_fraction, phi_new_max);
+  if (!s.landing) dg.min_dt_s = dg.min_dt_s == 0.0 ? dt : std::min(dg.min_dt_s, dt);
+  dg.last_limit = s.why;
+  ++dg.steps_by_limit[static_cast<int>(s.why)];
+  dg.solids_mass_kg = phi.sum() * volume * depth * rho_s;
+  dg.max_solids_fraction = std::max(dg.max_solids_fraction, s.phi_new_max);
   dg.max_theta_m2_s2 = std::max(dg.max_theta_m2_s2, theta_new.maxCoeff());
-  dg.flux_limited_faces += limited;
-  dg.implicit_viscosity_faces += implicit_faces;
-  dg.positivity_limited_cells += positivity_limited;
-  dg.packing_limited_cells += packing_limited;
+  dg.flux_limited_faces += s.limited;
+  dg.implicit_viscosity_faces += s.implicit_faces;
+  dg.positivity_limited_cells += s.positivity_limited;
+  dg.packing_limited_cells += s.packing_limited;
   dg.max_wave_speed_m_s = std::max(
-      dg.max_wave_speed_m_s, std::sqrt(std::max(c.pressure_derivative.maxCoeff(), 0.0) / rho_s));
-  dg.poisson_residual = m.pressure->diagnostics().relative_residual;
-  return dt;
+      dg.max_wave_speed_m_s, std::sqrt(std::max(s.c.pressure_derivative.maxCoeff(), 0.0) / rho_s));
+  dg.poisson_residual = pressure->diagnostics().relative_residual;
 }
 
 }  // namespace consumers
