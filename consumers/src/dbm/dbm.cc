@@ -344,6 +344,29 @@ struct DbmSimulation::Impl {
 
   static int AxisOf(int component) { return component == 0 ? 0 : (component == 1 ? 2 : 1); }
   int Cell(int i, int j, int k) const { return i + n[0] * (j + n[1] * k); }
+  /// A cell-centred field at (i, j, k) clamped into the grid.
+  double Clamped(const Eigen::VectorXd& f, int i, int j, int k) const {
+    return f(
+        Cell(std::clamp(i, 0, n[0] - 1), std::clamp(j, 0, n[1] - 1), std::clamp(k, 0, n[2] - 1)));
+  }
+  /// Index of face p of axis a (faces normal to a: n[a] + 1 of them along a).
+  int FaceIndex(int a, int i, int j, int k) const {
+    std::array<int, 3> f = n;
+    ++f[a];
+    return i + f[0] * (j + f[1] * k);
+  }
+  /// The cells on the two sides of the face (a, p): p - e_a and p (clamped at the top face).
+  int CellBelow(int a, std::array<int, 3> p) const {
+    --p[a];
+    return Cell(p[0], p[1], p[2]);
+  }
+  int CellAbove(int a, std::array<int, 3> p) const {
+    p[a] = std::min(p[a], n[a] - 1);
+    return Cell(p[0], p[1], p[2]);
+  }
+  double FaceFraction(const Eigen::VectorXd& e, int a, const std::array<int, 3>& p) const {
+    return 0.5 * (e(CellBelow(a, p)) + e(CellAbove(a, p)));
+  }
   internal::Tent3 TentOf(const Vec& x) const {
     return internal::TentAt3(x(0), x(1), x(2), h[0], h[2], h[1], n[0], n[2], n[1]);
   }
@@ -538,60 +561,97 @@ void DbmSimulation::Step() {
   Accumulate(dt);
 }
 
+/// The projection's face coefficients: eps_e u = eps_e u* - eps_e a (dt / rho_e) grad p',
+/// a = eps_e / (eps_e + C_VM eps_b), continuity with storage. The bubbles' response to the
+/// pressure change enters the pressure equation (semi-implicit):
+/// -div((C_e + M) grad p_new) = -residual - div(M grad p_old), M the face mobility.
+struct DbmSimulation::Projection {
+  std::array<Eigen::VectorXd, 3> coeff, eps_face, coeff_total;
+  Eigen::VectorXd mobility_flux;  ///< div(M grad p_old) V
+};
+
 double DbmSimulation::TakeStep(double dt) {
   Impl& m = *impl_;
   diag_.min_dt_s = diag_.steps == 0 ? dt : std::min(diag_.min_dt_s, dt);
   const double t1 = time_ + dt;
-  const double rho_e = opt_.emulsion_density_kg_m3;
-  const double g = opt_.gravity_m_s2;
-  const int nx = m.n[0], nz = m.n[1], ny = m.n[2];
   const auto bubbles_start = std::chrono::steady_clock::now();
-
-  // The bubble and emulsion fractions from the bubbles' mapped volumes (fraction clamps and the
-  // largest bubble fraction counted when `count`).
-  std::vector<Blob> blobs;
-  auto deposit_fractions = [&](bool count) {
-    m.eps_b.setZero();
-    for (const DbmBubble& b : bubbles_) {
-      // Gas breaking through the surface displaces less emulsion as it leaves, each lobe by
-      // its own height (by the bubble's, a merger with a bubble below would bring back gas
-      // that had left).
-      blobs.clear();
-      AppendBlobs(b, &blobs);
-      for (const Blob& blob : blobs) {
-        const double d = SphereDiameter(blob.volume);
-        const double inside = std::clamp((opt_.height_m - blob.x(2)) / (0.5 * d), 0.0, 1.0);
-        internal::Deposit3(m.eps_b, m.StencilOf(blob.x, d), inside * blob.volume / m.cell_volume,
-                           nx, nz);
-      }
-    }
-    for (std::size_t k = 0; k < m.forming.size(); ++k) {
-      const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
-      internal::Deposit3(m.eps_b, m.StencilOf(at, opt_.bubble_diameter_m),
-                         m.forming[k] / m.cell_volume, nx, nz);
-    }
-    for (int c = 0; c < m.cells; ++c) {
-      if (count) diag_.max_bubble_fraction = std::max(diag_.max_bubble_fraction, m.eps_b(c));
-      double e = 1.0 - m.eps_b(c);
-      if (e < kMinEmulsionFraction) {
-        e = kMinEmulsionFraction;
-        if (count) diag_.fraction_clamps += 1;
-      }
-      m.eps_e_new(c) = e;
-    }
-  };
   // Bubbles placed before the first step are the initial state, not a sudden displacement.
   if (diag_.steps == 0) {
-    deposit_fractions(false);
+    DepositFractions(false);
     m.eps_e = m.eps_e_new;
   }
+  SampleEmulsion(dt);
+  InjectBubbles(dt);
+  MoveBubbles(dt);
+  RemoveLeavingBubbles();
+  if (opt_.collisions && !opt_.coalescence && bubbles_.size() > 1) CollideBubbles();
+  if (opt_.coalescence && bubbles_.size() > 1) CoalesceBubbles(t1);
+  diag_.bubble_wall_s += Seconds(bubbles_start);
 
-  // 1. What the bubbles see: cell-centred emulsion velocity, pressure gradient (less the
-  // hydrostatic head), material acceleration and (for lift) vorticity, by physical component.
+  const auto emulsion_start = std::chrono::steady_clock::now();
+  DepositFractions(true);
+  const std::vector<double> bubble_mobility = BubbleMobility(dt);
+  PredictEmulsion(dt);
+  const Projection projection = ProjectionCoefficients(dt);
+  const Eigen::VectorXd pressure_old = m.pressure;
+  SolveEmulsionPressure(dt, t1, projection);
+  int fastest_cell = 0;
+  const double cfl = CorrectEmulsionVelocities(dt, projection, &fastest_cell);
+  if (opt_.implicit_bubble_pressure && !bubbles_.empty()) {
+    FollowPressureChange(dt, m.pressure - pressure_old, bubble_mobility);
+    DepositFractions(false);
+  }
+  m.eps_e = m.eps_e_new;
+  diag_.max_cfl = std::max(diag_.max_cfl, cfl);
+  diag_.emulsion_wall_s += Seconds(emulsion_start);
+  time_ = t1;
+  diag_.steps += 1;
+  m.fastest_cell = fastest_cell;
+  return cfl;
+}
+
+/// The bubble and emulsion fractions from the bubbles' mapped volumes (fraction clamps and the
+/// largest bubble fraction counted when `count`).
+void DbmSimulation::DepositFractions(bool count) {
+  Impl& m = *impl_;
+  const int nx = m.n[0], nz = m.n[1];
+  std::vector<Blob> blobs;
+  m.eps_b.setZero();
+  for (const DbmBubble& b : bubbles_) {
+    // Gas breaking through the surface displaces less emulsion as it leaves, each lobe by
+    // its own height (by the bubble's, a merger with a bubble below would bring back gas
+    // that had left).
+    blobs.clear();
+    AppendBlobs(b, &blobs);
+    for (const Blob& blob : blobs) {
+      const double d = SphereDiameter(blob.volume);
+      const double inside = std::clamp((opt_.height_m - blob.x(2)) / (0.5 * d), 0.0, 1.0);
+      internal::Deposit3(m.eps_b, m.StencilOf(blob.x, d), inside * blob.volume / m.cell_volume, nx,
+                         nz);
+    }
+  }
+  for (std::size_t k = 0; k < m.forming.size(); ++k) {
+    const Vec at(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * SphereDiameter(m.forming[k]));
+    internal::Deposit3(m.eps_b, m.StencilOf(at, opt_.bubble_diameter_m),
+                       m.forming[k] / m.cell_volume, nx, nz);
+  }
+  for (int c = 0; c < m.cells; ++c) {
+    if (count) diag_.max_bubble_fraction = std::max(diag_.max_bubble_fraction, m.eps_b(c));
+    double e = 1.0 - m.eps_b(c);
+    if (e < kMinEmulsionFraction) {
+      e = kMinEmulsionFraction;
+      if (count) diag_.fraction_clamps += 1;
+    }
+    m.eps_e_new(c) = e;
+  }
+}
+
+/// What the bubbles see: cell-centred emulsion velocity, pressure gradient (less the hydrostatic
+/// head), material acceleration and (for lift) vorticity, by physical component.
+void DbmSimulation::SampleEmulsion(double dt) {
+  Impl& m = *impl_;
+  const int nx = m.n[0], nz = m.n[1], ny = m.n[2];
   for (int c = 0; c < 3; ++c) m.uc[c] = emulsion_velocity(c);
-  auto at = [&](const Eigen::VectorXd& f, int i, int j, int k) {
-    return f(m.Cell(std::clamp(i, 0, nx - 1), std::clamp(j, 0, nz - 1), std::clamp(k, 0, ny - 1)));
-  };
 #pragma omp parallel for schedule(static) if (m.cells >= kParallelCells)
   for (int k = 0; k < ny; ++k) {
     for (int j = 0; j < nz; ++j) {
@@ -602,7 +662,7 @@ double DbmSimulation::TakeStep(double dt) {
         // averaged to the centre.
         auto face_grad = [&](int di, int dj, int dk, double hh, bool wall) {
           if (wall) return 0.0;
-          return (at(m.pressure, i + di, j + dj, k + dk) - p) / hh;
+          return (m.Clamped(m.pressure, i + di, j + dj, k + dk) - p) / hh;
         };
         const double gx =
             0.5 * (face_grad(1, 0, 0, m.h[0], i == nx - 1) - face_grad(-1, 0, 0, m.h[0], i == 0));
@@ -617,15 +677,15 @@ double DbmSimulation::TakeStep(double dt) {
         // Velocity gradients, central differences (one-sided at the boundaries).
         auto d_dx = [&](const Eigen::VectorXd& f) {
           const int a = std::max(i - 1, 0), b = std::min(i + 1, nx - 1);
-          return b > a ? (at(f, b, j, k) - at(f, a, j, k)) / ((b - a) * m.h[0]) : 0.0;
+          return b > a ? (m.Clamped(f, b, j, k) - m.Clamped(f, a, j, k)) / ((b - a) * m.h[0]) : 0.0;
         };
         auto d_dy = [&](const Eigen::VectorXd& f) {
           const int a = std::max(k - 1, 0), b = std::min(k + 1, ny - 1);
-          return b > a ? (at(f, i, j, b) - at(f, i, j, a)) / ((b - a) * m.h[2]) : 0.0;
+          return b > a ? (m.Clamped(f, i, j, b) - m.Clamped(f, i, j, a)) / ((b - a) * m.h[2]) : 0.0;
         };
         auto d_dz = [&](const Eigen::VectorXd& f) {
           const int a = std::max(j - 1, 0), b = std::min(j + 1, nz - 1);
-          return b > a ? (at(f, i, b, k) - at(f, i, a, k)) / ((b - a) * m.h[1]) : 0.0;
+          return b > a ? (m.Clamped(f, i, b, k) - m.Clamped(f, i, a, k)) / ((b - a) * m.h[1]) : 0.0;
         };
         const Vec u(m.uc[0](cell), m.uc[1](cell), m.uc[2](cell));
         for (int c = 0; c < 3; ++c) {
@@ -645,53 +705,61 @@ double DbmSimulation::TakeStep(double dt) {
   for (int c = 0; c < 3; ++c) m.uc_prev[c] = m.uc[c];
   m.have_prev = true;
   m.previous_dt = dt;
+}
 
-  // 2. Injection: the forming bubbles grow by the nozzle flow; a full one is released, leaving
-  // the nozzle at its rise velocity. The emulsion sees them grow (no impulsive displacement).
-  if (m.nozzle_flow > 0.0) {
-    const double d = opt_.bubble_diameter_m;
-    const double v_b = SphereVolume(d);
-    const double u_br = davies_taylor_rise_velocity(d, g);
-    // The start-up ramp: the flow rises linearly over injection_ramp_s (its mean over the step).
-    const double ramp = opt_.injection_ramp_s > 0.0
-                            ? std::min(1.0, (time_ + 0.5 * dt) / opt_.injection_ramp_s)
-                            : 1.0;
-    for (std::size_t k = 0; k < opt_.nozzles.size(); ++k) {
-      m.forming[k] += ramp * m.nozzle_flow * dt;
-      diag_.gas_injected_m3 += ramp * m.nozzle_flow * dt;
-      while (m.forming[k] >= v_b) {
-        AddBubble(Vec(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * d), Vec(0.0, 0.0, u_br), d);
-        diag_.bubbles_injected += 1;
-        m.forming[k] -= v_b;
-      }
+/// Injection: the forming bubbles grow by the nozzle flow; a full one is released, leaving the
+/// nozzle at its rise velocity. The emulsion sees them grow (no impulsive displacement).
+void DbmSimulation::InjectBubbles(double dt) {
+  Impl& m = *impl_;
+  if (!(m.nozzle_flow > 0.0)) return;
+  const double d = opt_.bubble_diameter_m;
+  const double v_b = SphereVolume(d);
+  const double u_br = davies_taylor_rise_velocity(d, opt_.gravity_m_s2);
+  // The start-up ramp: the flow rises linearly over injection_ramp_s (its mean over the step).
+  const double ramp =
+      opt_.injection_ramp_s > 0.0 ? std::min(1.0, (time_ + 0.5 * dt) / opt_.injection_ramp_s) : 1.0;
+  for (std::size_t k = 0; k < opt_.nozzles.size(); ++k) {
+    m.forming[k] += ramp * m.nozzle_flow * dt;
+    diag_.gas_injected_m3 += ramp * m.nozzle_flow * dt;
+    while (m.forming[k] >= v_b) {
+      AddBubble(Vec(opt_.nozzles[k].x_m, opt_.nozzles[k].y_m, 0.5 * d), Vec(0.0, 0.0, u_br), d);
+      diag_.bubbles_injected += 1;
+      m.forming[k] -= v_b;
     }
   }
+}
 
-  // Walls: a bubble's centre stays a radius away; its velocity into a wall is dropped.
-  // A merged bubble can grow into a wall: its centre then jumps off it, and its gas follows as
-  // after a merger (move_bubble_centre), not within the step.
-  auto KeepInside = [&](DbmBubble& bub) {
-    const double r = 0.5 * bub.diameter_m;
-    const double lo[3] = {r, r, r};
-    const double hi[3] = {opt_.width_m - r, opt_.depth_m - r, 1e300};
-    Vec delta = Vec::Zero();
-    for (int c = 0; c < 3; ++c) {
-      if (bub.x(c) < lo[c]) {
-        delta(c) = lo[c] - bub.x(c);
-        bub.v(c) = std::max(bub.v(c), 0.0);
-      } else if (bub.x(c) > hi[c]) {
-        delta(c) = hi[c] - bub.x(c);
-        bub.v(c) = std::min(bub.v(c), 0.0);
-      }
+/// Walls: a bubble's centre stays a radius away; its velocity into a wall is dropped. A merged
+/// bubble can grow into a wall: its centre then jumps off it, and its gas follows as after a
+/// merger (move_bubble_centre), not within the step.
+void DbmSimulation::KeepInside(DbmBubble& bub) const {
+  const double r = 0.5 * bub.diameter_m;
+  const double lo[3] = {r, r, r};
+  const double hi[3] = {opt_.width_m - r, opt_.depth_m - r, 1e300};
+  Vec delta = Vec::Zero();
+  for (int c = 0; c < 3; ++c) {
+    if (bub.x(c) < lo[c]) {
+      delta(c) = lo[c] - bub.x(c);
+      bub.v(c) = std::max(bub.v(c), 0.0);
+    } else if (bub.x(c) > hi[c]) {
+      delta(c) = hi[c] - bub.x(c);
+      bub.v(c) = std::min(bub.v(c), 0.0);
     }
-    move_bubble_centre(&bub, delta);
-  };  // 3. Bubble motion (drag implicit) and the force each exerts on the emulsion.
+  }
+  move_bubble_centre(&bub, delta);
+}
+
+/// Bubble motion (drag implicit) and the force each exerts on the emulsion (Impl::reaction).
+void DbmSimulation::MoveBubbles(double dt) {
+  Impl& m = *impl_;
+  const int nx = m.n[0], nz = m.n[1];
+  const double rho_e = opt_.emulsion_density_kg_m3;
+  const double g = opt_.gravity_m_s2;
   const long nb = static_cast<long>(bubbles_.size());
   std::vector<Vec> reaction(static_cast<std::size_t>(nb));
   const Vec gravity(0.0, 0.0, -g);
   const double rho_b = opt_.bubble_density_kg_m3;
   const double c_vm = opt_.virtual_mass_coefficient;
-  const std::array<double, 3> domain_hi{opt_.width_m, opt_.depth_m, opt_.height_m};
 #pragma omp parallel for schedule(static) if (nb >= kParallelBubbles)
   for (long b = 0; b < nb; ++b) {
     DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
@@ -734,139 +802,133 @@ double DbmSimulation::TakeStep(double dt) {
       internal::Deposit3(m.reaction[c], s,
                          -reaction[static_cast<std::size_t>(b)](c) / m.cell_volume, nx, nz);
   }
+}
 
-  // 4. Bubbles leave at the bed surface: when their centre, and the gas still relaxing to it
-  // after a jump (its lobes), have reached it.
-  {
-    std::size_t kept = 0;
-    std::vector<Blob> blobs;
-    auto left = [&](const DbmBubble& b) {
-      blobs.clear();
-      AppendBlobs(b, &blobs);
-      bool all = b.x(2) >= opt_.height_m;
-      for (const Blob& blob : blobs) all = all && blob.x(2) >= opt_.height_m;
-      return all;
-    };
-    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
-      if (left(bubbles_[b])) {
-        diag_.bubbles_left += 1;
-        diag_.gas_left_m3 += bubbles_[b].volume_m3;
-      } else {
-        bubbles_[kept++] = bubbles_[b];
-      }
-    }
-    bubbles_.resize(kept);
-  }
-
-  // 5. Bubble-bubble contacts: without coalescence, overlapping bubbles are pushed apart and
-  // their approach along the line of centres is removed (a perfectly inelastic hard-sphere
-  // collision, volume-weighted, so momentum is kept); with coalescence, touching bubbles merge
-  // after the film-drainage time.
-  if (opt_.collisions && !opt_.coalescence && bubbles_.size() > 1) {
-    for (int sweep = 0; sweep < kCollisionSweeps; ++sweep) {
-      bool any = false;
-      for (const auto& [a, b] : TouchingPairs(bubbles_, domain_hi)) {
-        DbmBubble& A = bubbles_[static_cast<std::size_t>(a)];
-        DbmBubble& B = bubbles_[static_cast<std::size_t>(b)];
-        Vec n = B.x - A.x;
-        const double dist = n.norm();
-        const double overlap = 0.5 * (A.diameter_m + B.diameter_m) - dist;
-        if (overlap <= 0.0) continue;
-        n = dist > 1e-12 ? Vec(n / dist) : Vec(0.0, 0.0, 1.0);  // coincident: stack them
-        const double wa = B.volume_m3 / (A.volume_m3 + B.volume_m3), wb = 1.0 - wa;
-        A.x -= wa * overlap * n;
-        B.x += wb * overlap * n;
-        const double approach = (B.v - A.v).dot(n);
-        if (approach < 0.0) {
-          A.v += wa * approach * n;
-          B.v -= wb * approach * n;
-        }
-        any = true;
-      }
-      for (DbmBubble& b : bubbles_) KeepInside(b);
-      if (!any) break;
-      diag_.collision_sweeps += 1;
+/// Bubbles leave at the bed surface: when their centre, and the gas still relaxing to it after
+/// a jump (its lobes), have reached it.
+void DbmSimulation::RemoveLeavingBubbles() {
+  std::size_t kept = 0;
+  std::vector<Blob> blobs;
+  auto left = [&](const DbmBubble& b) {
+    blobs.clear();
+    AppendBlobs(b, &blobs);
+    bool all = b.x(2) >= opt_.height_m;
+    for (const Blob& blob : blobs) all = all && blob.x(2) >= opt_.height_m;
+    return all;
+  };
+  for (std::size_t b = 0; b < bubbles_.size(); ++b) {
+    if (left(bubbles_[b])) {
+      diag_.bubbles_left += 1;
+      diag_.gas_left_m3 += bubbles_[b].volume_m3;
+    } else {
+      bubbles_[kept++] = bubbles_[b];
     }
   }
-  if (opt_.coalescence && bubbles_.size() > 1) {
-    std::map<std::pair<std::uint64_t, std::uint64_t>, double> touching;
-    std::vector<std::pair<int, int>> ready;
+  bubbles_.resize(kept);
+}
+
+/// Bubble-bubble contacts without coalescence: overlapping bubbles are pushed apart and their
+/// approach along the line of centres is removed (a perfectly inelastic hard-sphere collision,
+/// volume-weighted, so momentum is kept).
+void DbmSimulation::CollideBubbles() {
+  const std::array<double, 3> domain_hi{opt_.width_m, opt_.depth_m, opt_.height_m};
+  for (int sweep = 0; sweep < kCollisionSweeps; ++sweep) {
+    bool any = false;
     for (const auto& [a, b] : TouchingPairs(bubbles_, domain_hi)) {
-      const auto key = std::minmax(bubbles_[a].id, bubbles_[b].id);
-      const auto found = m.contact_since.find(key);
-      const double since = found == m.contact_since.end() ? t1 : found->second;
-      touching[key] = since;
-      if (t1 - since >= opt_.film_drainage_s - 1e-12) ready.emplace_back(a, b);
-    }
-    m.contact_since = std::move(touching);
-    std::vector<char> gone(bubbles_.size(), 0), merged(bubbles_.size(), 0);
-    for (const auto& [a, b] : ready) {
-      if (merged[a] || merged[b]) continue;  // each bubble merges at most once per step
-      DbmBubble& A = bubbles_[a];
-      A = merge_bubbles(A, bubbles_[b]);
-      gone[b] = merged[a] = merged[b] = 1;
-      // The merged bubble keeps A's id; its pending contacts restart.
-      diag_.coalescences += 1;
-      diag_.max_bubble_diameter_m = std::max(diag_.max_bubble_diameter_m, A.diameter_m);
-      if (A.diameter_m >= std::min(opt_.width_m, opt_.depth_m)) {
-        throw std::runtime_error(
-            "dbm: at t = " + fmt(t1) + " s coalescence made a bubble of " + fmt(A.diameter_m) +
-            " m, as wide as the column: the bed slugs, which spherical bubbles do not represent; "
-            "remedy: a wider column, a lower superficial velocity, or a film-drainage time");
+      DbmBubble& A = bubbles_[static_cast<std::size_t>(a)];
+      DbmBubble& B = bubbles_[static_cast<std::size_t>(b)];
+      Vec n = B.x - A.x;
+      const double dist = n.norm();
+      const double overlap = 0.5 * (A.diameter_m + B.diameter_m) - dist;
+      if (overlap <= 0.0) continue;
+      n = dist > 1e-12 ? Vec(n / dist) : Vec(0.0, 0.0, 1.0);  // coincident: stack them
+      const double wa = B.volume_m3 / (A.volume_m3 + B.volume_m3), wb = 1.0 - wa;
+      A.x -= wa * overlap * n;
+      B.x += wb * overlap * n;
+      const double approach = (B.v - A.v).dot(n);
+      if (approach < 0.0) {
+        A.v += wa * approach * n;
+        B.v -= wb * approach * n;
       }
+      any = true;
     }
-    std::size_t kept = 0;
-    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
-      if (!gone[b]) bubbles_[kept++] = bubbles_[b];
-    }
-    bubbles_.resize(kept);
+    for (DbmBubble& b : bubbles_) KeepInside(b);
+    if (!any) break;
+    diag_.collision_sweeps += 1;
   }
-  diag_.bubble_wall_s += Seconds(bubbles_start);
+}
 
-  // 6. The new bubble and emulsion fractions (again after the bubbles' pressure correction).
-  const auto emulsion_start = std::chrono::steady_clock::now();
-  deposit_fractions(true);
-  // The bubbles' mobility under a pressure-gradient change, per cell: sum of V dt / (m + k dt)
-  // (m the inertia density, k the drag linearised at the bubble's slip) over the cell volume.
+/// Coalescence: touching bubbles merge after the film-drainage time (t1: the end of the step).
+void DbmSimulation::CoalesceBubbles(double t1) {
+  Impl& m = *impl_;
+  const std::array<double, 3> domain_hi{opt_.width_m, opt_.depth_m, opt_.height_m};
+  std::map<std::pair<std::uint64_t, std::uint64_t>, double> touching;
+  std::vector<std::pair<int, int>> ready;
+  for (const auto& [a, b] : TouchingPairs(bubbles_, domain_hi)) {
+    const auto key = std::minmax(bubbles_[a].id, bubbles_[b].id);
+    const auto found = m.contact_since.find(key);
+    const double since = found == m.contact_since.end() ? t1 : found->second;
+    touching[key] = since;
+    if (t1 - since >= opt_.film_drainage_s - 1e-12) ready.emplace_back(a, b);
+  }
+  m.contact_since = std::move(touching);
+  std::vector<char> gone(bubbles_.size(), 0), merged(bubbles_.size(), 0);
+  for (const auto& [a, b] : ready) {
+    if (merged[a] || merged[b]) continue;  // each bubble merges at most once per step
+    DbmBubble& A = bubbles_[a];
+    A = merge_bubbles(A, bubbles_[b]);
+    gone[b] = merged[a] = merged[b] = 1;
+    // The merged bubble keeps A's id; its pending contacts restart.
+    diag_.coalescences += 1;
+    diag_.max_bubble_diameter_m = std::max(diag_.max_bubble_diameter_m, A.diameter_m);
+    if (A.diameter_m >= std::min(opt_.width_m, opt_.depth_m)) {
+      throw std::runtime_error(
+          "dbm: at t = " + fmt(t1) + " s coalescence made a bubble of " + fmt(A.diameter_m) +
+          " m, as wide as the column: the bed slugs, which spherical bubbles do not represent; "
+          "remedy: a wider column, a lower superficial velocity, or a film-drainage time");
+    }
+  }
+  std::size_t kept = 0;
+  for (std::size_t b = 0; b < bubbles_.size(); ++b) {
+    if (!gone[b]) bubbles_[kept++] = bubbles_[b];
+  }
+  bubbles_.resize(kept);
+}
+
+/// The bubbles' mobility under a pressure-gradient change (Impl::mobility, per cell: sum of
+/// V dt / (m + k dt), m the inertia density, k the drag linearised at the bubble's slip, over
+/// the cell volume); returns each bubble's dt / (m + k dt) (empty without the implicit
+/// bubble pressure).
+std::vector<double> DbmSimulation::BubbleMobility(double dt) {
+  Impl& m = *impl_;
+  const int nx = m.n[0], nz = m.n[1];
   m.mobility.setZero();
   std::vector<double> bubble_mobility(bubbles_.size(), 0.0);
-  if (opt_.implicit_bubble_pressure) {
-    const double inertia = force_.inertia_density();
-    for (std::size_t b = 0; b < bubbles_.size(); ++b) {
-      const DbmBubble& bub = bubbles_[b];
-      const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
-      Vec u;
-      for (int c = 0; c < 3; ++c) u(c) = internal::Interpolate3(m.uc[c], s, nx, nz);
-      const double k =
-          0.75 * force_.drag_coefficient() * rho_e * (bub.v - u).norm() / bub.diameter_m;
-      bubble_mobility[b] = dt / (inertia + k * dt);
-      internal::Deposit3(m.mobility, s, bub.volume_m3 * bubble_mobility[b] / m.cell_volume, nx, nz);
-    }
+  if (!opt_.implicit_bubble_pressure) return bubble_mobility;
+  const double inertia = force_.inertia_density();
+  for (std::size_t b = 0; b < bubbles_.size(); ++b) {
+    const DbmBubble& bub = bubbles_[b];
+    const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
+    Vec u;
+    for (int c = 0; c < 3; ++c) u(c) = internal::Interpolate3(m.uc[c], s, nx, nz);
+    const double k = 0.75 * force_.drag_coefficient() * opt_.emulsion_density_kg_m3 *
+                     (bub.v - u).norm() / bub.diameter_m;
+    bubble_mobility[b] = dt / (inertia + k * dt);
+    internal::Deposit3(m.mobility, s, bub.volume_m3 * bubble_mobility[b] / m.cell_volume, nx, nz);
   }
+  return bubble_mobility;
+}
 
-  // 7. Emulsion predictor: advection and viscosity explicit, the bubbles' reaction as a source,
-  // the inertia (eps_e + C_VM eps_b) rho_e with the bubbles' added mass.
+/// Emulsion predictor (Impl::vel_star): advection and viscosity explicit, the bubbles' reaction
+/// as a source, the inertia (eps_e + C_VM eps_b) rho_e with the bubbles' added mass.
+void DbmSimulation::PredictEmulsion(double dt) {
+  Impl& m = *impl_;
+  const double rho_e = opt_.emulsion_density_kg_m3;
+  const double c_vm = opt_.virtual_mass_coefficient;
   const std::array<const Eigen::VectorXd*, 3> vel{&m.vel[0], &m.vel[1], &m.vel[2]};
   const internal::MacOperators3D ops(vel, m.eps_e, m.n, m.h, opt_.emulsion_viscosity_pa_s,
                                      opt_.walls == WallSlip::kNoSlip,
                                      opt_.depth_walls == WallSlip::kNoSlip);
-  auto face_index = [&](int a, int i, int j, int k) {
-    std::array<int, 3> f = m.n;
-    ++f[a];
-    return i + f[0] * (j + f[1] * k);
-  };
-  // The cells on the two sides of the face (a, p): p - e_a and p (clamped at the top face).
-  auto cell_below = [&](int a, std::array<int, 3> p) {
-    --p[a];
-    return m.Cell(p[0], p[1], p[2]);
-  };
-  auto cell_above = [&](int a, std::array<int, 3> p) {
-    p[a] = std::min(p[a], m.n[a] - 1);
-    return m.Cell(p[0], p[1], p[2]);
-  };
-  auto face_eps = [&](const Eigen::VectorXd& e, int a, const std::array<int, 3>& p) {
-    return 0.5 * (e(cell_below(a, p)) + e(cell_above(a, p)));
-  };
   for (int a = 0; a < 3; ++a) {
     const int component = Impl::AxisOf(a);  // the involution maps axes to components too
     std::array<int, 3> f = m.n;
@@ -882,68 +944,75 @@ double DbmSimulation::TakeStep(double dt) {
           const std::array<int, 3> p{i, j, k};
           if (p[a] < 1 || p[a] > last) continue;
           const internal::FaceMomentumTerms terms = ops.Face(a, p);
-          const double e_f = face_eps(m.eps_e_new, a, p);
+          const double e_f = m.FaceFraction(m.eps_e_new, a, p);
           const double inertia = (e_f + c_vm * (1.0 - e_f)) * rho_e;
-          const double source = 0.5 * (m.reaction[component](cell_below(a, p)) +
-                                       m.reaction[component](cell_above(a, p)));
-          const int fi = face_index(a, i, j, k);
+          const double source = 0.5 * (m.reaction[component](m.CellBelow(a, p)) +
+                                       m.reaction[component](m.CellAbove(a, p)));
+          const int fi = m.FaceIndex(a, i, j, k);
           star(fi) = m.vel[a](fi) + dt * (-terms.advection + (terms.viscous + source) / inertia);
         }
       }
     }
   }
+}
 
-  // 8. Projection: eps_e u = eps_e u* - eps_e a (dt / rho_e) grad p', a = eps_e / (eps_e +
-  // C_VM eps_b), continuity with storage.
-  std::array<Eigen::VectorXd, 3> coeff, eps_face, coeff_total;
+DbmSimulation::Projection DbmSimulation::ProjectionCoefficients(double dt) const {
+  const Impl& m = *impl_;
+  const double rho_e = opt_.emulsion_density_kg_m3;
+  const double c_vm = opt_.virtual_mass_coefficient;
+  Projection pr;
   for (int a = 0; a < 3; ++a) {
     std::array<int, 3> f = m.n;
     ++f[a];
-    coeff[a] = Eigen::VectorXd::Zero(m.vel[a].size());
-    eps_face[a] = Eigen::VectorXd::Zero(m.vel[a].size());
+    pr.coeff[a] = Eigen::VectorXd::Zero(m.vel[a].size());
+    pr.eps_face[a] = Eigen::VectorXd::Zero(m.vel[a].size());
     for (int k = 0; k < f[2]; ++k) {
       for (int j = 0; j < f[1]; ++j) {
         for (int i = 0; i < f[0]; ++i) {
           const std::array<int, 3> p{i, j, k};
           const bool wall = p[a] == 0 || (p[a] == f[a] - 1 && a != 1);
           if (wall) continue;
-          const double e_f = face_eps(m.eps_e_new, a, p);
-          const int fi = face_index(a, i, j, k);
-          eps_face[a](fi) = e_f;
-          coeff[a](fi) = e_f * e_f / (e_f + c_vm * (1.0 - e_f)) * dt / rho_e;
+          const double e_f = m.FaceFraction(m.eps_e_new, a, p);
+          const int fi = m.FaceIndex(a, i, j, k);
+          pr.eps_face[a](fi) = e_f;
+          pr.coeff[a](fi) = e_f * e_f / (e_f + c_vm * (1.0 - e_f)) * dt / rho_e;
         }
       }
     }
-    coeff_total[a] = coeff[a];
+    pr.coeff_total[a] = pr.coeff[a];
   }
-  // The bubbles' response to the pressure change enters the pressure equation (semi-implicit):
-  // -div((C_e + M) grad p_new) = -residual - div(M grad p_old), M the face mobility.
-  Eigen::VectorXd mobility_flux = Eigen::VectorXd::Zero(m.cells);  // div(M grad p_old) V
-  if (opt_.implicit_bubble_pressure) {
-    for (int a = 0; a < 3; ++a) {
-      std::array<int, 3> f = m.n;
-      ++f[a];
-      const double face_area =
-          a == 0 ? m.h[1] * m.h[2] : (a == 1 ? m.h[0] * m.h[2] : m.h[0] * m.h[1]);
-      for (int k = 0; k < f[2]; ++k)
-        for (int j = 0; j < f[1]; ++j)
-          for (int i = 0; i < f[0]; ++i) {
-            const std::array<int, 3> p{i, j, k};
-            const int fi = face_index(a, i, j, k);
-            if (coeff[a](fi) == 0.0) continue;  // walls
-            const int below = cell_below(a, p);
-            const bool top = p[a] == m.n[a];
-            const double mf =
-                top ? m.mobility(below) : 0.5 * (m.mobility(below) + m.mobility(cell_above(a, p)));
-            coeff_total[a](fi) += mf;
-            const double hh = top ? 0.5 * m.h[a] : m.h[a];
-            const double p_up = top ? 0.0 : m.pressure(cell_above(a, p));
-            const double flux = mf * face_area * (m.pressure(below) - p_up) / hh;  // out of below
-            mobility_flux(below) += flux;
-            if (!top) mobility_flux(cell_above(a, p)) -= flux;
-          }
-    }
+  pr.mobility_flux = Eigen::VectorXd::Zero(m.cells);
+  if (!opt_.implicit_bubble_pressure) return pr;
+  for (int a = 0; a < 3; ++a) {
+    std::array<int, 3> f = m.n;
+    ++f[a];
+    const double face_area =
+        a == 0 ? m.h[1] * m.h[2] : (a == 1 ? m.h[0] * m.h[2] : m.h[0] * m.h[1]);
+    for (int k = 0; k < f[2]; ++k)
+      for (int j = 0; j < f[1]; ++j)
+        for (int i = 0; i < f[0]; ++i) {
+          const std::array<int, 3> p{i, j, k};
+          const int fi = m.FaceIndex(a, i, j, k);
+          if (pr.coeff[a](fi) == 0.0) continue;  // walls
+          const int below = m.CellBelow(a, p);
+          const bool top = p[a] == m.n[a];
+          const double mf =
+              top ? m.mobility(below) : 0.5 * (m.mobility(below) + m.mobility(m.CellAbove(a, p)));
+          pr.coeff_total[a](fi) += mf;
+          const double hh = top ? 0.5 * m.h[a] : m.h[a];
+          const double p_up = top ? 0.0 : m.pressure(m.CellAbove(a, p));
+          const double flux = mf * face_area * (m.pressure(below) - p_up) / hh;  // out of below
+          pr.mobility_flux(below) += flux;
+          if (!top) pr.mobility_flux(m.CellAbove(a, p)) -= flux;
+        }
   }
+  return pr;
+}
+
+/// The emulsion pressure from the continuity residual of the predicted velocities.
+void DbmSimulation::SolveEmulsionPressure(double dt, double t1, const Projection& pr) {
+  Impl& m = *impl_;
+  const int nx = m.n[0], nz = m.n[1], ny = m.n[2];
   const double area[3] = {m.h[1] * m.h[2], m.h[0] * m.h[2], m.h[0] * m.h[1]};
   Eigen::VectorXd residual(m.cells);
   for (int k = 0; k < ny; ++k) {
@@ -954,19 +1023,18 @@ double DbmSimulation::TakeStep(double dt) {
         for (int a = 0; a < 3; ++a) {
           std::array<int, 3> lo{i, j, k}, hi{i, j, k};
           ++hi[a];
-          const int flo = face_index(a, lo[0], lo[1], lo[2]);
-          const int fhi = face_index(a, hi[0], hi[1], hi[2]);
-          net += area[a] *
-                 (eps_face[a](fhi) * m.vel_star[a](fhi) - eps_face[a](flo) * m.vel_star[a](flo));
+          const int flo = m.FaceIndex(a, lo[0], lo[1], lo[2]);
+          const int fhi = m.FaceIndex(a, hi[0], hi[1], hi[2]);
+          net += area[a] * (pr.eps_face[a](fhi) * m.vel_star[a](fhi) -
+                            pr.eps_face[a](flo) * m.vel_star[a](flo));
         }
-        residual(cell) = net - mobility_flux(cell);
+        residual(cell) = net - pr.mobility_flux(cell);
       }
     }
   }
-  const Eigen::VectorXd pressure_old = m.pressure;
   try {
-    m.pressure =
-        m.solver->Solve(coeff_total[0], coeff_total[2], coeff_total[1], residual, 0.0, m.pressure);
+    m.pressure = m.solver->Solve(pr.coeff_total[0], pr.coeff_total[2], pr.coeff_total[1], residual,
+                                 0.0, m.pressure);
   } catch (const Error& e) {
     // A run-time failure (exit 1), with what the bubbles did to the pressure equation.
     throw std::runtime_error("dbm: at t = " + fmt(t1) + " s " + e.what() +
@@ -978,8 +1046,14 @@ double DbmSimulation::TakeStep(double dt) {
   diag_.max_continuity_residual =
       std::max(diag_.max_continuity_residual, m.solver->diagnostics().relative_residual);
   diag_.max_cg_iterations = std::max(diag_.max_cg_iterations, m.solver->diagnostics().iterations);
+}
+
+/// The emulsion's face velocities from the new pressure, and its outflow through the surface;
+/// returns the largest face CFL number (and the cell below that face).
+double DbmSimulation::CorrectEmulsionVelocities(double dt, const Projection& pr,
+                                                int* fastest_cell) {
+  Impl& m = *impl_;
   double cfl = 0.0;
-  int fastest_cell = 0;  // for the diagnosis
   for (int a = 0; a < 3; ++a) {
     std::array<int, 3> f = m.n;
     ++f[a];
@@ -987,74 +1061,69 @@ double DbmSimulation::TakeStep(double dt) {
       for (int j = 0; j < f[1]; ++j) {
         for (int i = 0; i < f[0]; ++i) {
           const std::array<int, 3> p{i, j, k};
-          const int fi = face_index(a, i, j, k);
-          if (coeff[a](fi) == 0.0) {
+          const int fi = m.FaceIndex(a, i, j, k);
+          if (pr.coeff[a](fi) == 0.0) {
             m.vel[a](fi) = 0.0;
             continue;
           }
-          const double p_up = p[a] < m.n[a] ? m.pressure(cell_above(a, p)) : 0.0;
+          const double p_up = p[a] < m.n[a] ? m.pressure(m.CellAbove(a, p)) : 0.0;
           const double hh = p[a] < m.n[a] ? m.h[a] : 0.5 * m.h[a];
-          const double grad = (p_up - m.pressure(cell_below(a, p))) / hh;
-          m.vel[a](fi) = m.vel_star[a](fi) - coeff[a](fi) / eps_face[a](fi) * grad;
+          const double grad = (p_up - m.pressure(m.CellBelow(a, p))) / hh;
+          m.vel[a](fi) = m.vel_star[a](fi) - pr.coeff[a](fi) / pr.eps_face[a](fi) * grad;
           const double face_cfl = std::abs(m.vel[a](fi)) * dt / m.h[a];
           if (face_cfl > cfl) {
             cfl = face_cfl;
-            fastest_cell = cell_below(a, p);
+            *fastest_cell = m.CellBelow(a, p);
           }
         }
       }
     }
   }
-  {
-    double out = 0.0;
-    for (int k = 0; k < ny; ++k)
+  const double top_area = m.h[0] * m.h[2];
+  double out = 0.0;
+  for (int k = 0; k < m.n[2]; ++k)
+    for (int i = 0; i < m.n[0]; ++i) {
+      const int fi = m.FaceIndex(1, i, m.n[1], k);
+      out += top_area * pr.eps_face[1](fi) * m.vel[1](fi);
+    }
+  m.top_outflow = out;
+  return cfl;
+}
+
+/// The bubbles follow the pressure change dp: dv = -dt / (m + k dt) grad dp.
+void DbmSimulation::FollowPressureChange(double dt, const Eigen::VectorXd& dp,
+                                         const std::vector<double>& bubble_mobility) {
+  Impl& m = *impl_;
+  const int nx = m.n[0], nz = m.n[1], ny = m.n[2];
+  std::array<Eigen::VectorXd, 3> grad_dp;
+  for (auto& g : grad_dp) g = Eigen::VectorXd::Zero(m.cells);
+  for (int k = 0; k < ny; ++k)
+    for (int j = 0; j < nz; ++j)
       for (int i = 0; i < nx; ++i) {
-        const int fi = face_index(1, i, nz, k);
-        out += area[1] * eps_face[1](fi) * m.vel[1](fi);
+        const int cell = m.Cell(i, j, k);
+        auto face_grad = [&](int di, int dj, int dk, double hh, bool wall) {
+          return wall ? 0.0 : (m.Clamped(dp, i + di, j + dj, k + dk) - dp(cell)) / hh;
+        };
+        grad_dp[0](cell) =
+            0.5 * (face_grad(1, 0, 0, m.h[0], i == nx - 1) - face_grad(-1, 0, 0, m.h[0], i == 0));
+        grad_dp[1](cell) =
+            0.5 * (face_grad(0, 0, 1, m.h[2], k == ny - 1) - face_grad(0, 0, -1, m.h[2], k == 0));
+        const double g_top =
+            j == nz - 1 ? -dp(cell) / (0.5 * m.h[1]) : face_grad(0, 1, 0, m.h[1], false);
+        grad_dp[2](cell) = 0.5 * (g_top - face_grad(0, -1, 0, m.h[1], j == 0));
       }
-    m.top_outflow = out;
-  }
-  if (opt_.implicit_bubble_pressure && !bubbles_.empty()) {
-    // The bubbles follow the pressure change: dv = -dt / (m + k dt) grad(p_new - p_old).
-    const Eigen::VectorXd dp = m.pressure - pressure_old;
-    std::array<Eigen::VectorXd, 3> grad_dp;
-    for (auto& g : grad_dp) g = Eigen::VectorXd::Zero(m.cells);
-    for (int k = 0; k < ny; ++k)
-      for (int j = 0; j < nz; ++j)
-        for (int i = 0; i < nx; ++i) {
-          const int cell = m.Cell(i, j, k);
-          auto face_grad = [&](int di, int dj, int dk, double hh, bool wall) {
-            return wall ? 0.0 : (at(dp, i + di, j + dj, k + dk) - dp(cell)) / hh;
-          };
-          grad_dp[0](cell) =
-              0.5 * (face_grad(1, 0, 0, m.h[0], i == nx - 1) - face_grad(-1, 0, 0, m.h[0], i == 0));
-          grad_dp[1](cell) =
-              0.5 * (face_grad(0, 0, 1, m.h[2], k == ny - 1) - face_grad(0, 0, -1, m.h[2], k == 0));
-          const double g_top =
-              j == nz - 1 ? -dp(cell) / (0.5 * m.h[1]) : face_grad(0, 1, 0, m.h[1], false);
-          grad_dp[2](cell) = 0.5 * (g_top - face_grad(0, -1, 0, m.h[1], j == 0));
-        }
 #pragma omp parallel for schedule(static) if (static_cast <long>(bubbles_.size()) >= \
                                               kParallelBubbles)
-    for (long b = 0; b < static_cast<long>(bubbles_.size()); ++b) {
-      DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
-      const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
-      Vec g;
-      for (int c = 0; c < 3; ++c) g(c) = internal::Interpolate3(grad_dp[c], s, nx, nz);
-      const Vec dv = -bubble_mobility[static_cast<std::size_t>(b)] * g;
-      bub.v += dv;
-      bub.x += dt * dv;
-      KeepInside(bub);
-    }
-    deposit_fractions(false);
+  for (long b = 0; b < static_cast<long>(bubbles_.size()); ++b) {
+    DbmBubble& bub = bubbles_[static_cast<std::size_t>(b)];
+    const internal::Smooth3 s = m.StencilOf(bub.x, bub.diameter_m);
+    Vec g;
+    for (int c = 0; c < 3; ++c) g(c) = internal::Interpolate3(grad_dp[c], s, nx, nz);
+    const Vec dv = -bubble_mobility[static_cast<std::size_t>(b)] * g;
+    bub.v += dv;
+    bub.x += dt * dv;
+    KeepInside(bub);
   }
-  m.eps_e = m.eps_e_new;
-  diag_.max_cfl = std::max(diag_.max_cfl, cfl);
-  diag_.emulsion_wall_s += Seconds(emulsion_start);
-  time_ = t1;
-  diag_.steps += 1;
-  m.fastest_cell = fastest_cell;
-  return cfl;
 }
 
 void DbmSimulation::Accumulate(double dt) {

@@ -257,6 +257,23 @@ class DbmSimulation {
 
   /// One step of dt (all but the time averages); returns the emulsion's CFL number reached.
   double TakeStep(double dt);
+  // The stages of TakeStep, in order (dbm.cc).
+  struct Projection;
+  void DepositFractions(bool count);
+  void SampleEmulsion(double dt);
+  void InjectBubbles(double dt);
+  void KeepInside(DbmBubble& bubble) const;
+  void MoveBubbles(double dt);
+  void RemoveLeavingBubbles();
+  void CollideBubbles();
+  void CoalesceBubbles(double t1);
+  std::vector<double> BubbleMobility(double dt);
+  void PredictEmulsion(double dt);
+  Projection ProjectionCoefficients(double dt) const;
+  void SolveEmulsionPressure(double dt, double t1, const Projection& projection);
+  double CorrectEmulsionVelocities(double dt, const Projection& projection, int* fastest_cell);
+  void FollowPressureChange(double dt, const Eigen::VectorXd& dp,
+                            const std::vector<double>& bubble_mobility);
   /// The time averages and bubble samples of the step just taken.
   void Accumulate(double dt);
 };
