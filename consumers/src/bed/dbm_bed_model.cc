@@ -123,6 +123,355 @@ double MeanOver(const Eigen::VectorXd& field, const DbmOptions& o, Keep keep) {
   return count > 0 ? sum / count : 0.0;
 }
 
+/// The realization a run starts from (an injection seed of the scene's) and the outputs.
+void CheckRealization(const Scene& scene, const BedRealization* start) {
+  if (start) {
+    if (!dynamic_cast<const DbmInjectionSeed*>(start))
+      Bad("dbm: the realization was not made by the DBM (an injection seed is expected)");
+    if (start->seed != scene.seed)
+      Bad("dbm: the injection seed " + std::to_string(start->seed) + " is not the scene's seed " +
+          std::to_string(scene.seed));
+  }
+  if (scene.outputs.particles)
+    Bad("[outputs] particles = true: the DBM has no particles (its bubbles go to the figure "
+        "data with [outputs] fields = true)");
+}
+
+/// The DBM's options for a scene and a law, checked: the gas flow above U_mf, the injected bubble
+/// against the column and the nozzle pitch, the stable step.
+DbmOptions CheckedOptions(const Scene& scene, const Law& law, const MinFluidizationResult& umf) {
+  const SceneDbm& sd = scene.dbm;
+  const std::string law_ref = law.record().reference();
+  if (!(sd.superficial_velocity_m_s > umf.umf_m_s))
+    Bad("[dbm] superficial_velocity_m_s = " + Num(sd.superficial_velocity_m_s) +
+        " m/s is not above U_mf = " + Num(umf.umf_m_s) + " m/s of " + law_ref +
+        ": by two-phase theory the bed carries no bubbles (raise u0 above U_mf)");
+  const DbmOptions o = SceneDbmOptions(scene, umf.umf_m_s, scene.seed);
+  const double column = std::min(o.width_m, o.depth_m);
+  if (!(o.bubble_diameter_m < column))
+    Bad("[dbm] bubble_diameter_m = 0: the Davidson-Harrison bubble of each nozzle's flow is " +
+        Num(o.bubble_diameter_m) + " m, not smaller than the column (" + Num(column) +
+        " m): more nozzles, or a fixed bubble_diameter_m");
+  if (sd.nozzles_per_side > 1 && sd.nozzle_pitch_m < o.bubble_diameter_m)
+    Bad("[dbm] nozzle_pitch_m = " + Num(sd.nozzle_pitch_m) + " m is below the injected bubble " +
+        Num(o.bubble_diameter_m) + " m (Davidson-Harrison with " + law_ref +
+        "): the bubbles of neighbouring nozzles would overlap");
+  std::string why;
+  if (!o.IsValid(&why)) Bad("[dbm] " + why);
+  const double stable = o.StableTimeStep();
+  if (o.dt_s > stable)
+    Bad("[dbm] dt_s = " + Num(o.dt_s) + " s is above the stability limit " + Num(stable) +
+        " s (the emulsion's explicit viscous limit and the bubbles' slip relaxation time at "
+        "d_b = " +
+        Num(o.bubble_diameter_m) + " m); remedy: dt_s <= " + Num(stable));
+  return o;
+}
+
+/// What the sampling loop records: the bed series (into the result), the JSON series and the
+/// hold-up samples after average_from_s (for the batch means).
+struct DbmSeries {
+  nlohmann::json series = nlohmann::json::array();
+  std::vector<double> holdup_samples;
+};
+
+/// Runs the simulation to `duration`, sampling at the scene's interval.
+DbmSeries SampleRun(DbmSimulation& dbm, const Scene& scene, const DbmOptions& o, double duration,
+                    const std::string& law_ref, const BedProgress& progress, BedResult* out) {
+  const SceneDbm& sd = scene.dbm;
+  const double column_volume = o.width_m * o.depth_m * o.height_m;
+  DbmSeries s;
+  try {
+    for (const double t : internal::sample_times(duration, sd.sample_interval_s)) {
+      dbm.AdvanceTo(t);
+      const auto& bubbles = dbm.bubbles();
+      double d_sum = 0.0, z_sum = 0.0;
+      for (const DbmBubble& b : bubbles) {
+        d_sum += b.diameter_m;
+        z_sum += b.x(2);
+      }
+      const double count = static_cast<double>(bubbles.size());
+      const double holdup = dbm.gas_in_bubbles_m3() / column_volume;
+      BedSample smp;
+      smp.t_s = dbm.time();
+      smp.bubble_diameter_m = count > 0 ? d_sum / count : 0.0;
+      smp.bubble_centroid_m = count > 0 ? z_sum / count : 0.0;
+      smp.bed_height_m = o.height_m;
+      out->series.push_back(smp);
+      if (smp.t_s > sd.average_from_s + 1e-12) s.holdup_samples.push_back(holdup);
+      s.series.push_back({{"t_s", smp.t_s},
+                          {"bubbles", bubbles.size()},
+                          {"holdup", holdup},
+                          {"mean_diameter_m", smp.bubble_diameter_m},
+                          {"mean_height_m", smp.bubble_centroid_m}});
+      if (progress)
+        progress(dbm.time() / duration,
+                 "DBM: " + std::to_string(bubbles.size()) + " bubbles, hold-up " + Num(holdup));
+    }
+    if (dbm.time() < duration - 1e-9 * o.dt_s) dbm.AdvanceTo(duration);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("dbm " + scene.name + " with " + law_ref + ": " + e.what());
+  }
+  return s;
+}
+
+/// Hold-up against height and overall; sizes against height.
+struct HeightProfiles {
+  nlohmann::json holdup = nlohmann::json::array(), size = nlohmann::json::array();
+  double holdup_mean = 0.0, d_sum = 0.0, d_count = 0.0;
+};
+
+HeightProfiles ProfilesOf(const DbmAverages& av, const DbmOptions& o) {
+  const double hz = o.height_m / o.nz;
+  HeightProfiles p;
+  for (int j = 0; j < o.nz; ++j) {
+    const double h = av.holdup_by_height(j) / av.samples;
+    p.holdup_mean += h / o.nz;
+    p.holdup.push_back({{"z_m", (j + 0.5) * hz}, {"holdup", h}});
+    const double c = av.count_by_height(j);
+    p.d_sum += av.diameter_sum_by_height(j);
+    p.d_count += c;
+    p.size.push_back({{"z_m", (j + 0.5) * hz},
+                      {"mean_diameter_m", c > 0 ? av.diameter_sum_by_height(j) / c : 0.0},
+                      {"bubbles_per_sample", c / av.samples}});
+  }
+  return p;
+}
+
+/// The mean bubble at each of the scene's size heights beside Darton's and Mori-Wen's
+/// correlations; appends each to the headline.
+nlohmann::json SizesAgainstCorrelations(const DbmAverages& av, const DbmOptions& o,
+                                        const SceneDbm& sd, double umf_m_s,
+                                        std::vector<std::pair<std::string, double>>* headline) {
+  const double hz = o.height_m / o.nz;
+  const double excess = sd.superficial_velocity_m_s - umf_m_s;
+  const double area_per_orifice = o.width_m * o.depth_m / static_cast<double>(o.nozzles.size());
+  const double bed_area = o.width_m * o.depth_m;
+  const double bed_diameter = std::sqrt(4.0 * bed_area / 3.14159265358979323846);
+  nlohmann::json sizes = nlohmann::json::array();
+  for (double h : sd.size_heights_m) {
+    const int j = std::clamp(static_cast<int>(h / hz), 0, o.nz - 1);
+    const double c = av.count_by_height(j);
+    const double mean = c > 0 ? av.diameter_sum_by_height(j) / c : 0.0;
+    const double darton = darton_bubble_diameter(excess, h, area_per_orifice, o.gravity_m_s2);
+    const double mori_wen = mori_wen_bubble_diameter(excess, h, bed_area, bed_diameter);
+    sizes.push_back({{"height_m", h},
+                     {"row_z_m", {j * hz, (j + 1) * hz}},
+                     {"mean_diameter_m", c > 0 ? nlohmann::json(mean) : nlohmann::json(nullptr)},
+                     {"bubbles_sampled", c},
+                     {"darton_m", darton},
+                     {"mori_wen_m", mori_wen},
+                     {"ratio_to_darton", c > 0 ? nlohmann::json(mean / darton) : nullptr},
+                     {"ratio_to_mori_wen", c > 0 ? nlohmann::json(mean / mori_wen) : nullptr}});
+    headline->push_back({"mean_diameter_at_" + Num(h) + "_m", mean});
+  }
+  return sizes;
+}
+
+/// Circulation: the time-averaged vertical emulsion velocity in the core (the central quarter
+/// of the cross-section) and near the walls (the rest), over the middle third of the height,
+/// and the upflow through the mid-height plane per unit column area.
+struct Circulation {
+  double w_core = 0.0, w_wall = 0.0, upflow = 0.0;
+};
+
+Circulation CirculationOf(const DbmAverages& av, const DbmOptions& o) {
+  const Eigen::VectorXd w_mean = av.w_cell / av.time_s;
+  const double W = o.width_m, D = o.depth_m, H = o.height_m, hz = o.height_m / o.nz;
+  auto core = [&](double x, double y) {
+    return std::abs(x - 0.5 * W) <= 0.25 * W && (o.ny == 1 || std::abs(y - 0.5 * D) <= 0.25 * D);
+  };
+  auto middle = [&](double z) { return z >= H / 3.0 && z <= 2.0 * H / 3.0; };
+  Circulation c;
+  c.w_core =
+      MeanOver(w_mean, o, [&](double x, double y, double z) { return core(x, y) && middle(z); });
+  c.w_wall =
+      MeanOver(w_mean, o, [&](double x, double y, double z) { return !core(x, y) && middle(z); });
+  const int j_mid = std::clamp(static_cast<int>(0.5 * H / hz), 0, o.nz - 1);
+  const Eigen::VectorXd w_up = w_mean.cwiseMax(0.0);
+  c.upflow = MeanOver(w_up, o,
+                      [&](double, double, double z) { return static_cast<int>(z / hz) == j_mid; });
+  return c;
+}
+
+/// Figure data ([outputs] fields = true): the mid-plane averaged field, profiles, size
+/// histograms, the last bubbles; returns the file written.
+std::string WriteFigureData(const DbmSimulation& dbm, const Scene& scene, const Law& law,
+                            const DbmOptions& o, double umf_m_s, const HeightProfiles& profiles,
+                            const std::string& output_directory) {
+  const SceneDbm& sd = scene.dbm;
+  const DbmAverages& av = dbm.averages();
+  const Eigen::VectorXd w_mean = av.w_cell / av.time_s;
+  const Eigen::VectorXd u_mean = av.u_cell / av.time_s;
+  const std::string dir = internal::scene_output_directory(scene, output_directory);
+  std::filesystem::create_directories(dir);
+  const int k0 = (o.ny - 1) / 2, k1 = o.ny / 2;  // the vertical mid-plane (y = D/2)
+  nlohmann::json ux = nlohmann::json::array(), uz = nlohmann::json::array(),
+                 eb = nlohmann::json::array();
+  const Eigen::VectorXd eb_mean = av.bubble_fraction / av.time_s;
+  for (int j = 0; j < o.nz; ++j) {
+    nlohmann::json rx = nlohmann::json::array(), rz = nlohmann::json::array(),
+                   re = nlohmann::json::array();
+    for (int i = 0; i < o.nx; ++i) {
+      const int a = i + o.nx * (j + o.nz * k0), b = i + o.nx * (j + o.nz * k1);
+      rx.push_back(0.5 * (u_mean(a) + u_mean(b)));
+      rz.push_back(0.5 * (w_mean(a) + w_mean(b)));
+      re.push_back(0.5 * (eb_mean(a) + eb_mean(b)));
+    }
+    ux.push_back(rx);
+    uz.push_back(rz);
+    eb.push_back(re);
+  }
+  nlohmann::json bx = nlohmann::json::array(), by = nlohmann::json::array(),
+                 bz = nlohmann::json::array(), bd = nlohmann::json::array();
+  for (const DbmBubble& b : dbm.bubbles()) {
+    bx.push_back(b.x(0));
+    by.push_back(b.x(1));
+    bz.push_back(b.x(2));
+    bd.push_back(b.diameter_m);
+  }
+  nlohmann::json hist = nlohmann::json::array();
+  for (int j = 0; j < o.nz; ++j) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int s = 0; s < av.size_histogram.cols(); ++s) row.push_back(av.size_histogram(j, s));
+    hist.push_back(row);
+  }
+  const double area_per_orifice = o.width_m * o.depth_m / static_cast<double>(o.nozzles.size());
+  const nlohmann::json fig = {
+      {"scene", scene.name},
+      {"law", law.record().reference()},
+      {"superficial_velocity_m_s", sd.superficial_velocity_m_s},
+      {"umf_m_s", umf_m_s},
+      {"area_per_orifice_m2", area_per_orifice},
+      {"gravity_m_s2", o.gravity_m_s2},
+      {"coalescence", sd.coalescence},
+      {"width_m", o.width_m},
+      {"depth_m", o.depth_m},
+      {"height_m", o.height_m},
+      {"cells", {o.nx, o.ny, o.nz}},
+      {"t_s", dbm.time()},
+      {"average_from_s", sd.average_from_s},
+      {"midplane_u_x", ux},
+      {"midplane_u_z", uz},
+      {"midplane_bubble_fraction", eb},
+      {"holdup_profile", profiles.holdup},
+      {"size_profile", profiles.size},
+      {"size_bin_m", av.size_bin_m},
+      {"size_histogram_by_row", hist},
+      {"bubbles", {{"x_m", bx}, {"y_m", by}, {"z_m", bz}, {"diameter_m", bd}}}};
+  const std::string path = dir + "/" + scene.name + "_" + law.record().name + "_dbm.json";
+  core::write_file_atomically(path, fig.dump(), "DBM figure data");
+  return path;
+}
+
+/// What the result JSON and the brief report share.
+struct DbmSummary {
+  double umf_m_s = 0.0, u_br = 0.0, holdup_theory = 0.0, gas_balance = 0.0;
+  double wall_s = 0.0, cells_steps = 0.0;
+  HeightProfiles profiles;
+  Circulation circulation;
+  BatchMeans holdup_error;
+  nlohmann::json sizes;
+  std::vector<std::pair<std::string, double>> headline;
+};
+
+nlohmann::json ResultJson(const DbmSimulation& dbm, const Scene& scene, const DbmOptions& o,
+                          const BedResult& out, const DbmSummary& s, const nlohmann::json& series) {
+  const SceneDbm& sd = scene.dbm;
+  const DbmDiagnostics& dg = dbm.diagnostics();
+  const DbmAverages& av = dbm.averages();
+  const double holdup_mean = s.profiles.holdup_mean;
+  nlohmann::json head = nlohmann::json::object();
+  for (const auto& [name, value] : s.headline) head[name] = value;
+  return {
+      {"solver", "dbm"},
+      {"scene", out.scene},
+      {"scene_hash", out.scene_hash},
+      {"law", out.law},
+      {"umf_m_s", s.umf_m_s},
+      {"eps_mf", scene.eps_mf},
+      {"superficial_velocity_m_s", sd.superficial_velocity_m_s},
+      {"bubble_gas_flow_m3_s", o.bubble_gas_flow_m3_s},
+      {"injected_diameter_m", o.bubble_diameter_m},
+      {"injected_diameter_from",
+       sd.bubble_diameter_m > 0.0 ? "scene" : "davidson_harrison_per_nozzle"},
+      {"nozzles", o.nozzles.size()},
+      {"coupling_width_m", o.CouplingWidth()},
+      {"coalescence", sd.coalescence},
+      {"film_drainage_s", sd.film_drainage_s},
+      {"collisions", sd.collisions && !sd.coalescence},
+      {"grid", {{"cells_x", o.nx}, {"cells_y", o.nz}, {"cells_z", o.ny}}},
+      {"dt_s", o.dt_s},
+      {"stable_dt_s", o.StableTimeStep()},
+      {"cfl", o.cfl},
+      {"min_dt_s", dg.min_dt_s},
+      {"headline", head},
+      {"holdup",
+       {{"mean", holdup_mean},
+        {"two_phase_theory", s.holdup_theory},
+        {"ratio_to_theory", s.holdup_theory > 0 ? holdup_mean / s.holdup_theory : 0.0},
+        {"standard_error", s.holdup_error.standard_error},
+        {"batches", s.holdup_error.batches},
+        {"rise_velocity_davies_taylor_m_s", s.u_br}}},
+      {"sizes", s.sizes},
+      {"circulation",
+       {{"core_mean_w_m_s", s.circulation.w_core},
+        {"wall_mean_w_m_s", s.circulation.w_wall},
+        {"upflow_mid_height_m_s", s.circulation.upflow},
+        {"up_in_core_down_at_walls", s.circulation.w_core > 0.0 && s.circulation.w_wall < 0.0}}},
+      {"holdup_profile", s.profiles.holdup},
+      {"size_profile", s.profiles.size},
+      {"series", series},
+      {"averaged_s", av.time_s},
+      {"samples", av.samples},
+      {"gas",
+       {{"injected_m3", dg.gas_injected_m3},
+        {"left_at_surface_m3", dg.gas_left_m3},
+        {"in_bubbles_m3", dbm.gas_in_bubbles_m3()},
+        {"forming_at_nozzles_m3", dbm.gas_forming_m3()},
+        {"relative_imbalance", s.gas_balance}}},
+      {"bubbles_injected", dg.bubbles_injected},
+      {"bubbles_left", dg.bubbles_left},
+      {"coalescences", dg.coalescences},
+      {"max_bubble_diameter_m", dg.max_bubble_diameter_m},
+      {"max_cfl", dg.max_cfl},
+      {"retaken_steps", dg.retaken_steps},
+      {"max_bubble_fraction", dg.max_bubble_fraction},
+      {"fraction_clamps", dg.fraction_clamps},
+      {"max_pressure_residual", dg.max_continuity_residual},
+      {"max_cg_iterations", dg.max_cg_iterations},
+      {"steps", dg.steps},
+      {"bubble_steps", dg.bubble_steps},
+      {"bubble_steps_per_s", dg.bubble_steps / s.wall_s},
+      {"cell_steps_per_s", s.cells_steps / s.wall_s},
+      {"emulsion_wall_s", dg.emulsion_wall_s},
+      {"bubble_wall_s", dg.bubble_wall_s},
+      {"drag_out_of_range", out.law_out_of_range},
+      {"wall_s", s.wall_s},
+      {"output_files", out.output_files}};
+}
+
+std::string BriefReport(const DbmSimulation& dbm, const Scene& scene, const DbmOptions& o,
+                        const BedResult& out, const DbmSummary& s) {
+  const DbmDiagnostics& dg = dbm.diagnostics();
+  std::ostringstream brief;
+  brief << "DBM " << scene.name << " with " << out.law << ": U_mf = " << Num(s.umf_m_s)
+        << " m/s, u0 = " << Num(scene.dbm.superficial_velocity_m_s) << " m/s, bubble gas "
+        << Num(o.bubble_gas_flow_m3_s) << " m^3/s as " << Num(o.bubble_diameter_m)
+        << " m bubbles from " << o.nozzles.size() << " nozzles; " << o.nx << " x " << o.ny << " x "
+        << o.nz << " cells, " << dg.steps << " steps of " << Num(o.dt_s) << " s; wall "
+        << Num(s.wall_s) << " s (" << Num(dg.bubble_steps / s.wall_s) << " bubble-steps/s, "
+        << Num(s.cells_steps / s.wall_s) << " cell-steps/s)\n  hold-up "
+        << Num(s.profiles.holdup_mean) << " +- " << Num(s.holdup_error.standard_error)
+        << " (batch means)"
+        << " (two-phase theory " << Num(s.holdup_theory) << "), mean bubble "
+        << Num(out.metrics.bubble_diameter_m) << " m, circulation: core "
+        << Num(s.circulation.w_core) << " m/s, walls " << Num(s.circulation.w_wall)
+        << " m/s, upflow " << Num(s.circulation.upflow) << " m/s\n  gas balance "
+        << Num(s.gas_balance) << " (rel.), " << dg.coalescences << " coalescences, max bubble "
+        << Num(dg.max_bubble_diameter_m) << " m, max CFL " << Num(dg.max_cfl);
+  return brief.str();
+}
+
 class DbmBedModel : public BedModel {
  public:
   std::string key() const override { return "dbm"; }
@@ -191,330 +540,72 @@ class DbmBedModel : public BedModel {
     const auto t0 = std::chrono::steady_clock::now();
     scene.Validate();
     if (!law) Bad("dbm: law is null");
-    if (start) {
-      if (!dynamic_cast<const DbmInjectionSeed*>(start))
-        Bad("dbm: the realization was not made by the DBM (an injection seed is expected)");
-      if (start->seed != scene.seed)
-        Bad("dbm: the injection seed " + std::to_string(start->seed) + " is not the scene's seed " +
-            std::to_string(scene.seed));
-    }
-    if (scene.outputs.particles)
-      Bad("[outputs] particles = true: the DBM has no particles (its bubbles go to the figure "
-          "data with [outputs] fields = true)");
+    CheckRealization(scene, start);
     const SceneDbm& sd = scene.dbm;
     MinFluidizationOptions mo;
     mo.eps_mf = scene.eps_mf;
     const MinFluidizationResult umf =
         minimum_fluidization(*law, scene.particles, scene.gas, mo);  // kOutOfValidity: stop here
     const std::string law_ref = law->record().reference();
-    if (!(sd.superficial_velocity_m_s > umf.umf_m_s))
-      Bad("[dbm] superficial_velocity_m_s = " + Num(sd.superficial_velocity_m_s) +
-          " m/s is not above U_mf = " + Num(umf.umf_m_s) + " m/s of " + law_ref +
-          ": by two-phase theory the bed carries no bubbles (raise u0 above U_mf)");
-    const DbmOptions o = SceneDbmOptions(scene, umf.umf_m_s, scene.seed);
-    const double column = std::min(o.width_m, o.depth_m);
-    if (!(o.bubble_diameter_m < column))
-      Bad("[dbm] bubble_diameter_m = 0: the Davidson-Harrison bubble of each nozzle's flow is " +
-          Num(o.bubble_diameter_m) + " m, not smaller than the column (" + Num(column) +
-          " m): more nozzles, or a fixed bubble_diameter_m");
-    if (sd.nozzles_per_side > 1 && sd.nozzle_pitch_m < o.bubble_diameter_m)
-      Bad("[dbm] nozzle_pitch_m = " + Num(sd.nozzle_pitch_m) + " m is below the injected bubble " +
-          Num(o.bubble_diameter_m) + " m (Davidson-Harrison with " + law_ref +
-          "): the bubbles of neighbouring nozzles would overlap");
-    {
-      std::string why;
-      if (!o.IsValid(&why)) Bad("[dbm] " + why);
-      const double stable = o.StableTimeStep();
-      if (o.dt_s > stable)
-        Bad("[dbm] dt_s = " + Num(o.dt_s) + " s is above the stability limit " + Num(stable) +
-            " s (the emulsion's explicit viscous limit and the bubbles' slip relaxation time at "
-            "d_b = " +
-            Num(o.bubble_diameter_m) + " m); remedy: dt_s <= " + Num(stable));
-    }
+    const DbmOptions o = CheckedOptions(scene, *law, umf);
     DbmSimulation dbm(o);
     const double duration = options.duration_s > 0.0 ? options.duration_s : scene.time.duration_s;
-    const double column_volume = o.width_m * o.depth_m * o.height_m;
-    const double u_br = davies_taylor_rise_velocity(o.bubble_diameter_m, o.gravity_m_s2);
 
     BedResult out = internal::result_header(key(), scene, law_ref, "two_phase");
-    nlohmann::json series = nlohmann::json::array();
-    std::vector<double> holdup_samples;  // after average_from_s, for the batch means
-    try {
-      for (const double t : internal::sample_times(duration, sd.sample_interval_s)) {
-        dbm.AdvanceTo(t);
-        const auto& bubbles = dbm.bubbles();
-        double d_sum = 0.0, z_sum = 0.0;
-        for (const DbmBubble& b : bubbles) {
-          d_sum += b.diameter_m;
-          z_sum += b.x(2);
-        }
-        const double count = static_cast<double>(bubbles.size());
-        const double holdup = dbm.gas_in_bubbles_m3() / column_volume;
-        BedSample smp;
-        smp.t_s = dbm.time();
-        smp.bubble_diameter_m = count > 0 ? d_sum / count : 0.0;
-        smp.bubble_centroid_m = count > 0 ? z_sum / count : 0.0;
-        smp.bed_height_m = o.height_m;
-        out.series.push_back(smp);
-        if (smp.t_s > sd.average_from_s + 1e-12) holdup_samples.push_back(holdup);
-        series.push_back({{"t_s", smp.t_s},
-                          {"bubbles", bubbles.size()},
-                          {"holdup", holdup},
-                          {"mean_diameter_m", smp.bubble_diameter_m},
-                          {"mean_height_m", smp.bubble_centroid_m}});
-        if (progress)
-          progress(dbm.time() / duration,
-                   "DBM: " + std::to_string(bubbles.size()) + " bubbles, hold-up " + Num(holdup));
-      }
-      if (dbm.time() < duration - 1e-9 * o.dt_s) dbm.AdvanceTo(duration);
-    } catch (const std::runtime_error& e) {
-      throw std::runtime_error("dbm " + scene.name + " with " + law_ref + ": " + e.what());
-    }
+    const DbmSeries series = SampleRun(dbm, scene, o, duration, law_ref, progress, &out);
     const DbmDiagnostics& dg = dbm.diagnostics();
     const DbmAverages& av = dbm.averages();
     if (av.samples == 0 || av.time_s <= 0.0)
       Bad("[dbm] average_from_s = " + Num(sd.average_from_s) + " s leaves no averaging time in " +
           Num(duration) + " s (lower it or run longer)");
 
-    // Hold-up against height and overall; sizes against height.
-    const double hz = o.height_m / o.nz;
-    nlohmann::json holdup_profile = nlohmann::json::array(), size_profile = nlohmann::json::array();
-    double holdup_mean = 0.0, d_sum = 0.0, d_count = 0.0;
-    for (int j = 0; j < o.nz; ++j) {
-      const double h = av.holdup_by_height(j) / av.samples;
-      holdup_mean += h / o.nz;
-      holdup_profile.push_back({{"z_m", (j + 0.5) * hz}, {"holdup", h}});
-      const double c = av.count_by_height(j);
-      d_sum += av.diameter_sum_by_height(j);
-      d_count += c;
-      size_profile.push_back({{"z_m", (j + 0.5) * hz},
-                              {"mean_diameter_m", c > 0 ? av.diameter_sum_by_height(j) / c : 0.0},
-                              {"bubbles_per_sample", c / av.samples}});
-    }
-    const double excess = sd.superficial_velocity_m_s - umf.umf_m_s;
-    const double holdup_theory = two_phase_holdup(sd.superficial_velocity_m_s, umf.umf_m_s, u_br);
-    const double area_per_orifice = o.width_m * o.depth_m / static_cast<double>(o.nozzles.size());
-    const double bed_area = o.width_m * o.depth_m;
-    const double bed_diameter = std::sqrt(4.0 * bed_area / 3.14159265358979323846);
-    nlohmann::json sizes = nlohmann::json::array();
-    std::vector<std::pair<std::string, double>> headline = {{"holdup", holdup_mean}};
-    for (double h : sd.size_heights_m) {
-      const int j = std::clamp(static_cast<int>(h / hz), 0, o.nz - 1);
-      const double c = av.count_by_height(j);
-      const double mean = c > 0 ? av.diameter_sum_by_height(j) / c : 0.0;
-      const double darton = darton_bubble_diameter(excess, h, area_per_orifice, o.gravity_m_s2);
-      const double mori_wen = mori_wen_bubble_diameter(excess, h, bed_area, bed_diameter);
-      sizes.push_back({{"height_m", h},
-                       {"row_z_m", {j * hz, (j + 1) * hz}},
-                       {"mean_diameter_m", c > 0 ? nlohmann::json(mean) : nlohmann::json(nullptr)},
-                       {"bubbles_sampled", c},
-                       {"darton_m", darton},
-                       {"mori_wen_m", mori_wen},
-                       {"ratio_to_darton", c > 0 ? nlohmann::json(mean / darton) : nullptr},
-                       {"ratio_to_mori_wen", c > 0 ? nlohmann::json(mean / mori_wen) : nullptr}});
-      headline.push_back({"mean_diameter_at_" + Num(h) + "_m", mean});
-    }
-
-    // Circulation: the time-averaged vertical emulsion velocity in the core (the central quarter
-    // of the cross-section) and near the walls (the rest), over the middle third of the height,
-    // and the upflow through the mid-height plane per unit column area.
-    const Eigen::VectorXd w_mean = av.w_cell / av.time_s;
-    const Eigen::VectorXd u_mean = av.u_cell / av.time_s;
-    const double W = o.width_m, D = o.depth_m, H = o.height_m;
-    auto core = [&](double x, double y) {
-      return std::abs(x - 0.5 * W) <= 0.25 * W && (o.ny == 1 || std::abs(y - 0.5 * D) <= 0.25 * D);
-    };
-    auto middle = [&](double z) { return z >= H / 3.0 && z <= 2.0 * H / 3.0; };
-    const double w_core =
-        MeanOver(w_mean, o, [&](double x, double y, double z) { return core(x, y) && middle(z); });
-    const double w_wall =
-        MeanOver(w_mean, o, [&](double x, double y, double z) { return !core(x, y) && middle(z); });
-    const int j_mid = std::clamp(static_cast<int>(0.5 * H / hz), 0, o.nz - 1);
-    const Eigen::VectorXd w_up = w_mean.cwiseMax(0.0);
-    const double upflow = MeanOver(
-        w_up, o, [&](double, double, double z) { return static_cast<int>(z / hz) == j_mid; });
-    headline.push_back({"circulation_upflow_m_s", upflow});
-
-    const double wall_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const double cells_steps = static_cast<double>(o.nx) * o.ny * o.nz * dg.steps;
-
-    // Figure data: the mid-plane averaged field, profiles, size histograms, the last bubbles.
+    DbmSummary s;
+    s.umf_m_s = umf.umf_m_s;
+    s.u_br = davies_taylor_rise_velocity(o.bubble_diameter_m, o.gravity_m_s2);
+    s.profiles = ProfilesOf(av, o);
+    s.holdup_theory = two_phase_holdup(sd.superficial_velocity_m_s, umf.umf_m_s, s.u_br);
+    s.headline = {{"holdup", s.profiles.holdup_mean}};
+    s.sizes = SizesAgainstCorrelations(av, o, sd, umf.umf_m_s, &s.headline);
+    s.circulation = CirculationOf(av, o);
+    s.headline.push_back({"circulation_upflow_m_s", s.circulation.upflow});
+    s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    s.cells_steps = static_cast<double>(o.nx) * o.ny * o.nz * dg.steps;
     if (scene.outputs.fields) {
-      const std::string dir = internal::scene_output_directory(scene, options.output_directory);
-      std::filesystem::create_directories(dir);
-      const int k0 = (o.ny - 1) / 2, k1 = o.ny / 2;  // the vertical mid-plane (y = D/2)
-      nlohmann::json ux = nlohmann::json::array(), uz = nlohmann::json::array(),
-                     eb = nlohmann::json::array();
-      const Eigen::VectorXd eb_mean = av.bubble_fraction / av.time_s;
-      for (int j = 0; j < o.nz; ++j) {
-        nlohmann::json rx = nlohmann::json::array(), rz = nlohmann::json::array(),
-                       re = nlohmann::json::array();
-        for (int i = 0; i < o.nx; ++i) {
-          const int a = i + o.nx * (j + o.nz * k0), b = i + o.nx * (j + o.nz * k1);
-          rx.push_back(0.5 * (u_mean(a) + u_mean(b)));
-          rz.push_back(0.5 * (w_mean(a) + w_mean(b)));
-          re.push_back(0.5 * (eb_mean(a) + eb_mean(b)));
-        }
-        ux.push_back(rx);
-        uz.push_back(rz);
-        eb.push_back(re);
-      }
-      nlohmann::json bx = nlohmann::json::array(), by = nlohmann::json::array(),
-                     bz = nlohmann::json::array(), bd = nlohmann::json::array();
-      for (const DbmBubble& b : dbm.bubbles()) {
-        bx.push_back(b.x(0));
-        by.push_back(b.x(1));
-        bz.push_back(b.x(2));
-        bd.push_back(b.diameter_m);
-      }
-      nlohmann::json hist = nlohmann::json::array();
-      for (int j = 0; j < o.nz; ++j) {
-        nlohmann::json row = nlohmann::json::array();
-        for (int s = 0; s < av.size_histogram.cols(); ++s) row.push_back(av.size_histogram(j, s));
-        hist.push_back(row);
-      }
-      const nlohmann::json fig = {
-          {"scene", scene.name},
-          {"law", law_ref},
-          {"superficial_velocity_m_s", sd.superficial_velocity_m_s},
-          {"umf_m_s", umf.umf_m_s},
-          {"area_per_orifice_m2", area_per_orifice},
-          {"gravity_m_s2", o.gravity_m_s2},
-          {"coalescence", sd.coalescence},
-          {"width_m", W},
-          {"depth_m", D},
-          {"height_m", H},
-          {"cells", {o.nx, o.ny, o.nz}},
-          {"t_s", dbm.time()},
-          {"average_from_s", sd.average_from_s},
-          {"midplane_u_x", ux},
-          {"midplane_u_z", uz},
-          {"midplane_bubble_fraction", eb},
-          {"holdup_profile", holdup_profile},
-          {"size_profile", size_profile},
-          {"size_bin_m", av.size_bin_m},
-          {"size_histogram_by_row", hist},
-          {"bubbles", {{"x_m", bx}, {"y_m", by}, {"z_m", bz}, {"diameter_m", bd}}}};
-      const std::string path = dir + "/" + scene.name + "_" + law->record().name + "_dbm.json";
-      core::write_file_atomically(path, fig.dump(), "DBM figure data");
-      out.output_files.push_back(path);
+      out.output_files.push_back(
+          WriteFigureData(dbm, scene, *law, o, umf.umf_m_s, s.profiles, options.output_directory));
     }
 
     ConsumerMetrics& m = out.metrics;
     m.umf_m_s = umf.umf_m_s;
     m.background_m_s = sd.superficial_velocity_m_s;
     m.t_ref_s = 0.0;
-    m.bubble_present = d_count > 0;
-    m.bubble_diameter_m = d_count > 0 ? d_sum / d_count : 0.0;
+    m.bubble_present = s.profiles.d_count > 0;
+    m.bubble_diameter_m = s.profiles.d_count > 0 ? s.profiles.d_sum / s.profiles.d_count : 0.0;
     m.bubble_centroid_m = 0.0;
-    m.max_bed_height_m = H;
+    m.max_bed_height_m = o.height_m;
     const double left_and_in = dg.gas_left_m3 + dbm.gas_in_bubbles_m3() + dbm.gas_forming_m3();
-    const double gas_balance =
+    s.gas_balance =
         dg.gas_injected_m3 > 0.0 ? (dg.gas_injected_m3 - left_and_in) / dg.gas_injected_m3 : 0.0;
-    out.max_relative_mass_imbalance = std::abs(gas_balance);
+    out.max_relative_mass_imbalance = std::abs(s.gas_balance);
     out.law_out_of_range = law->out_of_range_count();
     out.threads = 1;
     out.steps = dg.steps;
     out.mean_dt_s = dg.steps > 0 ? dbm.time() / static_cast<double>(dg.steps) : o.dt_s;
     out.inner_steps = dg.bubble_steps;
-    out.wall_s = wall_s;
-    m.wall_s = wall_s;
-    out.headline = headline;
+    out.wall_s = s.wall_s;
+    m.wall_s = s.wall_s;
+    out.headline = s.headline;
     // The hold-up's statistical error: the samples are correlated over a bubble's rise, so their
     // standard error understates it; the means of kBatches consecutive batches, each far longer
     // than a rise through the column, are close to independent.
-    const BatchMeans holdup_error = batch_means(holdup_samples);
-    out.headline_uncertainty = holdup_error.standard_error;
+    s.holdup_error = batch_means(series.holdup_samples);
+    out.headline_uncertainty = s.holdup_error.standard_error;
     out.headline_uncertainty_method =
-        "hold-up: standard error of the means of " + std::to_string(holdup_error.batches) +
+        "hold-up: standard error of the means of " + std::to_string(s.holdup_error.batches) +
         " consecutive batches of the samples after average_from_s (statistical; the grid's and "
         "step's errors are measured by draglab sensitivity --work-precision)";
-
-    nlohmann::json head = nlohmann::json::object();
-    for (const auto& [name, value] : headline) head[name] = value;
-    const nlohmann::json j = {
-        {"solver", "dbm"},
-        {"scene", out.scene},
-        {"scene_hash", out.scene_hash},
-        {"law", out.law},
-        {"umf_m_s", umf.umf_m_s},
-        {"eps_mf", scene.eps_mf},
-        {"superficial_velocity_m_s", sd.superficial_velocity_m_s},
-        {"bubble_gas_flow_m3_s", o.bubble_gas_flow_m3_s},
-        {"injected_diameter_m", o.bubble_diameter_m},
-        {"injected_diameter_from",
-         sd.bubble_diameter_m > 0.0 ? "scene" : "davidson_harrison_per_nozzle"},
-        {"nozzles", o.nozzles.size()},
-        {"coupling_width_m", o.CouplingWidth()},
-        {"coalescence", sd.coalescence},
-        {"film_drainage_s", sd.film_drainage_s},
-        {"collisions", sd.collisions && !sd.coalescence},
-        {"grid", {{"cells_x", o.nx}, {"cells_y", o.nz}, {"cells_z", o.ny}}},
-        {"dt_s", o.dt_s},
-        {"stable_dt_s", o.StableTimeStep()},
-        {"cfl", o.cfl},
-        {"min_dt_s", dg.min_dt_s},
-        {"headline", head},
-        {"holdup",
-         {{"mean", holdup_mean},
-          {"two_phase_theory", holdup_theory},
-          {"ratio_to_theory", holdup_theory > 0 ? holdup_mean / holdup_theory : 0.0},
-          {"standard_error", holdup_error.standard_error},
-          {"batches", holdup_error.batches},
-          {"rise_velocity_davies_taylor_m_s", u_br}}},
-        {"sizes", sizes},
-        {"circulation",
-         {{"core_mean_w_m_s", w_core},
-          {"wall_mean_w_m_s", w_wall},
-          {"upflow_mid_height_m_s", upflow},
-          {"up_in_core_down_at_walls", w_core > 0.0 && w_wall < 0.0}}},
-        {"holdup_profile", holdup_profile},
-        {"size_profile", size_profile},
-        {"series", series},
-        {"averaged_s", av.time_s},
-        {"samples", av.samples},
-        {"gas",
-         {{"injected_m3", dg.gas_injected_m3},
-          {"left_at_surface_m3", dg.gas_left_m3},
-          {"in_bubbles_m3", dbm.gas_in_bubbles_m3()},
-          {"forming_at_nozzles_m3", dbm.gas_forming_m3()},
-          {"relative_imbalance", gas_balance}}},
-        {"bubbles_injected", dg.bubbles_injected},
-        {"bubbles_left", dg.bubbles_left},
-        {"coalescences", dg.coalescences},
-        {"max_bubble_diameter_m", dg.max_bubble_diameter_m},
-        {"max_cfl", dg.max_cfl},
-        {"retaken_steps", dg.retaken_steps},
-        {"max_bubble_fraction", dg.max_bubble_fraction},
-        {"fraction_clamps", dg.fraction_clamps},
-        {"max_pressure_residual", dg.max_continuity_residual},
-        {"max_cg_iterations", dg.max_cg_iterations},
-        {"steps", dg.steps},
-        {"bubble_steps", dg.bubble_steps},
-        {"bubble_steps_per_s", dg.bubble_steps / wall_s},
-        {"cell_steps_per_s", cells_steps / wall_s},
-        {"emulsion_wall_s", dg.emulsion_wall_s},
-        {"bubble_wall_s", dg.bubble_wall_s},
-        {"drag_out_of_range", out.law_out_of_range},
-        {"wall_s", wall_s},
-        {"output_files", out.output_files}};
-    out.result_json = j.dump();
-    std::ostringstream brief;
-    brief << "DBM " << scene.name << " with " << out.law << ": U_mf = " << Num(umf.umf_m_s)
-          << " m/s, u0 = " << Num(sd.superficial_velocity_m_s) << " m/s, bubble gas "
-          << Num(o.bubble_gas_flow_m3_s) << " m^3/s as " << Num(o.bubble_diameter_m)
-          << " m bubbles from " << o.nozzles.size() << " nozzles; " << o.nx << " x " << o.ny
-          << " x " << o.nz << " cells, " << dg.steps << " steps of " << Num(o.dt_s) << " s; wall "
-          << Num(wall_s) << " s (" << Num(dg.bubble_steps / wall_s) << " bubble-steps/s, "
-          << Num(cells_steps / wall_s) << " cell-steps/s)\n  hold-up " << Num(holdup_mean) << " +- "
-          << Num(holdup_error.standard_error) << " (batch means)"
-          << " (two-phase theory " << Num(holdup_theory) << "), mean bubble "
-          << Num(m.bubble_diameter_m) << " m, circulation: core " << Num(w_core) << " m/s, walls "
-          << Num(w_wall) << " m/s, upflow " << Num(upflow) << " m/s\n  gas balance "
-          << Num(gas_balance) << " (rel.), " << dg.coalescences << " coalescences, max bubble "
-          << Num(dg.max_bubble_diameter_m) << " m, max CFL " << Num(dg.max_cfl);
-    out.brief = brief.str();
+    out.result_json = ResultJson(dbm, scene, o, out, s, series.series).dump();
+    out.brief = BriefReport(dbm, scene, o, out, s);
     return out;
   }
 };
