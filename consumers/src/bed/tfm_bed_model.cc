@@ -87,6 +87,197 @@ CellFields TfmCellFields(const TfmSimulation& tfm) {
   return c;
 }
 
+/// What the two-fluid model refuses before any work: a realization, an off-centre jet,
+/// particle output.
+void CheckScene(const Scene& scene, const BedRealization* start) {
+  if (start)
+    throw Error(ErrorCode::kInvalidArgument,
+                "tfm: the two-fluid model is deterministic and starts from no realization");
+  if (std::abs(scene.jet_center_m() - 0.5 * scene.geometry.width_m) > 1e-9 * scene.geometry.width_m)
+    throw Error(ErrorCode::kInvalidArgument,
+                "[jet] center_m: the gas inflow supports only a central slot (width / 2 = " +
+                    Num(0.5 * scene.geometry.width_m) + " m), got " + Num(scene.jet_center_m()));
+  if (scene.outputs.particles)
+    throw Error(ErrorCode::kInvalidArgument,
+                "[outputs] particles = true: the two-fluid model has no particles (its solids "
+                "fraction, velocities and theta are cell fields: [outputs] fields = true)");
+}
+
+/// Where the run stops: every sample, and every field output (each outputs.interval_s, or once
+/// at t_ref when it is 0) when fields are written, in time order: (time, is a field output).
+std::vector<std::pair<double, bool>> StopsOf(const Scene& scene, double duration) {
+  std::vector<std::pair<double, bool>> stops;
+  for (const double t : internal::sample_times(duration, scene.bubble.sample_interval_s))
+    stops.push_back({t, false});
+  if (scene.outputs.fields) {
+    const double t_ref_abs = scene.jet.start_s + scene.time.t_ref_s;
+    if (scene.outputs.interval_s > 0.0) {
+      for (int k = 1; k * scene.outputs.interval_s <= duration * (1.0 + 1e-12); ++k)
+        stops.push_back({k * scene.outputs.interval_s, true});
+    } else if (t_ref_abs <= duration) {
+      stops.push_back({t_ref_abs, true});
+    }
+  }
+  std::stable_sort(stops.begin(), stops.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  return stops;
+}
+
+/// What the sampling loop records besides the bed series: the JSON series and the sample
+/// nearest t_ref with its bubble.
+struct TfmSeries {
+  nlohmann::json series = nlohmann::json::array();
+  BedSample at_ref;
+  bool have_ref = false;
+  BubbleMetrics ref_bubble;
+};
+
+/// Runs the model to `duration` through `stops`, sampling the bed (into out: series, snapshot
+/// field, largest bed height) and writing the fields at the output stops.
+TfmSeries SampleRun(TfmSimulation& tfm, const Scene& scene, double duration,
+                    const std::vector<std::pair<double, bool>>& stops, DpmOutputWriter* writer,
+                    const BedProgress& progress, BedResult* out) {
+  internal::BedSampler sampler(scene, scene.bed_height_mf_m());
+  const double dz = tfm.dz();
+  TfmSeries s;
+  for (const auto& [t, is_output] : stops) {
+    tfm.AdvanceTo(t);
+    if (is_output) {
+      writer->WriteFields(tfm.time(), TfmCellFields(tfm));
+      continue;
+    }
+    const internal::BedSampler::Taken taken = sampler.Take(
+        tfm.time(), tfm.gas_fraction(), tfm.PressureDrop(0.5 * dz, scene.geometry.height_m));
+    const BedSample& smp = taken.sample;
+    out->series.push_back(smp);
+    out->metrics.max_bed_height_m = std::max(out->metrics.max_bed_height_m, smp.bed_height_m);
+    if (taken.nearest_to_ref) {
+      s.at_ref = smp;
+      s.have_ref = true;
+      s.ref_bubble = taken.bubble;
+      out->snapshot.void_fraction = internal::scene_grid_field(scene, tfm.gas_fraction());
+    }
+    s.series.push_back({{"t_s", smp.t_s},
+                        {"bubble_diameter_m", smp.bubble_diameter_m},
+                        {"bubble_centroid_m", smp.bubble_centroid_m},
+                        {"bed_height_m", smp.bed_height_m},
+                        {"pressure_drop_pa", smp.pressure_drop_pa},
+                        {"dt_s", tfm.diagnostics().last_dt_s}});
+    if (progress) {
+      progress(t / duration, "two-fluid run, dt " + Num(tfm.diagnostics().last_dt_s) + " s (" +
+                                 to_string(tfm.diagnostics().last_limit) + ")");
+    }
+  }
+  if (tfm.time() < duration) tfm.AdvanceTo(duration);
+  return s;
+}
+
+double SolidsMassChange(const TfmDiagnostics& dg) {
+  return dg.initial_solids_mass_kg > 0.0
+             ? (dg.solids_mass_kg - dg.initial_solids_mass_kg) / dg.initial_solids_mass_kg
+             : 0.0;
+}
+
+nlohmann::json ResultJson(const TfmSimulation& tfm, const Scene& scene, const BedResult& out,
+                          const TfmSeries& s) {
+  const TfmDiagnostics& dg = tfm.diagnostics();
+  const ConsumerMetrics& m = out.metrics;
+  nlohmann::json limits = nlohmann::json::object();
+  for (int k = 0; k < 7; ++k) {
+    if (dg.steps_by_limit[k] > 0)
+      limits[to_string(static_cast<TfmStepLimit>(k))] = dg.steps_by_limit[k];
+  }
+  const TfmOptions& o = tfm.options();
+  nlohmann::json j = {
+      {"solver", "tfm"},
+      {"scene", out.scene},
+      {"scene_hash", out.scene_hash},
+      {"law", out.law},
+      {"umf_m_s", m.umf_m_s},
+      {"background_m_s", m.background_m_s},
+      {"background", out.background_mode},
+      {"eps_mf", scene.eps_mf},
+      {"t_ref_s", m.t_ref_s},
+      {"bubble_at_t_ref", m.bubble_present},
+      {"bubble_diameter_m",
+       m.bubble_present ? nlohmann::json(m.bubble_diameter_m) : nlohmann::json(nullptr)},
+      {"series", s.series},
+      {"grid", {{"cells_x", o.gas.nx}, {"cells_y", o.gas.nz}}},
+      {"closures",
+       {{"set", to_string(o.ktgf.closures)},
+        {"radial_distribution", to_string(o.ktgf.radial)},
+        {"restitution", o.ktgf.restitution},
+        {"packing_limit", o.ktgf.packing_limit},
+        {"friction", to_string(o.ktgf.friction)},
+        {"friction_min_solids", o.ktgf.friction_min_solids},
+        {"friction_angle_deg", o.ktgf.friction_angle_deg},
+        {"friction_delta", o.ktgf.friction_delta},
+        {"friction_max_viscosity_pa_s", o.ktgf.friction_max_viscosity_pa_s},
+        {"knudsen_length_m", o.ktgf.knudsen_length_m},
+        {"granular_temperature",
+         o.granular_temperature == GranularTemperature::kAlgebraic ? "algebraic" : "transport"}}},
+      {"numerics",
+       {{"fraction_scheme", o.fraction_scheme == FractionScheme::kVanLeer ? "van_leer" : "upwind"},
+        {"solids_viscosity",
+         o.solids_viscosity == SolidsViscosity::kPointImplicit ? "point_implicit" : "explicit"},
+        {"solids_pressure",
+         o.solids_pressure == SolidsPressure::kImplicit ? "implicit" : "explicit"},
+        {"solids_walls", o.solids_walls == WallSlip::kNoSlip ? "no_slip" : "free_slip"},
+        {"cfl", o.cfl},
+        {"dt_max_s", o.dt_max_s}}},
+      {"steps", dg.steps},
+      {"dt_min_s", dg.min_dt_s},
+      {"dt_mean_s", dg.steps > 0 ? tfm.time() / static_cast<double>(dg.steps) : 0.0},
+      {"steps_by_limit", limits},
+      {"max_wave_speed_m_s", dg.max_wave_speed_m_s},
+      {"max_solids_fraction", dg.max_solids_fraction},
+      {"max_theta_m2_s2", dg.max_theta_m2_s2},
+      {"flux_limited_faces", dg.flux_limited_faces},
+      {"implicit_viscosity_faces", dg.implicit_viscosity_faces},
+      {"max_pressure_correction", dg.max_pressure_correction},
+      {"positivity_limited_cells", dg.positivity_limited_cells},
+      {"packing_limited_cells", dg.packing_limited_cells},
+      {"relative_solids_mass_change", SolidsMassChange(dg)},
+      {"max_relative_gas_mass_imbalance", out.max_relative_mass_imbalance},
+      {"momentum_mismatch", nullptr},
+      {"drag_out_of_range", out.law_out_of_range},
+      {"threads", out.threads},
+      {"wall_s", out.wall_s},
+      {"output_files", out.output_files}};
+  if (s.have_ref) {
+    const BubbleMetrics& b = s.ref_bubble;
+    j["snapshot"] = {{"t_s", s.at_ref.t_s},
+                     {"bubble_found", b.found},
+                     {"bubble_diameter_m", b.diameter_m},
+                     {"bubble_centroid_x_m", b.centroid_x_m},
+                     {"bubble_centroid_y_m", b.centroid_y_m},
+                     {"bubble_top_m", b.top_m},
+                     {"bubble_bottom_m", b.bottom_m},
+                     {"bubble_erupting", b.touches_surface},
+                     {"bed_height_m", b.bed_height_m}};
+  }
+  return j;
+}
+
+std::string BriefReport(const TfmSimulation& tfm, const Scene& scene, const BedResult& out) {
+  const TfmDiagnostics& dg = tfm.diagnostics();
+  const ConsumerMetrics& m = out.metrics;
+  const TfmOptions& o = tfm.options();
+  std::ostringstream brief;
+  brief << "TFM " << scene.name << " with " << out.law << ": U_mf = " << Num(m.umf_m_s)
+        << " m/s, background = " << Num(m.background_m_s) << " m/s (" << out.background_mode
+        << "), eps_mf = " << scene.eps_mf << "; " << o.gas.nx << " x " << o.gas.nz << " cells, "
+        << dg.steps << " steps (dt min " << Num(dg.min_dt_s) << " s, mean "
+        << Num(dg.steps > 0 ? tfm.time() / dg.steps : 0.0) << " s); wall " << Num(out.wall_s)
+        << " s\n  bubble D at t_ref = " << Num(scene.time.t_ref_s)
+        << " s: " << (m.bubble_present ? Num(m.bubble_diameter_m) + " m" : std::string("none"))
+        << "\n  solids mass change " << Num(SolidsMassChange(dg)) << " (rel.), gas mass imbalance "
+        << Num(out.max_relative_mass_imbalance) << " (rel.), max phi "
+        << Num(dg.max_solids_fraction) << ", flux-limited faces " << dg.flux_limited_faces
+        << ", drag out of range " << out.law_out_of_range;
+  return brief.str();
+}
+
 class TfmBedModel : public BedModel {
  public:
   std::string key() const override { return "tfm"; }
@@ -126,18 +317,7 @@ class TfmBedModel : public BedModel {
     const auto t0 = std::chrono::steady_clock::now();
     scene.Validate();
     if (!law) throw Error(ErrorCode::kInvalidArgument, "tfm: law is null");
-    if (start)
-      throw Error(ErrorCode::kInvalidArgument,
-                  "tfm: the two-fluid model is deterministic and starts from no realization");
-    if (std::abs(scene.jet_center_m() - 0.5 * scene.geometry.width_m) >
-        1e-9 * scene.geometry.width_m)
-      throw Error(ErrorCode::kInvalidArgument,
-                  "[jet] center_m: the gas inflow supports only a central slot (width / 2 = " +
-                      Num(0.5 * scene.geometry.width_m) + " m), got " + Num(scene.jet_center_m()));
-    if (scene.outputs.particles)
-      throw Error(ErrorCode::kInvalidArgument,
-                  "[outputs] particles = true: the two-fluid model has no particles (its solids "
-                  "fraction, velocities and theta are cell fields: [outputs] fields = true)");
+    CheckScene(scene, start);
     // U_mf first: a law whose validity box excludes the bed fails here, before any step.
     const SceneDerived derived = derive_scene(scene, *law);
     // The TFM bed starts uniform at eps_mf, so its packing is the eps_mf state: "umf_packing"
@@ -145,10 +325,6 @@ class TfmBedModel : public BedModel {
     const double background = derived.background_m_s;
     TfmSimulation tfm(SceneTfmOptions(scene, background), law);
     const double duration = options.duration_s > 0.0 ? options.duration_s : scene.time.duration_s;
-    const double interval = scene.bubble.sample_interval_s;
-    const double t_ref_abs = scene.jet.start_s + scene.time.t_ref_s;
-    internal::BedSampler sampler(scene, scene.bed_height_mf_m());
-    const double dz = tfm.dz();
 
     BedResult out = internal::result_header(key(), scene, law->record().reference(),
                                             to_string(scene.distributor.mode));
@@ -156,57 +332,14 @@ class TfmBedModel : public BedModel {
     m.umf_m_s = derived.umf.umf_m_s;
     m.background_m_s = background;
     m.t_ref_s = scene.time.t_ref_s;
-    nlohmann::json series = nlohmann::json::array();
-    BedSample at_ref;
-    bool have_ref = false;
-    BubbleMetrics ref_bubble;
-    // Where the run stops: every sample, and every field output (each outputs.interval_s, or
-    // once at t_ref when it is 0), in time order.
     std::unique_ptr<DpmOutputWriter> writer;
-    std::vector<std::pair<double, bool>> stops;  // (time, is a field output)
-    for (const double t : internal::sample_times(duration, interval)) stops.push_back({t, false});
     if (scene.outputs.fields) {
       const std::string dir = internal::scene_output_directory(scene, options.output_directory);
       writer = std::make_unique<DpmOutputWriter>(scene, out.law, dir, true, false);
-      if (scene.outputs.interval_s > 0.0) {
-        for (int k = 1; k * scene.outputs.interval_s <= duration * (1.0 + 1e-12); ++k)
-          stops.push_back({k * scene.outputs.interval_s, true});
-      } else if (t_ref_abs <= duration) {
-        stops.push_back({t_ref_abs, true});
-      }
     }
-    std::stable_sort(stops.begin(), stops.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    TfmSeries s;
     try {
-      for (const auto& [t, is_output] : stops) {
-        tfm.AdvanceTo(t);
-        if (is_output) {
-          writer->WriteFields(tfm.time(), TfmCellFields(tfm));
-          continue;
-        }
-        const internal::BedSampler::Taken taken = sampler.Take(
-            tfm.time(), tfm.gas_fraction(), tfm.PressureDrop(0.5 * dz, scene.geometry.height_m));
-        const BedSample& smp = taken.sample;
-        out.series.push_back(smp);
-        m.max_bed_height_m = std::max(m.max_bed_height_m, smp.bed_height_m);
-        if (taken.nearest_to_ref) {
-          at_ref = smp;
-          have_ref = true;
-          ref_bubble = taken.bubble;
-          out.snapshot.void_fraction = internal::scene_grid_field(scene, tfm.gas_fraction());
-        }
-        series.push_back({{"t_s", smp.t_s},
-                          {"bubble_diameter_m", smp.bubble_diameter_m},
-                          {"bubble_centroid_m", smp.bubble_centroid_m},
-                          {"bed_height_m", smp.bed_height_m},
-                          {"pressure_drop_pa", smp.pressure_drop_pa},
-                          {"dt_s", tfm.diagnostics().last_dt_s}});
-        if (progress) {
-          progress(t / duration, "two-fluid run, dt " + Num(tfm.diagnostics().last_dt_s) + " s (" +
-                                     to_string(tfm.diagnostics().last_limit) + ")");
-        }
-      }
-      if (tfm.time() < duration) tfm.AdvanceTo(duration);
+      s = SampleRun(tfm, scene, duration, StopsOf(scene, duration), writer.get(), progress, &out);
       if (writer) {
         writer->Finish();
         out.output_files = writer->files();
@@ -215,9 +348,9 @@ class TfmBedModel : public BedModel {
       throw Error(e.code(), "tfm " + scene.name + " with " + out.law + ": " + e.what());
     }
     const TfmDiagnostics& dg = tfm.diagnostics();
-    m.bubble_present = have_ref && ref_bubble.found;
-    m.bubble_diameter_m = m.bubble_present ? at_ref.bubble_diameter_m : 0.0;
-    m.bubble_centroid_m = m.bubble_present ? at_ref.bubble_centroid_m : 0.0;
+    m.bubble_present = s.have_ref && s.ref_bubble.found;
+    m.bubble_diameter_m = m.bubble_present ? s.at_ref.bubble_diameter_m : 0.0;
+    m.bubble_centroid_m = m.bubble_present ? s.at_ref.bubble_centroid_m : 0.0;
     out.max_relative_mass_imbalance =
         dg.gas_mass_in_kg > 0.0 ? std::abs(dg.gas_mass_imbalance_kg) / dg.gas_mass_in_kg : 0.0;
     out.momentum_mismatch = 0.0;
@@ -225,104 +358,13 @@ class TfmBedModel : public BedModel {
     out.threads = 1;
     out.steps = dg.steps;
     out.mean_dt_s = dg.steps > 0 ? tfm.time() / static_cast<double>(dg.steps) : 0.0;
-    out.has_snapshot = have_ref;
-    out.snapshot.t_s = at_ref.t_s;
-    out.snapshot.bubble = ref_bubble;
+    out.has_snapshot = s.have_ref;
+    out.snapshot.t_s = s.at_ref.t_s;
+    out.snapshot.bubble = s.ref_bubble;
     out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     m.wall_s = out.wall_s;
-
-    nlohmann::json limits = nlohmann::json::object();
-    for (int k = 0; k < 7; ++k) {
-      if (dg.steps_by_limit[k] > 0)
-        limits[to_string(static_cast<TfmStepLimit>(k))] = dg.steps_by_limit[k];
-    }
-    const TfmOptions& o = tfm.options();
-    const double solids_change =
-        dg.initial_solids_mass_kg > 0.0
-            ? (dg.solids_mass_kg - dg.initial_solids_mass_kg) / dg.initial_solids_mass_kg
-            : 0.0;
-    nlohmann::json j = {
-        {"solver", "tfm"},
-        {"scene", out.scene},
-        {"scene_hash", out.scene_hash},
-        {"law", out.law},
-        {"umf_m_s", m.umf_m_s},
-        {"background_m_s", background},
-        {"background", out.background_mode},
-        {"eps_mf", scene.eps_mf},
-        {"t_ref_s", m.t_ref_s},
-        {"bubble_at_t_ref", m.bubble_present},
-        {"bubble_diameter_m",
-         m.bubble_present ? nlohmann::json(m.bubble_diameter_m) : nlohmann::json(nullptr)},
-        {"series", series},
-        {"grid", {{"cells_x", o.gas.nx}, {"cells_y", o.gas.nz}}},
-        {"closures",
-         {{"set", to_string(o.ktgf.closures)},
-          {"radial_distribution", to_string(o.ktgf.radial)},
-          {"restitution", o.ktgf.restitution},
-          {"packing_limit", o.ktgf.packing_limit},
-          {"friction", to_string(o.ktgf.friction)},
-          {"friction_min_solids", o.ktgf.friction_min_solids},
-          {"friction_angle_deg", o.ktgf.friction_angle_deg},
-          {"friction_delta", o.ktgf.friction_delta},
-          {"friction_max_viscosity_pa_s", o.ktgf.friction_max_viscosity_pa_s},
-          {"knudsen_length_m", o.ktgf.knudsen_length_m},
-          {"granular_temperature",
-           o.granular_temperature == GranularTemperature::kAlgebraic ? "algebraic" : "transport"}}},
-        {"numerics",
-         {{"fraction_scheme",
-           o.fraction_scheme == FractionScheme::kVanLeer ? "van_leer" : "upwind"},
-          {"solids_viscosity",
-           o.solids_viscosity == SolidsViscosity::kPointImplicit ? "point_implicit" : "explicit"},
-          {"solids_pressure",
-           o.solids_pressure == SolidsPressure::kImplicit ? "implicit" : "explicit"},
-          {"solids_walls", o.solids_walls == WallSlip::kNoSlip ? "no_slip" : "free_slip"},
-          {"cfl", o.cfl},
-          {"dt_max_s", o.dt_max_s}}},
-        {"steps", dg.steps},
-        {"dt_min_s", dg.min_dt_s},
-        {"dt_mean_s", dg.steps > 0 ? tfm.time() / static_cast<double>(dg.steps) : 0.0},
-        {"steps_by_limit", limits},
-        {"max_wave_speed_m_s", dg.max_wave_speed_m_s},
-        {"max_solids_fraction", dg.max_solids_fraction},
-        {"max_theta_m2_s2", dg.max_theta_m2_s2},
-        {"flux_limited_faces", dg.flux_limited_faces},
-        {"implicit_viscosity_faces", dg.implicit_viscosity_faces},
-        {"max_pressure_correction", dg.max_pressure_correction},
-        {"positivity_limited_cells", dg.positivity_limited_cells},
-        {"packing_limited_cells", dg.packing_limited_cells},
-        {"relative_solids_mass_change", solids_change},
-        {"max_relative_gas_mass_imbalance", out.max_relative_mass_imbalance},
-        {"momentum_mismatch", nullptr},
-        {"drag_out_of_range", out.law_out_of_range},
-        {"threads", out.threads},
-        {"wall_s", out.wall_s},
-        {"output_files", out.output_files}};
-    if (have_ref) {
-      j["snapshot"] = {{"t_s", at_ref.t_s},
-                       {"bubble_found", ref_bubble.found},
-                       {"bubble_diameter_m", ref_bubble.diameter_m},
-                       {"bubble_centroid_x_m", ref_bubble.centroid_x_m},
-                       {"bubble_centroid_y_m", ref_bubble.centroid_y_m},
-                       {"bubble_top_m", ref_bubble.top_m},
-                       {"bubble_bottom_m", ref_bubble.bottom_m},
-                       {"bubble_erupting", ref_bubble.touches_surface},
-                       {"bed_height_m", ref_bubble.bed_height_m}};
-    }
-    out.result_json = j.dump();
-    std::ostringstream brief;
-    brief << "TFM " << scene.name << " with " << out.law << ": U_mf = " << Num(m.umf_m_s)
-          << " m/s, background = " << Num(background) << " m/s (" << out.background_mode
-          << "), eps_mf = " << scene.eps_mf << "; " << o.gas.nx << " x " << o.gas.nz << " cells, "
-          << dg.steps << " steps (dt min " << Num(dg.min_dt_s) << " s, mean "
-          << Num(dg.steps > 0 ? tfm.time() / dg.steps : 0.0) << " s); wall " << Num(out.wall_s)
-          << " s\n  bubble D at t_ref = " << Num(scene.time.t_ref_s)
-          << " s: " << (m.bubble_present ? Num(m.bubble_diameter_m) + " m" : std::string("none"))
-          << "\n  solids mass change " << Num(solids_change) << " (rel.), gas mass imbalance "
-          << Num(out.max_relative_mass_imbalance) << " (rel.), max phi "
-          << Num(dg.max_solids_fraction) << ", flux-limited faces " << dg.flux_limited_faces
-          << ", drag out of range " << out.law_out_of_range;
-    out.brief = brief.str();
+    out.result_json = ResultJson(tfm, scene, out, s).dump();
+    out.brief = BriefReport(tfm, scene, out);
     return out;
   }
 };
