@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "cell_list.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 #if defined(_OPENMP)
@@ -56,11 +57,7 @@ constexpr double kProgressInterval = 0.2;
 constexpr std::uint8_t kSolidBit = 1;
 constexpr std::uint8_t kSharedBit = 2;  ///< Inside more than one sphere (overlap or rounding).
 
-std::string number(double x) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.12g", x);
-  return buffer;
-}
+std::string number(double x) { return core::format_number(x, 12); }
 
 [[noreturn]] void invalid(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, message);

@@ -15,6 +15,7 @@
 #include "db/sqlite_util.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/error.h"
 
@@ -35,11 +36,7 @@ struct PointUnits {
   std::vector<std::string> diagnoses;
 };
 
-std::string format_g(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", x);
-  return buf;
-}
+std::string format_g(double x) { return core::format_number(x, 6); }
 
 }  // namespace
 

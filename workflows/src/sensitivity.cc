@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -36,12 +37,7 @@ using Clock = std::chrono::steady_clock;
   throw Error(ErrorCode::kInvalidArgument, message);
 }
 
-std::string Num(double x, int digits = 4) {
-  std::ostringstream s;
-  s.precision(digits);
-  s << x;
-  return s.str();
-}
+std::string Num(double x, int digits = 4) { return core::format_number(x, digits); }
 
 std::string Cm(double metres) { return Num(100.0 * metres, 3); }
 

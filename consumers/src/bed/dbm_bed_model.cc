@@ -22,18 +22,14 @@
 #include "bed/builtin_models.h"
 #include "dbm/dbm.h"
 #include "draglab/core/files.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
 namespace consumers {
 namespace {
 
-std::string Num(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
+std::string Num(double x) { return core::format_number(x, 4); }
 
 [[noreturn]] void Bad(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, message);

@@ -19,12 +19,7 @@ namespace draglab {
 namespace consumers {
 namespace {
 
-std::string Num(double x) {
-  std::ostringstream s;
-  s.precision(3);
-  s << x;
-  return s.str();
-}
+std::string Num(double x) { return core::format_number(x, 3); }
 
 /// A settled packing of one seed.
 class DpmPacking : public BedRealization {

@@ -14,6 +14,7 @@
 
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "io/dpm_output.h"
 #include "scene/scene_ktgf.h"
@@ -23,12 +24,7 @@ namespace draglab {
 namespace consumers {
 namespace {
 
-std::string Num(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
+std::string Num(double x) { return core::format_number(x, 4); }
 
 /// The two-fluid model's options for a scene whose background is `background_m_s`.
 TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {

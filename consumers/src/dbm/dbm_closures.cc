@@ -6,6 +6,7 @@
 #include <sstream>
 #include <string>
 
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -15,12 +16,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDaviesTaylor = 0.711;
 
-std::string Num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+std::string Num(double x) { return core::format_number(x, 6); }
 
 [[noreturn]] void Bad(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, message);

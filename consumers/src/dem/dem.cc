@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 
 namespace draglab {
@@ -26,11 +27,7 @@ constexpr int kMaxContacts = 20;
 // Packed per-particle state for the pair loop: x y z vx vy vz wx wy wz r m (+1 padding).
 constexpr int kStateStride = 12;
 
-std::string Num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
+std::string Num(double v) { return core::format_number(v, 4); }
 
 [[noreturn]] void Fail(const std::string& message) {
   throw Error(ErrorCode::kInvalidArgument, message);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "gas/particle_kernel.h"
 
@@ -27,12 +28,7 @@ namespace {
   throw Error(ErrorCode::kInvalidArgument, message);
 }
 
-std::string Num(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
+std::string Num(double x) { return core::format_number(x, 4); }
 
 using internal::Deposit;
 using internal::Interpolate;
