@@ -676,6 +676,362 @@ void normalise_converged(const LoopState& loop, const TimeAverage& average_F,
   result.error_estimate = result.discretisation_error + result.convergence_residual;
 }
 
+/// The stages of one check of run_impl's loop (after the pairs of steps up to it): the flow's
+/// health, the drag and the balance, the Stokes-mode rescaling, unsteady flow and its average,
+/// the target-Re control, convergence, progress. What a check measures lives in LoopState
+/// (kept by checkpoints); the rest is the run's constants.
+class RunChecks {
+ public:
+  /// The run's constants.
+  struct Scales {
+    double d = 0.0, nu = 0.0, phi = 0.0, target_re = 0.0;
+    bool stokes = false;
+    std::int64_t fluid = 0;
+    double total_nodes = 0.0;
+    std::size_t bodies = 0;
+    double mixture = 1.0;
+    std::int64_t interval = 0;
+    double balance_tolerance = 0.0;
+  };
+  /// What a stage asks of the loop: go on to the next stage, step on to the next check, stop
+  /// converged, or stop with `failure`.
+  enum class Next { kGoOn, kNextCheck, kConverged, kFail };
+
+  RunChecks(const RunOptions& options, const SparseLattice& lattice, SolverBase* solver,
+            const Scales& scales, LoopState* loop, RunResult* result,
+            const std::vector<double>* body_force, const ProgressCallback& progress)
+      : options_(options),
+        lattice_(lattice),
+        solver_(solver),
+        sc_(scales),
+        loop_(*loop),
+        result_(*result),
+        body_force_(*body_force),
+        progress_(progress),
+        last_progress_(Clock::now()) {
+    loop_.balance = std::numeric_limits<double>::infinity();
+    loop_.last_log_force = loop_.last_log_re = std::numeric_limits<double>::quiet_NaN();
+    loop_.relative_change = std::numeric_limits<double>::infinity();
+  }
+
+  const MomentSummary& moments() const { return m_; }
+  const TimeAverage& average_F() const { return average_F_; }
+  const TimeAverage& average_re() const { return average_re_; }
+  const std::string& failure() const { return failure_; }
+
+  /// The flow's health from the moment sweep: finite populations, positive density, the Mach
+  /// limit (a blow-up is told from a steady rise), the Mach warning.
+  Next Health() {
+    m_ = solver_->moments();
+    if (m_.nonfinite_node >= 0)
+      return Fail(Instability("a non-finite population", m_.nonfinite_node));
+    if (m_.min_rho <= 0.0)
+      return Fail(Instability("density " + fmt("%.3g", m_.min_rho) + " <= 0", m_.min_rho_node));
+    double& mach = loop_.mach;
+    mach = std::sqrt(3.0 * m_.max_speed2);
+    result_.mach_max = std::max(result_.mach_max, mach);
+    const std::int64_t step = loop_.step;
+    if (mach > options_.mach_limit) {
+      if (loop_.last_max_speed > 0.0 &&
+          std::sqrt(m_.max_speed2) > kBlowUpGrowth * loop_.last_max_speed) {
+        return Fail(Instability("max |u| grew from " + fmt("%.3g", loop_.last_max_speed) + " to " +
+                                    fmt("%.3g", std::sqrt(m_.max_speed2)) + " (Mach " +
+                                    fmt("%.3g", mach) + ") within " + std::to_string(sc_.interval) +
+                                    " steps",
+                                m_.max_speed_node));
+      }
+      return Fail("Mach number " + fmt("%.3g", mach) + " above the limit " +
+                  fmt("%g", options_.mach_limit) + " at step " + std::to_string(step) + ", " +
+                  node_text(lattice_, m_.max_speed_node) +
+                  " (max |u| = " + fmt("%.3g", std::sqrt(m_.max_speed2)) + ", grown steadily" +
+                  (sc_.target_re > 0.0 && options_.tau == 0.0
+                       ? std::string("); remedy: lower the Mach target (--mach)")
+                       : std::string("); remedy: lower tau (the velocity is U = Re nu / d at the "
+                                     "target Re), or leave tau to the engine")));
+    }
+    const double mach_warning = sc_.target_re > 0.0 && options_.tau == 0.0
+                                    ? std::max(kMachWarning, 1.5 * options_.mach_target)
+                                    : kMachWarning;
+    if (mach > mach_warning && !loop_.mach_warned) {
+      loop_.mach_warned = true;
+      result_.warnings.push_back(
+          "Mach number " + fmt("%.3g", mach) + " above " + fmt("%.3g", mach_warning) + " at step " +
+          std::to_string(step) + " (" + node_text(lattice_, m_.max_speed_node) +
+          "): compressibility error of order Ma^2 = " + fmt("%.2g", mach * mach));
+    }
+    loop_.last_max_speed = std::sqrt(m_.max_speed2);
+    loop_.last_max_node = m_.max_speed_node;
+    loop_.last_check_step = step;
+    return Next::kGoOn;
+  }
+
+  /// The superficial velocity, Re, the mean drag, its change per characteristic time and the
+  /// momentum balance (with its round-off floor); the history point.
+  Next Drag() {
+    loop_.U = m_.sum_u[0] / sc_.total_nodes;
+    loop_.re_lattice = loop_.U * sc_.d / sc_.nu;
+    sum_fx_ = 0.0;
+    for (std::size_t s = 0; s < sc_.bodies; ++s) sum_fx_ += body_force_[3 * s];
+    loop_.F_mean = sum_fx_ / static_cast<double>(sc_.bodies) /
+                   (3.0 * kPi * sc_.nu * sc_.d * loop_.U) * sc_.mixture;
+    if (!std::isfinite(loop_.F_mean)) {
+      return Fail(
+          Instability("a non-finite drag (superficial velocity " + fmt("%.3g", loop_.U) + ")",
+                      m_.max_speed_node));
+    }
+    auto& window = loop_.window;
+    window.push_back({loop_.F_mean, loop_.U});
+    double& relative_change = loop_.relative_change;
+    relative_change = std::numeric_limits<double>::infinity();
+    if (window.size() > static_cast<std::size_t>(kChecksPerTime)) {
+      const auto& before = window[window.size() - 1 - kChecksPerTime];
+      // In Stokes mode the velocity scale is arbitrary (the state may be rescaled, see
+      // Rescale): only F counts there.
+      relative_change = std::abs(loop_.F_mean - before.first) / std::abs(loop_.F_mean);
+      if (!sc_.stokes) {
+        relative_change =
+            std::max(relative_change, std::abs(loop_.U - before.second) / std::abs(loop_.U));
+      }
+    }
+    // Instantaneous unsteadiness: |sum of body forces - G N_fluid| / (G N_fluid) is the
+    // relative rate of change of the fluid momentum.
+    double sum_f[3] = {0, 0, 0};
+    for (std::size_t s = 0; s < sc_.bodies; ++s) {
+      for (int c = 0; c < 3; ++c) sum_f[c] += body_force_[3 * s + c];
+    }
+    const double expected = loop_.force * static_cast<double>(sc_.fluid);
+    loop_.balance = std::sqrt((sum_f[0] - expected) * (sum_f[0] - expected) + sum_f[1] * sum_f[1] +
+                              sum_f[2] * sum_f[2]) /
+                    expected;
+    // Round-off floor of the balance: the link sum carries about 1e-16 of the sum of its terms'
+    // magnitudes (which cancel between the up- and downstream faces); a tolerance below that
+    // could never be met.
+    balance_floor_ =
+        64.0 * std::numeric_limits<double>::epsilon() * solver_->force_magnitude() / expected;
+    result_.history.push_back({loop_.step, loop_.F_mean, loop_.re_lattice, loop_.relative_change});
+    return Next::kGoOn;
+  }
+
+  /// Stokes-mode acceleration. The slowest transient of a fixed bed is the spin-up of the mean
+  /// flow, on the Darcy time d^2 (1 - phi) / (18 nu phi F) (several characteristic times for
+  /// dilute arrays), during which the local flow already has its steady shape and only its
+  /// amplitude lags. The scheme is linear in Stokes mode, so multiplying the whole deviation
+  /// field (and the force, when a target Re sets it) by G N_fluid / sum F_x puts that amplitude
+  /// where the momentum balance holds; the remaining transients are the fast local ones. It
+  /// changes neither F (scale-free in Stokes mode) nor the steady state, and the convergence
+  /// test (F change per T and the momentum balance) is unaffected by it.
+  /// Applied at every check from half a characteristic time on (the local flow has its shape
+  /// by then). With the full equilibrium at Re = 0 the flow is linear to O(Re ~ 0.01), so it is
+  /// used there too; at finite Re the target-Re control rescales instead.
+  void Rescale() {
+    if ((sc_.stokes || sc_.target_re == 0.0) && loop_.window.size() >= kChecksPerTime / 2 &&
+        loop_.balance > options_.tolerance && sum_fx_ > 0.0) {
+      const double factor =
+          std::clamp(loop_.force * static_cast<double>(sc_.fluid) / sum_fx_, 0.5, 2.0);
+      if (factor != 1.0) solver_->scale_deviations(factor);
+    }
+  }
+
+  /// Unsteady flow. A flow that fluctuates around a stationary mean at the target Re never
+  /// meets the steady test: detect it, bring Re to its band on the filtered (window mean)
+  /// velocity, then hold the force and average F (averaging.h).
+  Next DetectUnsteady() {
+    auto& window = loop_.window;
+    if (loop_.averaging || !(sc_.target_re > 0.0) || sc_.stokes ||
+        !(loop_.relative_change > options_.tolerance) || window.size() < kUnsteadyWindowChecks) {
+      return Next::kGoOn;
+    }
+    std::vector<double> window_F(window.size());
+    double mean_U = 0.0;
+    for (std::size_t k = 0; k < window.size(); ++k) window_F[k] = window[k].first;
+    for (std::size_t k = window.size() - kUnsteadyWindowChecks; k < window.size(); ++k) {
+      mean_U += window[k].second / static_cast<double>(kUnsteadyWindowChecks);
+    }
+    if (!stationary_fluctuating(window_F, kUnsteadyWindowChecks,
+                                std::max(options_.tolerance, kUnsteadyMinAmplitude))) {
+      return Next::kGoOn;
+    }
+    const double mean_re = mean_U * sc_.d / sc_.nu;
+    if (std::abs(mean_re / sc_.target_re - 1.0) > options_.re_tolerance / 3.0 &&
+        loop_.adjustments < kMaxAdjustments) {
+      SetForce(adjusted_force(loop_.force, mean_re, sc_.target_re, sc_.phi, &loop_.last_log_force,
+                              &loop_.last_log_re));
+      window.clear();
+      ++loop_.adjustments;
+      return Next::kNextCheck;
+    }
+    const std::int64_t needed = static_cast<std::int64_t>(
+        std::ceil(options_.average_time * sc_.d / (sc_.target_re * sc_.nu / sc_.d)));
+    const std::int64_t step = loop_.step;
+    if (step + needed > options_.max_steps) {
+      return Fail("unsteady flow at Re = " + fmt("%.4g", mean_re) + " (F fluctuates by " +
+                  fmt("%.2g", loop_.relative_change) +
+                  " per characteristic time around a "
+                  "stationary mean): averaging over average_time = " +
+                  fmt("%g", options_.average_time) + " d/U needs " + std::to_string(needed) +
+                  " more steps, beyond max_steps = " + std::to_string(options_.max_steps) +
+                  "; remedy: --max-steps " + std::to_string(step + 2 * needed) + " or more");
+    }
+    loop_.averaging = true;
+    loop_.averaging_start = step;
+    result_.warnings.push_back("unsteady flow from step " + std::to_string(step) +
+                               ": the force is held and F time-averaged");
+    return Next::kGoOn;
+  }
+
+  /// While averaging: the time means of F, Re and each body's drag; Re brought back to its band
+  /// (restarting the average) or converged when the mean's standard error is small enough
+  /// after average_time d/U. Returns kNextCheck while the average goes on.
+  Next Average() {
+    loop_.series_F.push_back(loop_.F_mean);
+    loop_.series_re.push_back(loop_.re_lattice);
+    loop_.series_body.resize(sc_.bodies);
+    for (std::size_t s = 0; s < sc_.bodies; ++s) {
+      loop_.series_body[s].push_back(body_force_[3 * s] / (3.0 * kPi * sc_.nu * sc_.d * loop_.U));
+    }
+    average_F_ = time_average(loop_.series_F);
+    average_re_ = time_average(loop_.series_re, average_F_.truncated);
+    const double averaged_time = static_cast<double>(average_F_.used * sc_.interval) *
+                                 (sc_.target_re * sc_.nu / sc_.d) / sc_.d;
+    if (averaged_time >= options_.average_time && average_F_.used >= 2 * kMinBlocks) {
+      if (std::abs(average_re_.mean / sc_.target_re - 1.0) > options_.re_tolerance) {
+        if (loop_.averaging_restarts >= kMaxAveragingRestarts) {
+          return Fail("unsteady flow: the time-averaged Re " + fmt("%.4g", average_re_.mean) +
+                      " stays outside the band of the target " + fmt("%g", sc_.target_re) +
+                      " after " + std::to_string(loop_.averaging_restarts) +
+                      " corrections of the force; remedy: a wider re_tolerance");
+        }
+        SetForce(adjusted_force(loop_.force, average_re_.mean, sc_.target_re, sc_.phi,
+                                &loop_.last_log_force, &loop_.last_log_re));
+        loop_.series_F.clear();
+        loop_.series_re.clear();
+        loop_.series_body.clear();
+        loop_.averaging_start = loop_.step;
+        ++loop_.averaging_restarts;
+        return Next::kNextCheck;
+      }
+      if (average_F_.standard_error <= options_.average_tolerance * std::abs(average_F_.mean)) {
+        return Next::kConverged;
+      }
+    }
+    if (ProgressDue()) {
+      const double se = average_F_.mean != 0.0
+                            ? average_F_.standard_error / std::abs(average_F_.mean)
+                            : std::numeric_limits<double>::infinity();
+      progress_(
+          std::min(1.0, static_cast<double>(loop_.step) / static_cast<double>(options_.max_steps)),
+          "step " + std::to_string(loop_.step) + ": averaging, F = " +
+              fmt("%.6g", average_F_.mean) + " +- " + fmt("%.2g", 100.0 * se) + " % over " +
+              fmt("%.3g", averaged_time) + " d/U, Re = " + fmt("%.4g", average_re_.mean) + ", " +
+              fmt("%.4g", result_.mflups) + " MFLUPS");
+    }
+    return Next::kNextCheck;
+  }
+
+  /// The target Re: the force rescaled towards it (exactly in Stokes mode, where the scheme is
+  /// linear in G; once the flow has settled otherwise). kNextCheck after a change.
+  Next ControlRe() {
+    const double target_re = sc_.target_re;
+    const double re_ratio = target_re > 0.0 ? loop_.re_lattice / target_re : 1.0;
+    if (target_re > 0.0 && std::abs(re_ratio - 1.0) > options_.re_tolerance / 3.0 &&
+        loop_.adjustments < kMaxAdjustments && loop_.re_lattice > 0.0 &&
+        (sc_.stokes || loop_.relative_change < kAdjustBelowChange)) {
+      const double velocity_factor = 1.0 / re_ratio;
+      double new_force;
+      if (sc_.stokes) {
+        new_force = loop_.force * velocity_factor;  // exact: the Stokes-mode scheme is linear in G
+      } else {
+        new_force = adjusted_force(loop_.force, loop_.re_lattice, target_re, sc_.phi,
+                                   &loop_.last_log_force, &loop_.last_log_re);
+        loop_.window.clear();
+      }
+      solver_->scale_deviations(velocity_factor);
+      SetForce(new_force);
+      ++loop_.adjustments;
+      return Next::kNextCheck;
+    }
+    const bool re_ok = target_re == 0.0 || std::abs(re_ratio - 1.0) <= options_.re_tolerance;
+    if (loop_.relative_change < options_.tolerance &&
+        loop_.balance < std::max(sc_.balance_tolerance, balance_floor_) && re_ok) {
+      return Next::kConverged;
+    }
+    return Next::kGoOn;
+  }
+
+  /// The progress line of a steady run (at most every kProgressInterval seconds).
+  void Progress() {
+    if (!ProgressDue()) return;
+    const double relative_change = loop_.relative_change;
+    double fraction = static_cast<double>(loop_.step) / static_cast<double>(options_.max_steps);
+    if (std::isfinite(relative_change) && relative_change > 0.0) {
+      fraction = std::max(
+          fraction, std::clamp(std::log(relative_change) / std::log(options_.tolerance), 0.0, 1.0));
+    }
+    progress_(std::min(fraction, 1.0),
+              "step " + std::to_string(loop_.step) + ": F = " + fmt("%.6g", loop_.F_mean) +
+                  ", Re = " + fmt("%.4g", loop_.re_lattice) + ", change/T = " +
+                  fmt("%.2g", relative_change) + ", " + fmt("%.4g", result_.mflups) + " MFLUPS");
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  Next Fail(const std::string& why) {
+    failure_ = why;
+    return Next::kFail;
+  }
+  std::string Instability(const std::string& what, std::int64_t node) const {
+    return diverged_diagnosis(lattice_, options_, sc_.d, sc_.nu, sc_.target_re, sc_.phi, loop_.step,
+                              what, node, loop_.last_max_speed, loop_.last_max_node,
+                              loop_.last_check_step);
+  }
+  void SetForce(double force) {
+    loop_.force = force;
+    solver_->set_force(force);
+  }
+  bool ProgressDue() {
+    if (!progress_ ||
+        std::chrono::duration<double>(Clock::now() - last_progress_).count() < kProgressInterval)
+      return false;
+    last_progress_ = Clock::now();
+    return true;
+  }
+
+  const RunOptions& options_;
+  const SparseLattice& lattice_;
+  SolverBase* solver_;
+  const Scales sc_;
+  LoopState& loop_;
+  RunResult& result_;
+  const std::vector<double>& body_force_;
+  const ProgressCallback& progress_;
+  Clock::time_point last_progress_;
+  MomentSummary m_;
+  TimeAverage average_F_, average_re_;
+  double sum_fx_ = 0.0;         ///< Sum of the bodies' x-forces at this check.
+  double balance_floor_ = 0.0;  ///< Round-off floor of the momentum balance at this check.
+  std::string failure_;
+};
+
+/// Why a run that reached max_steps has no result: how far it got, and how to go on.
+std::string not_converged_diagnosis(const RunOptions& options, const RunResult& result,
+                                    const LoopState& loop, bool no_checkpoint) {
+  return "not converged after max_steps = " + std::to_string(options.max_steps) +
+         " steps: relative change of F per characteristic time (" +
+         std::to_string(result.characteristic_steps) + " steps) is " +
+         fmt("%.3g", loop.relative_change) + ", momentum balance " + fmt("%.3g", loop.balance) +
+         " (tolerance " + fmt("%.3g", options.tolerance) + ")" +
+         (options.re > 0.0
+              ? ", Re = " + fmt("%.5g", loop.re_lattice) + " for target " + fmt("%g", options.re)
+              : std::string()) +
+         "; remedy: raise max_steps (or loosen the tolerance); at high Re the flow "
+         "may be unsteady" +
+         (no_checkpoint ? std::string()
+                        : "; the checkpoint '" + options.checkpoint + "' holds step " +
+                              std::to_string(loop.step) +
+                              ": the same run with a larger max_steps goes on from there");
+}
+
 /// One run. `plan`: the velocity plan of a finite-Re run (null at Re = 0).
 RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,
                    Fields* fields, const ProgressCallback& progress, const VelocityPlan* plan) {
@@ -763,42 +1119,25 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   result.characteristic_steps = interval * kChecksPerTime;
 
   std::vector<double> body_force;
-  std::vector<std::pair<double, double>>& window = loop.window;
-  double& balance = loop.balance;
-  balance = std::numeric_limits<double>::infinity();
+  RunChecks::Scales check_scales;
+  check_scales.d = d;
+  check_scales.nu = nu;
+  check_scales.phi = phi;
+  check_scales.target_re = target_re;
+  check_scales.stokes = stokes;
+  check_scales.fluid = fluid;
+  check_scales.total_nodes = total_nodes;
+  check_scales.bodies = bodies;
+  check_scales.mixture = mixture;
+  check_scales.interval = interval;
   // Float storage rounds every population to ~1e-7 relative each step, which leaves a noise
   // floor in the momentum balance (measured ~1e-6 .. 1e-5); double reaches round-off.
-  const double balance_tolerance = options.precision == Precision::kFloat
+  check_scales.balance_tolerance = options.precision == Precision::kFloat
                                        ? std::max(options.tolerance, kFloatBalanceFloor)
                                        : options.tolerance;
+  RunChecks checks(options, lattice, solver, check_scales, &loop, &result, &body_force, progress);
   std::int64_t& step = loop.step;
   double& stepping_s = loop.stepping_s;
-  int& adjustments = loop.adjustments;
-  // Unsteady flow (averaging.h): once detected, the force is held and F averaged.
-  bool& averaging = loop.averaging;
-  int& averaging_restarts = loop.averaging_restarts;
-  std::int64_t& averaging_start = loop.averaging_start;
-  std::vector<double>& series_F = loop.series_F;
-  std::vector<double>& series_re = loop.series_re;
-  std::vector<std::vector<double>>& series_body = loop.series_body;
-  TimeAverage average_F, average_re;
-  double& last_log_force = loop.last_log_force;
-  double& last_log_re = loop.last_log_re;
-  last_log_force = last_log_re = std::numeric_limits<double>::quiet_NaN();
-  double& relative_change = loop.relative_change;
-  relative_change = std::numeric_limits<double>::infinity();
-  bool& mach_warned = loop.mach_warned;
-  auto last_progress = Clock::now();
-  double& F_mean = loop.F_mean;
-  double& U = loop.U;
-  double& re_lattice = loop.re_lattice;
-  double& mach = loop.mach;
-  MomentSummary m;
-  // The largest speed at the last healthy check: where and how fast the flow was before a
-  // blow-up, for the diagnosis.
-  double& last_max_speed = loop.last_max_speed;
-  std::int64_t& last_max_node = loop.last_max_node;
-  std::int64_t& last_check_step = loop.last_check_step;
 
   // Checkpoint: resume from it (the same run only), then rewrite it now and then.
   const std::size_t loop_warnings_from = result.warnings.size();
@@ -834,9 +1173,10 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     ++result.checkpoints_written;
     last_checkpoint = Clock::now();
   };
-  auto instability = [&](const std::string& what, std::int64_t node) {
-    return diverged_diagnosis(lattice, options, d, nu, target_re, phi, step, what, node,
-                              last_max_speed, last_max_node, last_check_step);
+  // A check's stage that stops the run: the fields as they are, then the diagnosis.
+  auto stop = [&](const std::string& diagnosis) {
+    if (fields != nullptr) solver->fill_fields(fields);
+    return fail(diagnosis);
   };
 
   while (true) {
@@ -852,22 +1192,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
       }
       result.steps = step;
       result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
-      if (fields != nullptr) solver->fill_fields(fields);
-      return fail("not converged after max_steps = " + std::to_string(options.max_steps) +
-                  " steps: relative change of F per characteristic time (" +
-                  std::to_string(result.characteristic_steps) + " steps) is " +
-                  fmt("%.3g", relative_change) + ", momentum balance " + fmt("%.3g", balance) +
-                  " (tolerance " + fmt("%.3g", options.tolerance) + ")" +
-                  (target_re > 0.0
-                       ? ", Re = " + fmt("%.5g", re_lattice) + " for target " + fmt("%g", target_re)
-                       : std::string()) +
-                  "; remedy: raise max_steps (or loosen the tolerance); at high Re the flow "
-                  "may be unsteady" +
-                  (checkpoint_path.empty() ? std::string()
-                                           : "; the checkpoint '" + options.checkpoint +
-                                                 "' holds step " + std::to_string(step) +
-                                                 ": the same run with a larger max_steps goes "
-                                                 "on from there"));
+      return stop(not_converged_diagnosis(options, result, loop, checkpoint_path.empty()));
     }
     // Checks at every multiple of the interval (a resumed run keeps the schedule), the last
     // one cut short at max_steps (rounded up to a pair).
@@ -887,231 +1212,19 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     result.steps = step;
     result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
 
-    m = solver->moments();
-    if (m.nonfinite_node >= 0) {
-      if (fields != nullptr) solver->fill_fields(fields);
-      return fail(instability("a non-finite population", m.nonfinite_node));
+    using Next = RunChecks::Next;
+    if (checks.Health() == Next::kFail || checks.Drag() == Next::kFail) {
+      return stop(checks.failure());
     }
-    if (m.min_rho <= 0.0) {
-      if (fields != nullptr) solver->fill_fields(fields);
-      return fail(instability("density " + fmt("%.3g", m.min_rho) + " <= 0", m.min_rho_node));
-    }
-    mach = std::sqrt(3.0 * m.max_speed2);
-    result.mach_max = std::max(result.mach_max, mach);
-    if (mach > options.mach_limit) {
-      if (fields != nullptr) solver->fill_fields(fields);
-      if (last_max_speed > 0.0 && std::sqrt(m.max_speed2) > kBlowUpGrowth * last_max_speed) {
-        return fail(instability("max |u| grew from " + fmt("%.3g", last_max_speed) + " to " +
-                                    fmt("%.3g", std::sqrt(m.max_speed2)) + " (Mach " +
-                                    fmt("%.3g", mach) + ") within " + std::to_string(interval) +
-                                    " steps",
-                                m.max_speed_node));
-      }
-      return fail("Mach number " + fmt("%.3g", mach) + " above the limit " +
-                  fmt("%g", options.mach_limit) + " at step " + std::to_string(step) + ", " +
-                  node_text(lattice, m.max_speed_node) +
-                  " (max |u| = " + fmt("%.3g", std::sqrt(m.max_speed2)) + ", grown steadily" +
-                  (target_re > 0.0 && options.tau == 0.0
-                       ? std::string("); remedy: lower the Mach target (--mach)")
-                       : std::string("); remedy: lower tau (the velocity is U = Re nu / d at the "
-                                     "target Re), or leave tau to the engine")));
-    }
-    const double mach_warning = target_re > 0.0 && options.tau == 0.0
-                                    ? std::max(kMachWarning, 1.5 * options.mach_target)
-                                    : kMachWarning;
-    if (mach > mach_warning && !mach_warned) {
-      mach_warned = true;
-      result.warnings.push_back(
-          "Mach number " + fmt("%.3g", mach) + " above " + fmt("%.3g", mach_warning) + " at step " +
-          std::to_string(step) + " (" + node_text(lattice, m.max_speed_node) +
-          "): compressibility error of order Ma^2 = " + fmt("%.2g", mach * mach));
-    }
-    last_max_speed = std::sqrt(m.max_speed2);
-    last_max_node = m.max_speed_node;
-    last_check_step = step;
-
-    U = m.sum_u[0] / total_nodes;
-    re_lattice = U * d / nu;
-    double sum_fx = 0.0;
-    for (std::size_t s = 0; s < bodies; ++s) sum_fx += body_force[3 * s];
-    F_mean = sum_fx / static_cast<double>(bodies) / (3.0 * kPi * nu * d * U) * mixture;
-    if (!std::isfinite(F_mean)) {
-      if (fields != nullptr) solver->fill_fields(fields);
-      return fail(instability("a non-finite drag (superficial velocity " + fmt("%.3g", U) + ")",
-                              m.max_speed_node));
-    }
-    window.push_back({F_mean, U});
-    relative_change = std::numeric_limits<double>::infinity();
-    if (window.size() > static_cast<std::size_t>(kChecksPerTime)) {
-      const auto& before = window[window.size() - 1 - kChecksPerTime];
-      // In Stokes mode the velocity scale is arbitrary (the state may be rescaled, see below):
-      // only F counts there.
-      relative_change = std::abs(F_mean - before.first) / std::abs(F_mean);
-      if (!stokes) {
-        relative_change = std::max(relative_change, std::abs(U - before.second) / std::abs(U));
-      }
-    }
-    // Instantaneous unsteadiness: |sum of body forces - G N_fluid| / (G N_fluid) is the
-    // relative rate of change of the fluid momentum.
-    double sum_f[3] = {0, 0, 0};
-    for (std::size_t s = 0; s < bodies; ++s) {
-      for (int c = 0; c < 3; ++c) sum_f[c] += body_force[3 * s + c];
-    }
-    const double expected = force * static_cast<double>(fluid);
-    balance = std::sqrt((sum_f[0] - expected) * (sum_f[0] - expected) + sum_f[1] * sum_f[1] +
-                        sum_f[2] * sum_f[2]) /
-              expected;
-    // Round-off floor of the balance: the link sum carries about 1e-16 of the sum of its terms'
-    // magnitudes (which cancel between the up- and downstream faces); a tolerance below that
-    // could never be met.
-    const double balance_floor =
-        64.0 * std::numeric_limits<double>::epsilon() * solver->force_magnitude() / expected;
-    result.history.push_back({step, F_mean, re_lattice, relative_change});
-
-    // Stokes-mode acceleration. The slowest transient of a fixed bed is the spin-up of the mean
-    // flow, on the Darcy time d^2 (1 - phi) / (18 nu phi F) (several characteristic times for
-    // dilute arrays), during which the local flow already has its steady shape and only its
-    // amplitude lags. The scheme is linear in Stokes mode, so multiplying the whole deviation
-    // field (and the force, when a target Re sets it) by G N_fluid / sum F_x puts that amplitude
-    // where the momentum balance holds; the remaining transients are the fast local ones. It
-    // changes neither F (scale-free in Stokes mode) nor the steady state, and the convergence
-    // test (F change per T and the momentum balance) is unaffected by it.
-    // Applied at every check from half a characteristic time on (the local flow has its shape
-    // by then). With the full equilibrium at Re = 0 the flow is linear to O(Re ~ 0.01), so it is
-    // used there too; at finite Re the target-Re control below rescales instead.
-    if ((stokes || target_re == 0.0) && window.size() >= kChecksPerTime / 2 &&
-        balance > options.tolerance && sum_fx > 0.0) {
-      const double factor = std::clamp(force * static_cast<double>(fluid) / sum_fx, 0.5, 2.0);
-      if (factor != 1.0) solver->scale_deviations(factor);
-    }
-
-    // Unsteady flow. A flow that fluctuates around a stationary mean at the target Re never
-    // meets the steady test: detect it, bring Re to its band on the filtered (window mean)
-    // velocity, then hold the force and average F (averaging.h).
-    if (!averaging && target_re > 0.0 && !stokes && relative_change > options.tolerance &&
-        window.size() >= kUnsteadyWindowChecks) {
-      std::vector<double> window_F(window.size());
-      double mean_U = 0.0;
-      for (std::size_t k = 0; k < window.size(); ++k) window_F[k] = window[k].first;
-      for (std::size_t k = window.size() - kUnsteadyWindowChecks; k < window.size(); ++k) {
-        mean_U += window[k].second / static_cast<double>(kUnsteadyWindowChecks);
-      }
-      if (stationary_fluctuating(window_F, kUnsteadyWindowChecks,
-                                 std::max(options.tolerance, kUnsteadyMinAmplitude))) {
-        const double mean_re = mean_U * d / nu;
-        if (std::abs(mean_re / target_re - 1.0) > options.re_tolerance / 3.0 &&
-            adjustments < kMaxAdjustments) {
-          force = adjusted_force(force, mean_re, target_re, phi, &last_log_force, &last_log_re);
-          solver->set_force(force);
-          window.clear();
-          ++adjustments;
-          continue;
-        }
-        const std::int64_t needed =
-            static_cast<std::int64_t>(std::ceil(options.average_time * d / (target_re * nu / d)));
-        if (step + needed > options.max_steps) {
-          if (fields != nullptr) solver->fill_fields(fields);
-          return fail("unsteady flow at Re = " + fmt("%.4g", mean_re) + " (F fluctuates by " +
-                      fmt("%.2g", relative_change) +
-                      " per characteristic time around a "
-                      "stationary mean): averaging over average_time = " +
-                      fmt("%g", options.average_time) + " d/U needs " + std::to_string(needed) +
-                      " more steps, beyond max_steps = " + std::to_string(options.max_steps) +
-                      "; remedy: --max-steps " + std::to_string(step + 2 * needed) + " or more");
-        }
-        averaging = true;
-        averaging_start = step;
-        result.warnings.push_back("unsteady flow from step " + std::to_string(step) +
-                                  ": the force is held and F time-averaged");
-      }
-    }
-    if (averaging) {
-      series_F.push_back(F_mean);
-      series_re.push_back(re_lattice);
-      series_body.resize(bodies);
-      for (std::size_t s = 0; s < bodies; ++s) {
-        series_body[s].push_back(body_force[3 * s] / (3.0 * kPi * nu * d * U));
-      }
-      average_F = time_average(series_F);
-      average_re = time_average(series_re, average_F.truncated);
-      const double averaged_time =
-          static_cast<double>(average_F.used * interval) * (target_re * nu / d) / d;
-      if (averaged_time >= options.average_time && average_F.used >= 2 * kMinBlocks) {
-        if (std::abs(average_re.mean / target_re - 1.0) > options.re_tolerance) {
-          if (averaging_restarts >= kMaxAveragingRestarts) {
-            if (fields != nullptr) solver->fill_fields(fields);
-            return fail("unsteady flow: the time-averaged Re " + fmt("%.4g", average_re.mean) +
-                        " stays outside the band of the target " + fmt("%g", target_re) +
-                        " after " + std::to_string(averaging_restarts) +
-                        " corrections of the force; remedy: a wider re_tolerance");
-          }
-          force =
-              adjusted_force(force, average_re.mean, target_re, phi, &last_log_force, &last_log_re);
-          solver->set_force(force);
-          series_F.clear();
-          series_re.clear();
-          series_body.clear();
-          averaging_start = step;
-          ++averaging_restarts;
-          continue;
-        }
-        if (average_F.standard_error <= options.average_tolerance * std::abs(average_F.mean)) {
-          break;
-        }
-      }
-      if (progress && seconds_since(last_progress) >= kProgressInterval) {
-        last_progress = Clock::now();
-        const double se = average_F.mean != 0.0
-                              ? average_F.standard_error / std::abs(average_F.mean)
-                              : std::numeric_limits<double>::infinity();
-        progress(std::min(1.0, static_cast<double>(step) / static_cast<double>(options.max_steps)),
-                 "step " + std::to_string(step) + ": averaging, F = " +
-                     fmt("%.6g", average_F.mean) + " +- " + fmt("%.2g", 100.0 * se) + " % over " +
-                     fmt("%.3g", averaged_time) + " d/U, Re = " + fmt("%.4g", average_re.mean) +
-                     ", " + fmt("%.4g", result.mflups) + " MFLUPS");
-      }
-      continue;
-    }
-
-    // Target Re.
-    const double re_ratio = target_re > 0.0 ? re_lattice / target_re : 1.0;
-    if (target_re > 0.0 && std::abs(re_ratio - 1.0) > options.re_tolerance / 3.0 &&
-        adjustments < kMaxAdjustments && re_lattice > 0.0 &&
-        (stokes || relative_change < kAdjustBelowChange)) {
-      const double velocity_factor = 1.0 / re_ratio;
-      double new_force;
-      if (stokes) {
-        new_force = force * velocity_factor;  // exact: the Stokes-mode scheme is linear in G
-      } else {
-        new_force =
-            adjusted_force(force, re_lattice, target_re, phi, &last_log_force, &last_log_re);
-        window.clear();
-      }
-      solver->scale_deviations(velocity_factor);
-      force = new_force;
-      solver->set_force(force);
-      ++adjustments;
-      continue;
-    }
-    const bool re_ok = target_re == 0.0 || std::abs(re_ratio - 1.0) <= options.re_tolerance;
-    if (relative_change < options.tolerance &&
-        balance < std::max(balance_tolerance, balance_floor) && re_ok) {
-      break;
-    }
-
-    if (progress && seconds_since(last_progress) >= kProgressInterval) {
-      last_progress = Clock::now();
-      double fraction = static_cast<double>(step) / static_cast<double>(options.max_steps);
-      if (std::isfinite(relative_change) && relative_change > 0.0) {
-        fraction =
-            std::max(fraction,
-                     std::clamp(std::log(relative_change) / std::log(options.tolerance), 0.0, 1.0));
-      }
-      progress(std::min(fraction, 1.0),
-               "step " + std::to_string(step) + ": F = " + fmt("%.6g", F_mean) + ", Re = " +
-                   fmt("%.4g", re_lattice) + ", change/T = " + fmt("%.2g", relative_change) + ", " +
-                   fmt("%.4g", result.mflups) + " MFLUPS");
-    }
+    checks.Rescale();
+    Next next = checks.DetectUnsteady();
+    if (next == Next::kFail) return stop(checks.failure());
+    if (next == Next::kNextCheck) continue;
+    next = loop.averaging ? checks.Average() : checks.ControlRe();
+    if (next == Next::kFail) return stop(checks.failure());
+    if (next == Next::kConverged) break;
+    if (next == Next::kNextCheck) continue;
+    checks.Progress();
   }
 
   // Converged: normalise.
@@ -1125,7 +1238,8 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   scales.fluid = fluid;
   scales.bodies = bodies;
   scales.mixture = mixture;
-  normalise_converged(loop, average_F, average_re, m, body_force, scales, options, grid, &result);
+  normalise_converged(loop, checks.average_F(), checks.average_re(), checks.moments(), body_force,
+                      scales, options, grid, &result);
   if (fields != nullptr) solver->fill_fields(fields);
   if (checkpoint_owned) std::remove(checkpoint_path.c_str());
   result.wall_s = seconds_since(start);

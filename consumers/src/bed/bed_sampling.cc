@@ -103,6 +103,18 @@ std::vector<double> sample_times(double duration_s, double interval_s) {
   return times;
 }
 
+nlohmann::json snapshot_json(double t_s, const BubbleMetrics& b) {
+  return {{"t_s", t_s},
+          {"bubble_found", b.found},
+          {"bubble_diameter_m", b.diameter_m},
+          {"bubble_centroid_x_m", b.centroid_x_m},
+          {"bubble_centroid_y_m", b.centroid_y_m},
+          {"bubble_top_m", b.top_m},
+          {"bubble_bottom_m", b.bottom_m},
+          {"bubble_erupting", b.touches_surface},
+          {"bed_height_m", b.bed_height_m}};
+}
+
 }  // namespace internal
 }  // namespace consumers
 }  // namespace draglab

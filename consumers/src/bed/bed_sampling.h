@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include <string>
 #include <vector>
@@ -42,6 +43,9 @@ std::vector<double> sample_times(double duration_s, double interval_s);
 
 /// A cell field (nx x nz, Eigen index (i, j)) on the scene's grid as a GridField2D.
 GridField2D scene_grid_field(const Scene& scene, const Eigen::ArrayXXd& values);
+
+/// The "snapshot" entry of a model's result JSON: the bubble of the sample nearest t_ref.
+nlohmann::json snapshot_json(double t_s, const BubbleMetrics& bubble);
 
 /// The bubble sampling every bed model does: at each sample time, the bubble in the gas
 /// fraction (the scene's criterion), the bed height and the pressure drop, and whether the

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/core/text.h"
@@ -188,18 +189,7 @@ std::string dpm_result_json(const DpmResult& r) {
                       {"eps_packing", r.eps_packing},
                       {"umf_packing_m_s", r.umf_packing_m_s},
                       {"output_files", r.output_files}};
-  if (r.has_snapshot) {
-    const BubbleMetrics& b = r.snapshot.bubble;
-    j["snapshot"] = {{"t_s", r.snapshot.t_s},
-                     {"bubble_found", b.found},
-                     {"bubble_diameter_m", b.diameter_m},
-                     {"bubble_centroid_x_m", b.centroid_x_m},
-                     {"bubble_centroid_y_m", b.centroid_y_m},
-                     {"bubble_top_m", b.top_m},
-                     {"bubble_bottom_m", b.bottom_m},
-                     {"bubble_erupting", b.touches_surface},
-                     {"bed_height_m", b.bed_height_m}};
-  }
+  if (r.has_snapshot) j["snapshot"] = internal::snapshot_json(r.snapshot.t_s, r.snapshot.bubble);
   return j.dump();
 }
 

@@ -240,18 +240,7 @@ nlohmann::json ResultJson(const TfmSimulation& tfm, const Scene& scene, const Be
       {"threads", out.threads},
       {"wall_s", out.wall_s},
       {"output_files", out.output_files}};
-  if (s.have_ref) {
-    const BubbleMetrics& b = s.ref_bubble;
-    j["snapshot"] = {{"t_s", s.at_ref.t_s},
-                     {"bubble_found", b.found},
-                     {"bubble_diameter_m", b.diameter_m},
-                     {"bubble_centroid_x_m", b.centroid_x_m},
-                     {"bubble_centroid_y_m", b.centroid_y_m},
-                     {"bubble_top_m", b.top_m},
-                     {"bubble_bottom_m", b.bottom_m},
-                     {"bubble_erupting", b.touches_surface},
-                     {"bed_height_m", b.bed_height_m}};
-  }
+  if (s.have_ref) j["snapshot"] = internal::snapshot_json(s.at_ref.t_s, s.ref_bubble);
   return j;
 }
 
