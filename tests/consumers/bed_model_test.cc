@@ -5,7 +5,9 @@
 // thread count (the family changes no DPM number). The realization hook: a DPM packing settled
 // once and passed to several runs gives each run bit-identical results to a run that settles its
 // own (the studies reuse one packing across laws and grids), a packing of another seed is
-// refused, and the time-resolution hook sets the value that sets each model's step.
+// refused, and the time-resolution hook sets the value that sets each model's step. A model
+// registered from the test with its own scene table ([toy]) has it read, type-checked and checked
+// by the model, refused in another model's scene, and copied with the scene.
 #include <algorithm>
 #include <memory>
 #include <string>
@@ -115,6 +117,77 @@ TEST(BedModel, ScenesNameRegisteredModelsAndRunsDispatchToThem) {
   EXPECT_EQ(r.wall_s, 0.25);
   options.duration_s = -1.0;
   EXPECT_THROW(run_bed_model(scene, ergun(), options), Error);
+}
+
+/// The section of a model registered from the test: one number, checked by the model.
+struct ToySection : SceneSection {
+  double speed_m_s = 1.0;
+  std::unique_ptr<SceneSection> Clone() const override {
+    return std::make_unique<ToySection>(*this);
+  }
+};
+
+/// A model with its own scene table, [toy]: required by its scenes, refused by the others.
+class ToyModel : public EchoModel {
+ public:
+  std::string key() const override { return "toy_test"; }
+  const SceneTable* scene_table() const override {
+    static const SceneTable table = [] {
+      SceneTable t;
+      t.name = "toy";
+      t.make = [] { return std::make_unique<ToySection>(); };
+      t.keys = {{"speed_m_s", [](SceneSection& s, const SceneValue& v) {
+                   static_cast<ToySection&>(s).speed_m_s = v.number();
+                 }}};
+      t.is_valid = [](const Scene& scene, std::string* error) {
+        const SceneSection* s = scene.sections.Find("toy");
+        const bool present = s != nullptr && s->present;
+        std::string why;
+        if (scene.solver == "toy_test" && !present) why = "[toy] table is missing";
+        if (scene.solver != "toy_test" && present) why = "[toy] is read only with toy_test";
+        if (present && !(static_cast<const ToySection*>(s)->speed_m_s > 0.0))
+          why = "[toy] speed_m_s must be > 0";
+        if (why.empty()) return true;
+        if (error) *error = why;
+        return false;
+      };
+      return t;
+    }();
+    return &table;
+  }
+};
+
+TEST(BedModel, AModelRegisteredOutsideTheLibraryBringsItsOwnSceneTable) {
+  const std::string toy = scene_text("toy_test") + "\n[toy]\nspeed_m_s = 2.5\n";
+  // Before registration neither the solver nor the table is known.
+  EXPECT_THROW(parse_scene(toy, "toy"), Error);
+  register_bed_model(std::make_unique<ToyModel>());
+  const Scene scene = parse_scene(toy, "toy");
+  const auto* section = dynamic_cast<const ToySection*>(scene.sections.Find("toy"));
+  ASSERT_NE(section, nullptr);
+  EXPECT_TRUE(section->present);
+  EXPECT_EQ(section->speed_m_s, 2.5);
+  // A copy of the scene owns its own section (a study's variant changes only the copy).
+  Scene copy = scene;
+  static_cast<ToySection&>(copy.sections.Get("toy", nullptr)).speed_m_s = 4.0;
+  EXPECT_EQ(static_cast<const ToySection*>(scene.sections.Find("toy"))->speed_m_s, 2.5);
+  // The model's keys, type checks and checks, through the scene's messages.
+  auto refused = [](const std::string& text, const std::string& expected) {
+    try {
+      parse_scene(text, "toy");
+      ADD_FAILURE() << "expected: " << expected;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused(scene_text("toy_test") + "\n[toy]\nspeed = 2.5\n", "unknown key 'speed' in [toy]");
+  refused(scene_text("toy_test") + "\n[toy]\nspeed_m_s = \"fast\"\n", "speed_m_s");
+  refused(scene_text("toy_test") + "\n[toy]\nspeed_m_s = -1.0\n", "[toy] speed_m_s must be > 0");
+  refused(scene_text("toy_test"), "[toy] table is missing");
+  refused(scene_text("dpm") + "\n[toy]\nspeed_m_s = 2.5\n", "[toy] is read only with toy_test");
+  // A scene of another model never has it.
+  EXPECT_EQ(parse_scene(scene_text("dpm"), "dpm").sections.Find("toy"), nullptr);
 }
 
 TEST(BedModel, DpmThroughTheRegistryIsBitIdenticalToADirectRun) {

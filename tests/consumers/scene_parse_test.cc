@@ -11,6 +11,7 @@
 
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/error.h"
+#include "tfm/tfm_scene.h"
 
 namespace draglab {
 namespace consumers {
@@ -122,10 +123,10 @@ TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
   const std::string base = read("tfm_bubble.toml");
   const Scene s = parse_scene(base, "tfm_bubble.toml");
   EXPECT_EQ(s.solver, "tfm");
-  EXPECT_TRUE(s.tfm.present);
-  EXPECT_EQ(s.tfm.closures, "nieuwland");
-  EXPECT_DOUBLE_EQ(s.tfm.packing_limit, 0.64);
-  EXPECT_DOUBLE_EQ(s.tfm.restitution, -1.0) << "from [particles] unless given";
+  EXPECT_TRUE(tfm_section(s).present);
+  EXPECT_EQ(tfm_section(s).closures, "nieuwland");
+  EXPECT_DOUBLE_EQ(tfm_section(s).packing_limit, 0.64);
+  EXPECT_DOUBLE_EQ(tfm_section(s).restitution, -1.0) << "from [particles] unless given";
   EXPECT_DOUBLE_EQ(s.geometry.height_m, 0.60) << "the seed's TFM box is 60 cm high";
   const Scene kuipers = parse_scene(read("tfm_kuipers_jet.toml"), "tfm_kuipers_jet.toml");
   EXPECT_EQ(kuipers.solver, "tfm");
@@ -150,11 +151,11 @@ TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
   expect_bad(read("dpm_bubble.toml") + "\n[tfm]\nclosures = \"nieuwland\"\n",
              {"[tfm] is read only with solver = \"tfm\""});
   // The numerical and modelling options: defaults, values, and bad names.
-  EXPECT_EQ(s.tfm.solids_walls, "free_slip");
-  EXPECT_EQ(s.tfm.fraction_scheme, "upwind");
-  EXPECT_EQ(s.tfm.granular_temperature, "transport");
-  EXPECT_EQ(s.tfm.solids_viscosity, "explicit");
-  EXPECT_DOUBLE_EQ(s.tfm.friction_max_viscosity_pa_s, 10.0);
+  EXPECT_EQ(tfm_section(s).solids_walls, "free_slip");
+  EXPECT_EQ(tfm_section(s).fraction_scheme, "upwind");
+  EXPECT_EQ(tfm_section(s).granular_temperature, "transport");
+  EXPECT_EQ(tfm_section(s).solids_viscosity, "explicit");
+  EXPECT_DOUBLE_EQ(tfm_section(s).friction_max_viscosity_pa_s, 10.0);
   const Scene options =
       parse_scene(edit(edit(base, "tfm", "friction", "friction = \"johnson_jackson_openfoam\""),
                        "tfm", "closures",
@@ -163,12 +164,12 @@ TEST(SceneParse, TwoFluidSceneAndItsBadInput) {
                        "friction_max_viscosity_pa_s = 100.0\nsolids_viscosity = "
                        "\"point_implicit\""),
                   "edited.toml");
-  EXPECT_EQ(options.tfm.solids_walls, "no_slip");
-  EXPECT_EQ(options.tfm.fraction_scheme, "van_leer");
-  EXPECT_EQ(options.tfm.granular_temperature, "algebraic");
-  EXPECT_DOUBLE_EQ(options.tfm.friction_max_viscosity_pa_s, 100.0);
-  EXPECT_EQ(options.tfm.solids_viscosity, "point_implicit");
-  EXPECT_EQ(options.tfm.friction, "johnson_jackson_openfoam");
+  EXPECT_EQ(tfm_section(options).solids_walls, "no_slip");
+  EXPECT_EQ(tfm_section(options).fraction_scheme, "van_leer");
+  EXPECT_EQ(tfm_section(options).granular_temperature, "algebraic");
+  EXPECT_DOUBLE_EQ(tfm_section(options).friction_max_viscosity_pa_s, 100.0);
+  EXPECT_EQ(tfm_section(options).solids_viscosity, "point_implicit");
+  EXPECT_EQ(tfm_section(options).friction, "johnson_jackson_openfoam");
   expect_bad(edit(base, "tfm", "closures", "solids_viscosity = \"implicit\""),
              {"[tfm] solids_viscosity", "point_implicit"});
   expect_bad(edit(base, "tfm", "friction", "friction = \"coulomb\""),

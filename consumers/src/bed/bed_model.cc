@@ -61,13 +61,13 @@ constexpr double kMemoryShare = 0.8;
 /// naming [grid] (it would otherwise allocate for a while and die in std::bad_alloc).
 void check_grid_memory(const Scene& scene) {
   const double cells = static_cast<double>(scene.grid.cells_x) * scene.grid.cells_y *
-                       (scene.solver == "dbm" ? scene.grid.cells_z : 1);
+                       scene.grid.cells_z;  // 1 for the pseudo-2D models
   const double bytes = kGridBytesPerCell * cells;
   const double memory = core::physical_memory_bytes();
   if (memory <= 0.0 || bytes <= kMemoryShare * memory) return;
   throw Error(ErrorCode::kInvalidArgument,
               "[grid] " + core::format_number(cells) + " cells (cells_x x cells_y" +
-                  (scene.solver == "dbm" ? " x cells_z" : "") + ") need about " +
+                  (scene.grid.cells_z > 1 ? " x cells_z" : "") + ") need about " +
                   core::format_number(bytes / 1073741824.0, 3) + " GiB, more than " +
                   core::format_number(100.0 * kMemoryShare, 2) + " % of this machine's " +
                   core::format_number(memory / 1073741824.0, 3) +

@@ -21,6 +21,7 @@
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
 #include "dbm/dbm.h"
+#include "dbm/dbm_scene.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
@@ -37,7 +38,7 @@ std::string Num(double x) { return core::format_number(x, 4); }
 
 /// The DBM's options for a scene, given the law's U_mf.
 DbmOptions SceneDbmOptions(const Scene& s, double umf_m_s, std::uint64_t seed) {
-  const SceneDbm& d = s.dbm;
+  const SceneDbm& d = dbm_section(s);
   DbmOptions o;
   o.width_m = s.geometry.width_m;
   o.depth_m = s.geometry.depth_m;
@@ -136,7 +137,7 @@ void CheckRealization(const Scene& scene, const BedRealization* start) {
 /// The DBM's options for a scene and a law, checked: the gas flow above U_mf, the injected bubble
 /// against the column and the nozzle pitch, the stable step.
 DbmOptions CheckedOptions(const Scene& scene, const Law& law, const MinFluidizationResult& umf) {
-  const SceneDbm& sd = scene.dbm;
+  const SceneDbm& sd = dbm_section(scene);
   const std::string law_ref = law.record().reference();
   if (!(sd.superficial_velocity_m_s > umf.umf_m_s))
     Bad("[dbm] superficial_velocity_m_s = " + Num(sd.superficial_velocity_m_s) +
@@ -173,7 +174,7 @@ struct DbmSeries {
 /// Runs the simulation to `duration`, sampling at the scene's interval.
 DbmSeries SampleRun(DbmSimulation& dbm, const Scene& scene, const DbmOptions& o, double duration,
                     const std::string& law_ref, const BedProgress& progress, BedResult* out) {
-  const SceneDbm& sd = scene.dbm;
+  const SceneDbm& sd = dbm_section(scene);
   const double column_volume = o.width_m * o.depth_m * o.height_m;
   DbmSeries s;
   try {
@@ -294,7 +295,7 @@ Circulation CirculationOf(const DbmAverages& av, const DbmOptions& o) {
 std::string WriteFigureData(const DbmSimulation& dbm, const Scene& scene, const Law& law,
                             const DbmOptions& o, double umf_m_s, const HeightProfiles& profiles,
                             const std::string& output_directory) {
-  const SceneDbm& sd = scene.dbm;
+  const SceneDbm& sd = dbm_section(scene);
   const DbmAverages& av = dbm.averages();
   const Eigen::VectorXd w_mean = av.w_cell / av.time_s;
   const Eigen::VectorXd u_mean = av.u_cell / av.time_s;
@@ -372,7 +373,7 @@ struct DbmSummary {
 
 nlohmann::json ResultJson(const DbmSimulation& dbm, const Scene& scene, const DbmOptions& o,
                           const BedResult& out, const DbmSummary& s, const nlohmann::json& series) {
-  const SceneDbm& sd = scene.dbm;
+  const SceneDbm& sd = dbm_section(scene);
   const DbmDiagnostics& dg = dbm.diagnostics();
   const DbmAverages& av = dbm.averages();
   const double holdup_mean = s.profiles.holdup_mean;
@@ -451,7 +452,7 @@ std::string BriefReport(const DbmSimulation& dbm, const Scene& scene, const DbmO
   const DbmDiagnostics& dg = dbm.diagnostics();
   std::ostringstream brief;
   brief << "DBM " << scene.name << " with " << out.law << ": U_mf = " << Num(s.umf_m_s)
-        << " m/s, u0 = " << Num(scene.dbm.superficial_velocity_m_s) << " m/s, bubble gas "
+        << " m/s, u0 = " << Num(dbm_section(scene).superficial_velocity_m_s) << " m/s, bubble gas "
         << Num(o.bubble_gas_flow_m3_s) << " m^3/s as " << Num(o.bubble_diameter_m)
         << " m bubbles from " << o.nozzles.size() << " nozzles; " << o.nx << " x " << o.ny << " x "
         << o.nz << " cells, " << dg.steps << " steps of " << Num(o.dt_s) << " s; wall "
@@ -471,11 +472,14 @@ std::string BriefReport(const DbmSimulation& dbm, const Scene& scene, const DbmO
 class DbmBedModel : public BedModel {
  public:
   std::string key() const override { return "dbm"; }
+  const SceneTable* scene_table() const override { return &dbm_scene_table(); }
+  /// The emulsion fills the column: no particle inventory.
+  bool particle_bed() const override { return false; }
   std::string description() const override {
     return "discrete bubble model: Lagrangian bubbles in a continuous emulsion (dbm.h)";
   }
   BedModelSettings Settings(const Scene& scene) const override {
-    const SceneDbm& d = scene.dbm;
+    const SceneDbm& d = dbm_section(scene);
     BedModelSettings s;
     s.line = "discrete bubbles: u0 = " + Num(d.superficial_velocity_m_s) + " m/s, emulsion " +
              Num(d.emulsion_density_kg_m3) + " kg/m^3 and " + Num(d.emulsion_viscosity_pa_s) +
@@ -524,10 +528,10 @@ class DbmBedModel : public BedModel {
     return {"dt_s", "the fixed DBM step (bounded by DbmOptions::StableTimeStep)",
             "(0, the stability limit]", /*whole_number=*/false, /*larger_is_finer=*/false};
   }
-  double time_resolution_of(const Scene& scene) const override { return scene.dbm.dt_s; }
+  double time_resolution_of(const Scene& scene) const override { return dbm_section(scene).dt_s; }
   Scene WithTimeResolution(const Scene& scene, double value) const override {
     Scene s = scene;
-    s.dbm.dt_s = value;
+    dbm_section(s).dt_s = value;
     return s;
   }
 
@@ -537,7 +541,7 @@ class DbmBedModel : public BedModel {
     scene.Validate();
     if (!law) Bad("dbm: law is null");
     CheckRealization(scene, start);
-    const SceneDbm& sd = scene.dbm;
+    const SceneDbm& sd = dbm_section(scene);
     MinFluidizationOptions mo;
     mo.eps_mf = scene.eps_mf;
     const MinFluidizationResult umf =

@@ -17,8 +17,8 @@
 #include "draglab/core/text.h"
 #include "draglab/drag_db/error.h"
 #include "io/dpm_output.h"
-#include "scene/scene_ktgf.h"
 #include "tfm/tfm.h"
+#include "tfm/tfm_scene.h"
 
 namespace draglab {
 namespace consumers {
@@ -34,22 +34,22 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   o.particle_density_kg_m3 = s.particles.density_kg_m3;
   o.ktgf = internal::scene_ktgf_options(s);
   o.initial_solids = 1.0 - s.eps_mf;
+  const SceneTfm& t = tfm_section(s);
   o.initial_bed_height_m = s.bed_height_mf_m();
-  o.initial_theta_m2_s2 = s.tfm.theta_initial_m2_s2;
-  o.residual_solids = s.tfm.residual_solids;
-  o.cfl = s.tfm.cfl;
-  o.dt_max_s = s.tfm.dt_max_s;
+  o.initial_theta_m2_s2 = t.theta_initial_m2_s2;
+  o.residual_solids = t.residual_solids;
+  o.cfl = t.cfl;
+  o.dt_max_s = t.dt_max_s;
   o.fixed_dt_s = s.time.gas_dt_s;
-  o.solids_walls = s.tfm.solids_walls == "no_slip" ? WallSlip::kNoSlip : WallSlip::kFreeSlip;
+  o.solids_walls = t.solids_walls == "no_slip" ? WallSlip::kNoSlip : WallSlip::kFreeSlip;
   o.fraction_scheme =
-      s.tfm.fraction_scheme == "van_leer" ? FractionScheme::kVanLeer : FractionScheme::kUpwind;
-  o.solids_viscosity = s.tfm.solids_viscosity == "point_implicit" ? SolidsViscosity::kPointImplicit
-                                                                  : SolidsViscosity::kExplicit;
+      t.fraction_scheme == "van_leer" ? FractionScheme::kVanLeer : FractionScheme::kUpwind;
+  o.solids_viscosity = t.solids_viscosity == "point_implicit" ? SolidsViscosity::kPointImplicit
+                                                              : SolidsViscosity::kExplicit;
   o.solids_pressure =
-      s.tfm.solids_pressure == "implicit" ? SolidsPressure::kImplicit : SolidsPressure::kExplicit;
-  o.granular_temperature = s.tfm.granular_temperature == "algebraic"
-                               ? GranularTemperature::kAlgebraic
-                               : GranularTemperature::kTransport;
+      t.solids_pressure == "implicit" ? SolidsPressure::kImplicit : SolidsPressure::kExplicit;
+  o.granular_temperature = t.granular_temperature == "algebraic" ? GranularTemperature::kAlgebraic
+                                                                 : GranularTemperature::kTransport;
   return o;
 }
 
@@ -266,19 +266,21 @@ std::string BriefReport(const TfmSimulation& tfm, const Scene& scene, const BedR
 class TfmBedModel : public BedModel {
  public:
   std::string key() const override { return "tfm"; }
+  const SceneTable* scene_table() const override { return &tfm_scene_table(); }
   std::string description() const override {
     return "two-fluid model with the kinetic theory of granular flow (tfm.h)";
   }
   BedModelSettings Settings(const Scene& scene) const override {
     const KtgfOptions k = internal::scene_ktgf_options(scene);
+    const SceneTfm& t = tfm_section(scene);
     BedModelSettings s;
-    s.line = "two-fluid: " + scene.tfm.closures + " closures, g0 " + scene.tfm.radial_distribution +
+    s.line = "two-fluid: " + t.closures + " closures, g0 " + t.radial_distribution +
              ", e = " + Num(k.restitution) + ", packing limit " + Num(k.packing_limit) +
-             ", friction " + scene.tfm.friction + "; solids pressure " + scene.tfm.solids_pressure +
-             ", viscosity " + scene.tfm.solids_viscosity + "; adaptive step (CFL " +
-             Num(scene.tfm.cfl) + ", at most " + Num(scene.tfm.dt_max_s) + " s)";
-    s.numbers = {{"cfl", scene.tfm.cfl},
-                 {"dt_max_s", scene.tfm.dt_max_s},
+             ", friction " + t.friction + "; solids pressure " + t.solids_pressure +
+             ", viscosity " + t.solids_viscosity + "; adaptive step (CFL " + Num(t.cfl) +
+             ", at most " + Num(t.dt_max_s) + " s)";
+    s.numbers = {{"cfl", t.cfl},
+                 {"dt_max_s", t.dt_max_s},
                  {"packing_limit", k.packing_limit},
                  {"restitution", k.restitution}};
     return s;
@@ -290,10 +292,10 @@ class TfmBedModel : public BedModel {
             "the granular pressure wave)",
             "(0, 0.5]", /*whole_number=*/false, /*larger_is_finer=*/false};
   }
-  double time_resolution_of(const Scene& scene) const override { return scene.tfm.cfl; }
+  double time_resolution_of(const Scene& scene) const override { return tfm_section(scene).cfl; }
   Scene WithTimeResolution(const Scene& scene, double value) const override {
     Scene s = scene;
-    s.tfm.cfl = value;
+    tfm_section(s).cfl = value;
     return s;
   }
 

@@ -20,9 +20,7 @@
 #include "draglab/consumers/bed_model.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/drag_db/error.h"
-#include "scene/scene_ktgf.h"
 #include "scene/scene_util.h"
-#include "tfm/ktgf.h"
 
 namespace draglab {
 namespace consumers {
@@ -36,14 +34,7 @@ using scene_util::kPi;
   throw Error(ErrorCode::kInvalidArgument, message);
 }
 
-/// lo < x <= hi (open_lo) or lo <= x <= hi, finite; else a message naming field and range.
-bool in_range(double x, double lo, double hi, bool open_lo, bool open_hi, const std::string& field,
-              const std::string& unit, std::string* error) {
-  const bool ok = std::isfinite(x) && (open_lo ? x > lo : x >= lo) && (open_hi ? x < hi : x <= hi);
-  if (ok) return true;
-  return fail(error, field + " = " + fmt(x) + " is outside " + (open_lo ? "(" : "[") + fmt(lo) +
-                         ", " + fmt(hi) + (open_hi ? ")" : "]") + (unit.empty() ? "" : " " + unit));
-}
+using scene_util::in_range;
 
 /// One key of a section and how to store it into the Scene.
 struct Key {
@@ -226,97 +217,6 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                 num("settle_s", [](S& s) -> double& { return s.time.settle_s; }),
                 num("dem_dt_s", [](S& s) -> double& { return s.time.dem_dt_s; }),
                 {"contact_steps", read_contact_steps}}},
-              {"tfm",
-               {{"closures", [](S& s, const toml::node& n, const std::string& f,
-                                const std::string& at) { s.tfm.closures = as_text(n, f, at); }},
-                {"radial_distribution",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.tfm.radial_distribution = as_text(n, f, at);
-                 }},
-                num_or_default("restitution", [](S& s) -> double& { return s.tfm.restitution; }),
-                num("packing_limit", [](S& s) -> double& { return s.tfm.packing_limit; }),
-                {"friction", [](S& s, const toml::node& n, const std::string& f,
-                                const std::string& at) { s.tfm.friction = as_text(n, f, at); }},
-                num("friction_min_solids",
-                    [](S& s) -> double& { return s.tfm.friction_min_solids; }),
-                num("friction_angle_deg", [](S& s) -> double& { return s.tfm.friction_angle_deg; }),
-                num("friction_delta", [](S& s) -> double& { return s.tfm.friction_delta; }),
-                num("friction_max_viscosity_pa_s",
-                    [](S& s) -> double& { return s.tfm.friction_max_viscosity_pa_s; }),
-                num("theta_initial_m2_s2",
-                    [](S& s) -> double& { return s.tfm.theta_initial_m2_s2; }),
-                num("residual_solids", [](S& s) -> double& { return s.tfm.residual_solids; }),
-                num("cfl", [](S& s) -> double& { return s.tfm.cfl; }),
-                num("dt_max_s", [](S& s) -> double& { return s.tfm.dt_max_s; }),
-                {"solids_walls",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.tfm.solids_walls = as_text(n, f, at);
-                 }},
-                {"fraction_scheme",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.tfm.fraction_scheme = as_text(n, f, at);
-                 }},
-                {"solids_viscosity",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.tfm.solids_viscosity = as_text(n, f, at);
-                 }},
-                {"solids_pressure",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.tfm.solids_pressure = as_text(n, f, at);
-                 }},
-                {"granular_temperature",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.tfm.granular_temperature = as_text(n, f, at);
-                 }}}},
-              {"dbm",
-               {num("superficial_velocity_m_s",
-                    [](S& s) -> double& { return s.dbm.superficial_velocity_m_s; }),
-                num("emulsion_density_kg_m3",
-                    [](S& s) -> double& { return s.dbm.emulsion_density_kg_m3; }),
-                num("emulsion_viscosity_pa_s",
-                    [](S& s) -> double& { return s.dbm.emulsion_viscosity_pa_s; }),
-                num("bubble_density_kg_m3",
-                    [](S& s) -> double& { return s.dbm.bubble_density_kg_m3; }),
-                num("bubble_diameter_m", [](S& s) -> double& { return s.dbm.bubble_diameter_m; }),
-                {"nozzles_per_side",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   const std::int64_t v = as_integer(n, f, at);
-                   if (v < 1 || v > 100)
-                     bad(at + ": " + f + " = " + std::to_string(v) + " is outside [1, 100]");
-                   s.dbm.nozzles_per_side = static_cast<int>(v);
-                 }},
-                num("nozzle_pitch_m", [](S& s) -> double& { return s.dbm.nozzle_pitch_m; }),
-                num("virtual_mass_coefficient",
-                    [](S& s) -> double& { return s.dbm.virtual_mass_coefficient; }),
-                {"lift", [](S& s, const toml::node& n, const std::string& f,
-                            const std::string& at) { s.dbm.lift = as_bool(n, f, at); }},
-                num("lift_coefficient", [](S& s) -> double& { return s.dbm.lift_coefficient; }),
-                num("coupling_width_m", [](S& s) -> double& { return s.dbm.coupling_width_m; }),
-                {"coalescence",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.dbm.coalescence = as_bool(n, f, at);
-                 }},
-                num("film_drainage_s", [](S& s) -> double& { return s.dbm.film_drainage_s; }),
-                {"collisions",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.dbm.collisions = as_bool(n, f, at);
-                 }},
-                num("dt_s", [](S& s) -> double& { return s.dbm.dt_s; }),
-                num("injection_ramp_s", [](S& s) -> double& { return s.dbm.injection_ramp_s; }),
-                num("cfl", [](S& s) -> double& { return s.dbm.cfl; }),
-                {"walls", [](S& s, const toml::node& n, const std::string& f,
-                             const std::string& at) { s.dbm.walls = as_text(n, f, at); }},
-                num("average_from_s", [](S& s) -> double& { return s.dbm.average_from_s; }),
-                num("sample_interval_s", [](S& s) -> double& { return s.dbm.sample_interval_s; }),
-                {"size_heights_m",
-                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
-                   s.dbm.size_heights_m.clear();
-                   const toml::array* a = n.as_array();
-                   if (!a) bad(at + ": " + f + " must be an array of heights in m");
-                   for (std::size_t i = 0; i < a->size(); ++i)
-                     s.dbm.size_heights_m.push_back(
-                         as_number(*a->get(i), f + "[" + std::to_string(i) + "]", at));
-                 }}}},
               {"drag",
                {{"laws",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
@@ -338,187 +238,92 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
   return table;
 }
 
+/// The sections of a scene file: the shared ones, then each registered model's own table
+/// (BedModel::scene_table) before [drag].
+std::vector<std::pair<std::string, std::vector<Key>>> all_sections() {
+  std::vector<std::pair<std::string, std::vector<Key>>> out = sections();
+  std::vector<std::pair<std::string, std::vector<Key>>> tables;
+  for (const std::string& model : bed_model_keys()) {
+    const SceneTable* table = find_bed_model(model).scene_table();
+    if (table == nullptr) continue;
+    std::vector<Key> keys;
+    for (const auto& [name, read] : table->keys) {
+      keys.push_back({name, [table, read = read](Scene& s, const toml::node& n,
+                                                 const std::string& f, const std::string& at) {
+                        read(s.sections.Get(table->name, table->make), SceneValue(&n, f, at));
+                      }});
+    }
+    tables.push_back({table->name, std::move(keys)});
+  }
+  const auto drag =
+      std::find_if(out.begin(), out.end(), [](const auto& s) { return s.first == "drag"; });
+  out.insert(drag, tables.begin(), tables.end());
+  return out;
+}
+
+/// The model tables' checks, for every scene.
+bool model_tables_are_valid(const Scene& s, std::string* error) {
+  for (const std::string& model : bed_model_keys()) {
+    const SceneTable* table = find_bed_model(model).scene_table();
+    if (table != nullptr && table->is_valid && !table->is_valid(s, error)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
-namespace internal {
-KtgfOptions scene_ktgf_options(const Scene& s) {
-  KtgfOptions k;
-  parse_closure_set(s.tfm.closures, &k.closures);
-  parse_radial_distribution(s.tfm.radial_distribution, &k.radial);
-  parse_friction_model(s.tfm.friction, &k.friction);
-  k.restitution = s.tfm.restitution == -1.0 ? s.particles.restitution : s.tfm.restitution;
-  k.packing_limit = s.tfm.packing_limit;
-  k.friction_min_solids = s.tfm.friction_min_solids;
-  k.friction_angle_deg = s.tfm.friction_angle_deg;
-  k.friction_delta = s.tfm.friction_delta;
-  k.friction_max_viscosity_pa_s = s.tfm.friction_max_viscosity_pa_s;
-  return k;
+SceneSections::SceneSections(const SceneSections& other) {
+  for (const auto& [name, section] : other.sections_) sections_[name] = section->Clone();
 }
-}  // namespace internal
+
+SceneSections& SceneSections::operator=(const SceneSections& other) {
+  if (this != &other) {
+    SceneSections copy(other);
+    sections_.swap(copy.sections_);
+  }
+  return *this;
+}
+
+SceneSection& SceneSections::Get(const std::string& table,
+                                 const std::function<std::unique_ptr<SceneSection>()>& make) {
+  std::unique_ptr<SceneSection>& s = sections_[table];
+  if (!s) s = make();
+  return *s;
+}
+
+const SceneSection* SceneSections::Find(const std::string& table) const {
+  const auto it = sections_.find(table);
+  return it == sections_.end() ? nullptr : it->second.get();
+}
 
 namespace {
-
-/// The [dbm] table: required by solver = "dbm", refused by the others; the DBM in turn refuses the
-/// tables of the jet-driven models and a particle inventory (its emulsion fills the column).
-bool dbm_is_valid(const Scene& s, std::string* error) {
-  const bool dbm = s.solver == "dbm";
-  if (!dbm) {
-    if (s.dbm.present)
-      return fail(error, "[dbm] is read only with solver = \"dbm\" (this scene's solver is \"" +
-                             s.solver + "\"): remove the table or change the solver");
-    if (s.grid.cells_z != 1)
-      return fail(error, "[grid] cells_z = " + std::to_string(s.grid.cells_z) +
-                             ": the pseudo-2D models have one cell across the depth (cells_z = 1); "
-                             "only the DBM's emulsion grid is 3-D");
-    return true;
-  }
-  if (!s.dbm.present)
-    return fail(error,
-                "[dbm] table is missing: solver = \"dbm\" needs it (superficial_velocity_m_s, "
-                "emulsion and bubble properties, nozzles; docs/scenes.md)");
-  for (const char* table : {"jet", "distributor", "bubble", "dem", "tfm"}) {
-    if (std::find(s.tables.begin(), s.tables.end(), table) != s.tables.end())
-      return fail(error, std::string("[") + table +
-                             "] is not read by solver = \"dbm\" (its bubbles come from the [dbm] "
-                             "nozzles): remove the table");
-  }
-  if (s.particles.count != 0 || s.particles.bed_height_mf_m != 0.0)
-    return fail(error,
-                "[particles] count / bed_height_mf_m: the DBM's emulsion fills the column (its "
-                "surface is [geometry] height_m); remove them");
-  const SceneDbm& d = s.dbm;
-  const double column = std::min(s.geometry.width_m, s.geometry.depth_m);
-  if (!in_range(d.superficial_velocity_m_s, 0.0, 10.0, true, false,
-                "[dbm] superficial_velocity_m_s", "m/s", error) ||
-      !in_range(d.bubble_density_kg_m3, 0.0, 20000.0, true, false, "[dbm] bubble_density_kg_m3",
-                "kg/m^3", error) ||
-      !in_range(d.emulsion_density_kg_m3, d.bubble_density_kg_m3, 20000.0, true, false,
-                "[dbm] emulsion_density_kg_m3", "kg/m^3 (above bubble_density_kg_m3)", error) ||
-      !in_range(d.emulsion_viscosity_pa_s, 0.0, 1000.0, true, false,
-                "[dbm] emulsion_viscosity_pa_s", "Pa s", error) ||
-      !in_range(d.bubble_diameter_m, 0.0, column, false, true, "[dbm] bubble_diameter_m",
-                "m (0: Davidson-Harrison; below the column's width and depth)", error) ||
-      !in_range(d.nozzle_pitch_m, 0.0, column, true, false, "[dbm] nozzle_pitch_m", "m", error) ||
-      !in_range(d.virtual_mass_coefficient, 0.0, 10.0, false, false,
-                "[dbm] virtual_mass_coefficient", "", error) ||
-      !in_range(d.lift_coefficient, -1.0, 1.0, false, false, "[dbm] lift_coefficient", "", error) ||
-      !in_range(d.film_drainage_s, 0.0, 10.0, false, false, "[dbm] film_drainage_s", "s", error) ||
-      !in_range(d.coupling_width_m, 0.0, column, false, false, "[dbm] coupling_width_m",
-                "m (0: 5 bubble diameters; at most the column's width and depth)", error) ||
-      !in_range(d.dt_s, 0.0, 1.0, true, false, "[dbm] dt_s", "s (and the stability limit)",
-                error) ||
-      !in_range(s.time.duration_s, 0.0, 1e5, true, false, "[time] duration_s", "s", error) ||
-      !in_range(d.cfl, 0.0, 0.9, false, false, "[dbm] cfl", "(0: the fixed step dt_s)", error) ||
-      !in_range(d.injection_ramp_s, 0.0, s.time.duration_s, false, true, "[dbm] injection_ramp_s",
-                "s [0, duration_s)", error) ||
-      !in_range(d.average_from_s, 0.0, s.time.duration_s, false, true, "[dbm] average_from_s",
-                "s [0, duration_s)", error) ||
-      !in_range(d.sample_interval_s, 0.0, s.time.duration_s, true, false, "[dbm] sample_interval_s",
-                "s (0, duration_s]", error)) {
-    return false;
-  }
-  if (d.walls != "no_slip" && d.walls != "free_slip")
-    return fail(error, "[dbm] walls = '" + d.walls + "' is not one of no_slip, free_slip");
-  const double span = (d.nozzles_per_side - 1) * d.nozzle_pitch_m;
-  if (span + std::max(d.bubble_diameter_m, 0.0) >= column)
-    return fail(error, "[dbm] nozzles_per_side = " + std::to_string(d.nozzles_per_side) +
-                           " at nozzle_pitch_m = " + fmt(d.nozzle_pitch_m) + " span " + fmt(span) +
-                           " m: with the bubbles they do not fit the " + fmt(column) + " m bottom");
-  if (d.bubble_diameter_m > 0.0 && d.nozzles_per_side > 1 && d.nozzle_pitch_m < d.bubble_diameter_m)
-    return fail(error, "[dbm] nozzle_pitch_m = " + fmt(d.nozzle_pitch_m) +
-                           " m is below bubble_diameter_m = " + fmt(d.bubble_diameter_m) +
-                           " m: the bubbles of neighbouring nozzles would overlap");
-  if (d.size_heights_m.empty())
-    return fail(error, "[dbm] size_heights_m is empty (give the heights of the size report)");
-  for (double h : d.size_heights_m) {
-    if (!in_range(h, 0.0, s.geometry.height_m, true, true, "[dbm] size_heights_m",
-                  "m (inside the bed)", error))
-      return false;
-  }
-  if (s.time.duration_s / d.dt_s > 1e9)
-    return fail(error, "[dbm] dt_s = " + fmt(d.dt_s) + " s would take more than 1e9 steps");
-  if (s.grid.cells_x < 2 || s.grid.cells_y < 2)
-    return fail(error, "[grid] cells_x and cells_y must be >= 2 for the DBM's emulsion");
-  // The emulsion is a continuum of particles: its cells are at least one particle wide along
-  // the depth too (x and y are checked with every model).
-  const double dz = s.geometry.depth_m / s.grid.cells_z;
-  if (dz < s.particles.diameter_m)
-    return fail(error, "[grid] cells_z = " + std::to_string(s.grid.cells_z) + " makes cells " +
-                           fmt(dz) + " m deep, less than one particle ([particles] diameter_m = " +
-                           fmt(s.particles.diameter_m) + " m): at most " +
-                           std::to_string(static_cast<long long>(s.geometry.depth_m /
-                                                                 s.particles.diameter_m)) +
-                           " cells_z");
-  return true;
-}
-
-/// The [tfm] table: required by solver = "tfm", refused by the others; ranges via ktgf.h.
-bool tfm_is_valid(const Scene& s, std::string* error) {
-  const bool tfm = s.solver == "tfm";
-  if (tfm && !s.tfm.present) {
-    return fail(error,
-                "[tfm] table is missing: solver = \"tfm\" needs it (closures, packing_limit, "
-                "friction, ...; docs/scenes.md)");
-  }
-  if (!tfm) {
-    if (s.tfm.present) {
-      return fail(error, "[tfm] is read only with solver = \"tfm\" (this scene's solver is \"" +
-                             s.solver + "\"): remove the table or change the solver");
-    }
-    return true;
-  }
-  KtgfOptions k;
-  if (!parse_closure_set(s.tfm.closures, &k.closures)) {
-    return fail(error,
-                "[tfm] closures = '" + s.tfm.closures + "' is not one of nieuwland, gidaspow");
-  }
-  if (!parse_radial_distribution(s.tfm.radial_distribution, &k.radial)) {
-    return fail(error, "[tfm] radial_distribution = '" + s.tfm.radial_distribution +
-                           "' is not one of ma_ahmadi, carnahan_starling, sinclair_jackson, "
-                           "lun_savage");
-  }
-  if (!parse_friction_model(s.tfm.friction, &k.friction)) {
-    return fail(error, "[tfm] friction = '" + s.tfm.friction +
-                           "' is not one of none, johnson_jackson_schaeffer, "
-                           "johnson_jackson_openfoam");
-  }
-  // A key whose value names one of two choices.
-  auto either = [error](const std::string& value, const char* field, const char* a, const char* b) {
-    if (value == a || value == b) return true;
-    return fail(error,
-                std::string("[tfm] ") + field + " = '" + value + "' is not one of " + a + ", " + b);
-  };
-  if (!either(s.tfm.solids_walls, "solids_walls", "free_slip", "no_slip") ||
-      !either(s.tfm.fraction_scheme, "fraction_scheme", "upwind", "van_leer") ||
-      !either(s.tfm.solids_viscosity, "solids_viscosity", "explicit", "point_implicit") ||
-      !either(s.tfm.solids_pressure, "solids_pressure", "explicit", "implicit") ||
-      !either(s.tfm.granular_temperature, "granular_temperature", "transport", "algebraic")) {
-    return false;
-  }
-  if (s.tfm.restitution != -1.0 &&
-      !in_range(s.tfm.restitution, 0.0, 1.0, true, false, "[tfm] restitution", "", error)) {
-    return false;
-  }
-  k = internal::scene_ktgf_options(s);
-  if (!(s.tfm.packing_limit > 1.0 - s.eps_mf)) {
-    return fail(error, "[tfm] packing_limit = " + fmt(s.tfm.packing_limit) +
-                           " must exceed the bed's solids fraction at minimum fluidization 1 - "
-                           "[drag] eps_mf = " +
-                           fmt(1.0 - s.eps_mf));
-  }
-  if (!k.IsValid(error)) return false;
-  if (!in_range(s.tfm.theta_initial_m2_s2, 0.0, 100.0, false, false, "[tfm] theta_initial_m2_s2",
-                "m^2/s^2 (a granular temperature is >= 0)", error) ||
-      !in_range(s.tfm.residual_solids, 0.0, 1e-2, true, false, "[tfm] residual_solids", "",
-                error) ||
-      !in_range(s.tfm.cfl, 0.0, 0.5, true, false, "[tfm] cfl", "", error) ||
-      !in_range(s.tfm.dt_max_s, 0.0, 0.1, true, false, "[tfm] dt_max_s", "s", error)) {
-    return false;
-  }
-  return true;
-}
-
+const toml::node& node_of(const void* node) { return *static_cast<const toml::node*>(node); }
 }  // namespace
+
+double SceneValue::number() const { return as_number(node_of(node_), field_, at_); }
+
+double SceneValue::number_or_default() const {
+  const double v = number();
+  if (!(v >= 0.0)) {
+    bad(at_ + ": " + field_ + " = " + core::format_number(v) + " must be >= 0 (leave " + field_ +
+        " out for its default)");
+  }
+  return v;
+}
+
+std::int64_t SceneValue::integer() const { return as_integer(node_of(node_), field_, at_); }
+std::string SceneValue::text() const { return as_text(node_of(node_), field_, at_); }
+bool SceneValue::boolean() const { return as_bool(node_of(node_), field_, at_); }
+
+std::vector<double> SceneValue::numbers(const std::string& what) const {
+  const toml::array* a = node_of(node_).as_array();
+  if (!a) bad(at_ + ": " + field_ + " must be an array of " + what);
+  std::vector<double> out;
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    out.push_back(as_number(*a->get(i), field_ + "[" + std::to_string(i) + "]", at_));
+  }
+  return out;
+}
 
 const char* to_string(BackgroundMode mode) {
   switch (mode) {
@@ -535,21 +340,23 @@ const char* to_string(BackgroundMode mode) {
 Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   namespace ts = core::toml_schema;
   const toml::table root = ts::parse(toml_text, origin);
-  static const ts::Schema names = [] {
-    ts::Schema out;
-    for (const auto& [section, keys] : sections()) {
-      out.push_back({section, {}});
-      for (const Key& k : keys) out.back().second.push_back(k.name);
-    }
-    return out;
-  }();
+  // Built per file: a model registered at run time brings its table.
+  const std::vector<std::pair<std::string, std::vector<Key>>> tables = all_sections();
+  ts::Schema names;
+  for (const auto& [section, keys] : tables) {
+    names.push_back({section, {}});
+    for (const Key& k : keys) names.back().second.push_back(k.name);
+  }
   Scene s;
   s.origin = origin;
   s.source_text = toml_text;
   const auto on_section = [&](const std::string& section, const toml::table& table,
                               const std::string& at) {
-    if (section == "tfm") s.tfm.present = true;
-    if (section == "dbm") s.dbm.present = true;
+    for (const std::string& model : bed_model_keys()) {
+      const SceneTable* own = find_bed_model(model).scene_table();
+      if (own != nullptr && own->name == section)
+        s.sections.Get(own->name, own->make).present = true;
+    }
     s.tables.push_back(section);
     if (section == "dem") {
       s.dem_table = true;
@@ -563,7 +370,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
     }
   };
   ts::visit(root, origin, names, on_section, [&](const ts::Entry& e) {
-    for (const auto& [section, keys] : sections()) {
+    for (const auto& [section, keys] : tables) {
       if (section != e.section) continue;
       for (const Key& k : keys) {
         if (k.name == e.key) k.read(s, e.node, e.field, e.at);
@@ -648,8 +455,8 @@ bool Scene::IsValid(std::string* error) const {
                 error)) {
     return false;
   }
-  if (!dbm_is_valid(*this, error)) return false;
-  if (solver != "dbm") {
+  if (!model_tables_are_valid(*this, error)) return false;
+  if (find_bed_model(solver).particle_bed()) {
     const bool has_count = particles.count > 0;
     const bool has_height = particles.bed_height_mf_m != 0.0;
     if (has_count == has_height) {
@@ -786,10 +593,13 @@ bool Scene::IsValid(std::string* error) const {
             " cells_x and height/d = " + std::to_string(static_cast<int>(geometry.height_m / d)) +
             " cells_y");
   }
-  if ((solver != "dbm" && !in_range(bubble.eps_threshold, eps_mf, 1.0, true, true,
-                                    "[bubble] eps_threshold", "(eps_mf, 1)", error)) ||
-      (solver != "dbm" && !in_range(bubble.sample_interval_s, 0.0, time.duration_s, true, false,
-                                    "[bubble] sample_interval_s", "s (0, duration_s]", error)) ||
+  // The bubble criterion is a void fraction of a particle bed (a model whose bed fills the
+  // column, the DBM, tracks its bubbles itself).
+  const bool bubble_criterion = find_bed_model(solver).particle_bed();
+  if ((bubble_criterion && !in_range(bubble.eps_threshold, eps_mf, 1.0, true, true,
+                                     "[bubble] eps_threshold", "(eps_mf, 1)", error)) ||
+      (bubble_criterion && !in_range(bubble.sample_interval_s, 0.0, time.duration_s, true, false,
+                                     "[bubble] sample_interval_s", "s (0, duration_s]", error)) ||
       !in_range(outputs.interval_s, 0.0, time.duration_s, false, false, "[outputs] interval_s",
                 "s [0, duration_s]", error)) {
     return false;
@@ -805,7 +615,6 @@ bool Scene::IsValid(std::string* error) const {
       return fail(error, "[drag] laws lists '" + laws[i] + "' twice");
     }
   }
-  if (!tfm_is_valid(*this, error)) return false;
   if (dem_table && solver != "dpm") {
     return fail(error, "[dem] is read only with solver = \"dpm\" (this scene's solver is \"" +
                            solver + "\"): remove the table or change the solver");
@@ -836,7 +645,11 @@ std::int64_t Scene::particle_count() const {
 }
 
 double Scene::bed_height_mf_m() const {
-  if (solver == "dbm") return geometry.height_m;
+  // A model whose bed fills the column (a solver the scene refuses counts as a particle bed).
+  const std::vector<std::string> models = bed_model_keys();
+  if (std::find(models.begin(), models.end(), solver) != models.end() &&
+      !find_bed_model(solver).particle_bed())
+    return geometry.height_m;
   if (particles.count <= 0) return particles.bed_height_mf_m;
   return static_cast<double>(particles.count) * particle_volume_m3() /
          ((1.0 - eps_mf) * geometry.width_m * geometry.depth_m);

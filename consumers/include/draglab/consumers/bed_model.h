@@ -108,6 +108,19 @@ struct BedModelSettings {
   std::vector<std::pair<std::string, double>> numbers;
 };
 
+/// A model's own table of scene files ([tfm], [dbm]): its keys, each read into the model's
+/// SceneSection, and its checks of a scene. Scene files accept the tables of every registered
+/// model; the checks run for every scene (a model refuses its table in another model's scene).
+struct SceneTable {
+  std::string name;  ///< The table's name, e.g. "tfm".
+  /// A section holding the defaults.
+  std::function<std::unique_ptr<SceneSection>()> make;
+  /// The keys, in documentation order, and how each is read into the section.
+  std::vector<std::pair<std::string, std::function<void(SceneSection&, const SceneValue&)>>> keys;
+  /// On failure *error names the field and the allowed range.
+  std::function<bool(const Scene&, std::string*)> is_valid;
+};
+
 /// A bed model. Run throws draglab::Error as the model documents (invalid scene: kInvalidArgument;
 /// a bed outside the law's validity box: kOutOfValidity; instability: with a diagnosis).
 class BedModel {
@@ -118,6 +131,12 @@ class BedModel {
   /// The scene's settings that only this model reads (DPM: the contact time and DEM step; TFM:
   /// closures and step control), for `scene check`.
   virtual BedModelSettings Settings(const Scene& scene) const = 0;
+  /// The model's own scene table; null: it has none (it reads only the shared tables).
+  virtual const SceneTable* scene_table() const { return nullptr; }
+  /// Whether the bed is a particle inventory ([particles] count or bed_height_mf_m, checked
+  /// and turned into a bed height by the scene); false: the model's bed fills the column (the
+  /// DBM's emulsion).
+  virtual bool particle_bed() const { return true; }
 
   /// What a realization is ("packing"); empty: the model is deterministic and has none.
   virtual std::string realization_kind() const { return ""; }

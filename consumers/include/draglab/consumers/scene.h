@@ -20,8 +20,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "draglab/drag_db/law.h"
@@ -121,57 +124,55 @@ struct SceneOutputs {
   double interval_s = 0.0;  ///< Output spacing; 0: only the snapshot at t_ref.
 };
 
-/// [tfm]: closures and numerics of the two-fluid model (read only with solver = "tfm", which
-/// requires the table; tfm.h, ktgf.h, docs/tfm.md). Names as ktgf.h's to_string.
-struct SceneTfm {
-  bool present = false;                ///< The file has a [tfm] table.
-  std::string closures = "nieuwland";  ///< "nieuwland" or "gidaspow".
-  std::string radial_distribution = "ma_ahmadi";
-  double restitution = -1.0;    ///< Particle-particle e, (0, 1]; -1: [particles] restitution.
-  double packing_limit = 0.64;  ///< phi_max, (1 - eps_mf, 0.74].
-  std::string friction = "johnson_jackson_schaeffer";  ///< Or "johnson_jackson_openfoam", "none".
-  double friction_min_solids = 0.5;           ///< Johnson-Jackson phi_min, (0, packing_limit).
-  double friction_angle_deg = 28.5;           ///< (0, 90).
-  double friction_delta = 0.02;               ///< Johnson-Jackson delta (the gap clip), (0, 0.1].
-  double friction_max_viscosity_pa_s = 10.0;  ///< Cap of the Schaeffer viscosity, (0, 1e4].
-  double theta_initial_m2_s2 = 1e-4;          ///< Initial granular temperature of the bed, >= 0.
-  double residual_solids = 1e-4;              ///< (0, 1e-2].
-  double cfl = 0.3;                           ///< (0, 0.5].
-  double dt_max_s = 5e-4;                     ///< (0, 0.1].
-  std::string solids_walls = "free_slip";     ///< Or "no_slip": the solids' wall condition.
-  std::string fraction_scheme = "upwind";     ///< Or "van_leer": face solids fractions.
-  std::string solids_viscosity = "explicit";  ///< Or "point_implicit" (tfm.h).
-  std::string solids_pressure = "explicit";   ///< Or "implicit" (tfm.h).
-  std::string granular_temperature = "transport";  ///< Or "algebraic" (local equilibrium).
+/// A bed model's own table of a scene file ([tfm], [dbm]): the model defines its fields in its
+/// folder and reads and checks them through BedModel::scene_table (bed_model.h).
+class SceneSection {
+ public:
+  virtual ~SceneSection() = default;
+  virtual std::unique_ptr<SceneSection> Clone() const = 0;
+  bool present = false;  ///< The file has the table.
 };
 
-/// [dbm]: the discrete bubble model (read only with solver = "dbm", which requires the table;
-/// dbm.h, docs/dbm.md). The emulsion fills the column; its top is the bed surface.
-struct SceneDbm {
-  bool present = false;
-  double superficial_velocity_m_s = 0.1;  ///< u0, (0, 10]; bubbles carry (u0 - U_mf) A.
-  double emulsion_density_kg_m3 = 400.0;  ///< (bubble density, 20000].
-  double emulsion_viscosity_pa_s = 1.0;   ///< Apparent viscosity, (0, 1000].
-  double bubble_density_kg_m3 = 25.0;     ///< (0, emulsion density).
-  /// Injected size [m], (0, column); 0: Davidson-Harrison from each nozzle's flow.
-  double bubble_diameter_m = 0.04;
-  int nozzles_per_side = 7;     ///< A square of n x n nozzles centred on the bottom, [1, 100].
-  double nozzle_pitch_m = 0.1;  ///< Their spacing, > 0; the square must fit the bottom.
-  double virtual_mass_coefficient = 0.5;  ///< [0, 10].
-  bool lift = false;
-  double lift_coefficient = 0.5;  ///< [-1, 1], with lift = true.
-  /// Width of the kernel mapping bubbles to cells [m], [0, column]; 0: 5 injected diameters.
-  double coupling_width_m = 0.0;
-  bool coalescence = false;
-  double film_drainage_s = 0.0;    ///< [0, 10].
-  bool collisions = true;          ///< Without coalescence: overlapping bubbles pushed apart.
-  double dt_s = 2e-3;              ///< Fixed step, (0, the stability limit].
-  double cfl = 0.0;                ///< > 0: the step is cut to this emulsion CFL, (0, 0.9].
-  double injection_ramp_s = 0.0;   ///< Start-up ramp of the bubble flow, [0, duration_s).
-  std::string walls = "no_slip";   ///< Or "free_slip": the emulsion at the side walls.
-  double average_from_s = 10.0;    ///< Time averages from here, [0, duration_s).
-  double sample_interval_s = 0.1;  ///< Bubble samples, (0, duration_s].
-  std::vector<double> size_heights_m = {1.0, 2.0};  ///< Where mean sizes are reported.
+/// The model tables of a scene by table name; copied with the scene (each section cloned).
+class SceneSections {
+ public:
+  SceneSections() = default;
+  SceneSections(const SceneSections& other);
+  SceneSections& operator=(const SceneSections& other);
+  SceneSections(SceneSections&&) = default;
+  SceneSections& operator=(SceneSections&&) = default;
+
+  /// The section of `table`, made with `make` (the model's defaults) when the scene has none.
+  SceneSection& Get(const std::string& table,
+                    const std::function<std::unique_ptr<SceneSection>()>& make);
+  /// The section of `table`, or null.
+  const SceneSection* Find(const std::string& table) const;
+
+ private:
+  std::map<std::string, std::unique_ptr<SceneSection>> sections_;
+};
+
+/// A value of a scene file as a model's key reader gets it: typed reads whose errors name the
+/// key and where it stands.
+class SceneValue {
+ public:
+  /// `node` is the TOML node (toml++'s toml::node) of `field` at `at` (file:line).
+  SceneValue(const void* node, std::string field, std::string at)
+      : node_(node), field_(std::move(field)), at_(std::move(at)) {}
+  double number() const;
+  /// A number that must be >= 0 (its absence selects a default, held as -1).
+  double number_or_default() const;
+  std::int64_t integer() const;
+  std::string text() const;
+  bool boolean() const;
+  /// An array of numbers ("<what> in m" names its elements in the message).
+  std::vector<double> numbers(const std::string& what) const;
+  const std::string& field() const { return field_; }
+  const std::string& at() const { return at_; }
+
+ private:
+  const void* node_;
+  std::string field_, at_;
 };
 
 /// A scene file, parsed. Built by parse_scene / load_scene; IsValid checks every range.
@@ -189,8 +190,8 @@ struct Scene {
   SceneGrid grid;
   SceneBubble bubble;
   SceneOutputs outputs;
-  SceneTfm tfm;
-  SceneDbm dbm;
+  /// The tables of the bed models (BedModel::scene_table), by table name.
+  SceneSections sections;
   /// The tables the file has (the DBM refuses those of the jet-driven models).
   std::vector<std::string> tables;
   /// The file has a [dem] table (the DPM's contact and DEM-step keys there; older files keep
