@@ -161,7 +161,7 @@ class DpmSimulation {
   std::unique_ptr<Impl> impl_;
 };
 
-// The DPM's result in the forms its bed model stores (bed/dpm_bed_model.cc).
+// The DPM's result in the forms its bed model stores (src/dpm/dpm_bed_model.cc).
 /// What a regression compares, from a DPM result: U_mf, background, the bubble at t_ref (its
 /// diameter and centroid height), the highest bed surface over the samples, wall time.
 ConsumerMetrics consumer_metrics_of(const DpmResult& result);
