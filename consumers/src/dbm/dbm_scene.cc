@@ -115,38 +115,22 @@ bool dbm_is_valid(const Scene& s, std::string* error) {
   return true;
 }
 
-using KeyReader = std::pair<std::string, std::function<void(SceneSection&, const SceneValue&)>>;
-
-KeyReader number_key(const std::string& name, double SceneDbm::*member) {
-  return {name, [member](SceneSection& s, const SceneValue& v) { Dbm(s).*member = v.number(); }};
-}
-KeyReader bool_key(const std::string& name, bool SceneDbm::*member) {
-  return {name, [member](SceneSection& s, const SceneValue& v) { Dbm(s).*member = v.boolean(); }};
-}
-
 }  // namespace
 
-const SceneDbm& dbm_section(const Scene& scene) {
-  static const SceneDbm defaults;
-  const SceneSection* s = scene.sections.Find(kTable);
-  return s ? static_cast<const SceneDbm&>(*s) : defaults;
-}
+const SceneDbm& dbm_section(const Scene& scene) { return scene.sections.As<SceneDbm>(kTable); }
 
-SceneDbm& dbm_section(Scene& scene) {
-  return static_cast<SceneDbm&>(
-      scene.sections.Get(kTable, [] { return std::make_unique<SceneDbm>(); }));
-}
+SceneDbm& dbm_section(Scene& scene) { return scene.sections.As<SceneDbm>(kTable); }
 
 const SceneTable& dbm_scene_table() {
   static const SceneTable table = [] {
     SceneTable t;
     t.name = kTable;
     t.make = [] { return std::make_unique<SceneDbm>(); };
-    t.keys = {number_key("superficial_velocity_m_s", &SceneDbm::superficial_velocity_m_s),
-              number_key("emulsion_density_kg_m3", &SceneDbm::emulsion_density_kg_m3),
-              number_key("emulsion_viscosity_pa_s", &SceneDbm::emulsion_viscosity_pa_s),
-              number_key("bubble_density_kg_m3", &SceneDbm::bubble_density_kg_m3),
-              number_key("bubble_diameter_m", &SceneDbm::bubble_diameter_m),
+    t.keys = {scene_key("superficial_velocity_m_s", &SceneDbm::superficial_velocity_m_s),
+              scene_key("emulsion_density_kg_m3", &SceneDbm::emulsion_density_kg_m3),
+              scene_key("emulsion_viscosity_pa_s", &SceneDbm::emulsion_viscosity_pa_s),
+              scene_key("bubble_density_kg_m3", &SceneDbm::bubble_density_kg_m3),
+              scene_key("bubble_diameter_m", &SceneDbm::bubble_diameter_m),
               {"nozzles_per_side",
                [](SceneSection& s, const SceneValue& v) {
                  const std::int64_t n = v.integer();
@@ -157,20 +141,20 @@ const SceneTable& dbm_scene_table() {
                  }
                  Dbm(s).nozzles_per_side = static_cast<int>(n);
                }},
-              number_key("nozzle_pitch_m", &SceneDbm::nozzle_pitch_m),
-              number_key("virtual_mass_coefficient", &SceneDbm::virtual_mass_coefficient),
-              bool_key("lift", &SceneDbm::lift),
-              number_key("lift_coefficient", &SceneDbm::lift_coefficient),
-              number_key("coupling_width_m", &SceneDbm::coupling_width_m),
-              bool_key("coalescence", &SceneDbm::coalescence),
-              number_key("film_drainage_s", &SceneDbm::film_drainage_s),
-              bool_key("collisions", &SceneDbm::collisions),
-              number_key("dt_s", &SceneDbm::dt_s),
-              number_key("injection_ramp_s", &SceneDbm::injection_ramp_s),
-              number_key("cfl", &SceneDbm::cfl),
-              {"walls", [](SceneSection& s, const SceneValue& v) { Dbm(s).walls = v.text(); }},
-              number_key("average_from_s", &SceneDbm::average_from_s),
-              number_key("sample_interval_s", &SceneDbm::sample_interval_s),
+              scene_key("nozzle_pitch_m", &SceneDbm::nozzle_pitch_m),
+              scene_key("virtual_mass_coefficient", &SceneDbm::virtual_mass_coefficient),
+              scene_key("lift", &SceneDbm::lift),
+              scene_key("lift_coefficient", &SceneDbm::lift_coefficient),
+              scene_key("coupling_width_m", &SceneDbm::coupling_width_m),
+              scene_key("coalescence", &SceneDbm::coalescence),
+              scene_key("film_drainage_s", &SceneDbm::film_drainage_s),
+              scene_key("collisions", &SceneDbm::collisions),
+              scene_key("dt_s", &SceneDbm::dt_s),
+              scene_key("injection_ramp_s", &SceneDbm::injection_ramp_s),
+              scene_key("cfl", &SceneDbm::cfl),
+              scene_key("walls", &SceneDbm::walls),
+              scene_key("average_from_s", &SceneDbm::average_from_s),
+              scene_key("sample_interval_s", &SceneDbm::sample_interval_s),
               {"size_heights_m", [](SceneSection& s, const SceneValue& v) {
                  Dbm(s).size_heights_m = v.numbers("heights in m");
                }}};

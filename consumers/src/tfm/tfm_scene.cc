@@ -82,29 +82,11 @@ bool tfm_is_valid(const Scene& s, std::string* error) {
   return true;
 }
 
-/// A text key of [tfm].
-std::pair<std::string, std::function<void(SceneSection&, const SceneValue&)>> text_key(
-    const std::string& name, std::string SceneTfm::*member) {
-  return {name, [member](SceneSection& s, const SceneValue& v) { Tfm(s).*member = v.text(); }};
-}
-/// A number key of [tfm].
-std::pair<std::string, std::function<void(SceneSection&, const SceneValue&)>> number_key(
-    const std::string& name, double SceneTfm::*member) {
-  return {name, [member](SceneSection& s, const SceneValue& v) { Tfm(s).*member = v.number(); }};
-}
-
 }  // namespace
 
-const SceneTfm& tfm_section(const Scene& scene) {
-  static const SceneTfm defaults;
-  const SceneSection* s = scene.sections.Find(kTable);
-  return s ? static_cast<const SceneTfm&>(*s) : defaults;
-}
+const SceneTfm& tfm_section(const Scene& scene) { return scene.sections.As<SceneTfm>(kTable); }
 
-SceneTfm& tfm_section(Scene& scene) {
-  return static_cast<SceneTfm&>(
-      scene.sections.Get(kTable, [] { return std::make_unique<SceneTfm>(); }));
-}
+SceneTfm& tfm_section(Scene& scene) { return scene.sections.As<SceneTfm>(kTable); }
 
 const SceneTable& tfm_scene_table() {
   static const SceneTable table = [] {
@@ -112,25 +94,25 @@ const SceneTable& tfm_scene_table() {
     t.name = kTable;
     t.make = [] { return std::make_unique<SceneTfm>(); };
     t.keys = {
-        text_key("closures", &SceneTfm::closures),
-        text_key("radial_distribution", &SceneTfm::radial_distribution),
+        scene_key("closures", &SceneTfm::closures),
+        scene_key("radial_distribution", &SceneTfm::radial_distribution),
         {"restitution",
          [](SceneSection& s, const SceneValue& v) { Tfm(s).restitution = v.number_or_default(); }},
-        number_key("packing_limit", &SceneTfm::packing_limit),
-        text_key("friction", &SceneTfm::friction),
-        number_key("friction_min_solids", &SceneTfm::friction_min_solids),
-        number_key("friction_angle_deg", &SceneTfm::friction_angle_deg),
-        number_key("friction_delta", &SceneTfm::friction_delta),
-        number_key("friction_max_viscosity_pa_s", &SceneTfm::friction_max_viscosity_pa_s),
-        number_key("theta_initial_m2_s2", &SceneTfm::theta_initial_m2_s2),
-        number_key("residual_solids", &SceneTfm::residual_solids),
-        number_key("cfl", &SceneTfm::cfl),
-        number_key("dt_max_s", &SceneTfm::dt_max_s),
-        text_key("solids_walls", &SceneTfm::solids_walls),
-        text_key("fraction_scheme", &SceneTfm::fraction_scheme),
-        text_key("solids_viscosity", &SceneTfm::solids_viscosity),
-        text_key("solids_pressure", &SceneTfm::solids_pressure),
-        text_key("granular_temperature", &SceneTfm::granular_temperature)};
+        scene_key("packing_limit", &SceneTfm::packing_limit),
+        scene_key("friction", &SceneTfm::friction),
+        scene_key("friction_min_solids", &SceneTfm::friction_min_solids),
+        scene_key("friction_angle_deg", &SceneTfm::friction_angle_deg),
+        scene_key("friction_delta", &SceneTfm::friction_delta),
+        scene_key("friction_max_viscosity_pa_s", &SceneTfm::friction_max_viscosity_pa_s),
+        scene_key("theta_initial_m2_s2", &SceneTfm::theta_initial_m2_s2),
+        scene_key("residual_solids", &SceneTfm::residual_solids),
+        scene_key("cfl", &SceneTfm::cfl),
+        scene_key("dt_max_s", &SceneTfm::dt_max_s),
+        scene_key("solids_walls", &SceneTfm::solids_walls),
+        scene_key("fraction_scheme", &SceneTfm::fraction_scheme),
+        scene_key("solids_viscosity", &SceneTfm::solids_viscosity),
+        scene_key("solids_pressure", &SceneTfm::solids_pressure),
+        scene_key("granular_temperature", &SceneTfm::granular_temperature)};
     t.is_valid = tfm_is_valid;
     return t;
   }();

@@ -108,6 +108,29 @@ struct BedModelSettings {
   std::vector<std::pair<std::string, double>> numbers;
 };
 
+/// A key of a model's scene table and how it is read into the model's section.
+using SceneKey = std::pair<std::string, std::function<void(SceneSection&, const SceneValue&)>>;
+
+/// A key read into a member of the model's section type T: a number, a text or a flag.
+template <typename T>
+SceneKey scene_key(const std::string& name, double T::*member) {
+  return {name, [member](SceneSection& s, const SceneValue& v) {
+            static_cast<T&>(s).*member = v.number();
+          }};
+}
+template <typename T>
+SceneKey scene_key(const std::string& name, std::string T::*member) {
+  return {name, [member](SceneSection& s, const SceneValue& v) {
+            static_cast<T&>(s).*member = v.text();
+          }};
+}
+template <typename T>
+SceneKey scene_key(const std::string& name, bool T::*member) {
+  return {name, [member](SceneSection& s, const SceneValue& v) {
+            static_cast<T&>(s).*member = v.boolean();
+          }};
+}
+
 /// A model's own table of scene files ([tfm], [dbm]): its keys, each read into the model's
 /// SceneSection, and its checks of a scene. Scene files accept the tables of every registered
 /// model; the checks run for every scene (a model refuses its table in another model's scene).
@@ -116,7 +139,7 @@ struct SceneTable {
   /// A section holding the defaults.
   std::function<std::unique_ptr<SceneSection>()> make;
   /// The keys, in documentation order, and how each is read into the section.
-  std::vector<std::pair<std::string, std::function<void(SceneSection&, const SceneValue&)>>> keys;
+  std::vector<SceneKey> keys;
   /// On failure *error names the field and the allowed range.
   std::function<bool(const Scene&, std::string*)> is_valid;
 };

@@ -147,6 +147,17 @@ class SceneSections {
                     const std::function<std::unique_ptr<SceneSection>()>& make);
   /// The section of `table`, or null.
   const SceneSection* Find(const std::string& table) const;
+  /// The section of `table` as its model's type T (T's defaults when the scene has none).
+  template <typename T>
+  const T& As(const std::string& table) const {
+    static const T defaults;
+    const SceneSection* s = Find(table);
+    return s != nullptr ? static_cast<const T&>(*s) : defaults;
+  }
+  template <typename T>
+  T& As(const std::string& table) {
+    return static_cast<T&>(Get(table, [] { return std::make_unique<T>(); }));
+  }
 
  private:
   std::map<std::string, std::unique_ptr<SceneSection>> sections_;
