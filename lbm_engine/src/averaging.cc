@@ -90,5 +90,23 @@ bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, do
          sd_b > kUndampedFraction * sd_a;
 }
 
+double finite_re_correction(double re_now, double re_filtered, double target_re,
+                            double re_tolerance, ReControlState* state) {
+  const auto deviation = [target_re](double re) { return std::abs(re / target_re - 1.0); };
+  if (state->reached && deviation(re_filtered) > re_tolerance) return re_filtered;
+  if (deviation(re_now) <= re_tolerance / 3.0) {
+    state->reached = true;
+    return 0.0;
+  }
+  if (deviation(re_now) <= re_tolerance) {
+    state->reached = true;
+    if (state->fine_corrections >= kMaxFineCorrections) return 0.0;
+    ++state->fine_corrections;
+    return re_now;
+  }
+  // Outside the band on the instantaneous Re only: the start-up's approach, or a swing.
+  return state->reached ? 0.0 : re_now;
+}
+
 }  // namespace lbm
 }  // namespace draglab

@@ -14,6 +14,11 @@
 //    tolerance while its two halves have nearly the same mean (no trend) and nearly the same
 //    fluctuation (no decay): the flow is stationary but not steady, and waiting for it to settle
 //    would never end. A transient that settles, even slowly or oscillating, decays.
+//  - Re control of a settled flow (finite_re_correction): the force is corrected towards the
+//    target until Re first reaches its band, then held unless the Re of the velocity filtered
+//    over a characteristic time leaves the band, with a few corrections inside it: a flow that
+//    fluctuates slowly would otherwise have its force corrected at every swing of Re, and every
+//    correction restarts the window on which its unsteadiness is judged.
 #pragma once
 
 #include <cstddef>
@@ -50,6 +55,23 @@ TimeAverage time_average(const std::vector<double>& x, std::size_t truncated);
 /// the standard deviation) and no decay (the second half's standard deviation above
 /// kUndampedFraction of the first's).
 bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, double tolerance);
+
+/// Corrections of the force inside Re's band (towards its middle third) once Re has reached
+/// it: a steady flow needs one or two.
+constexpr int kMaxFineCorrections = 3;
+
+/// The Re control's memory across checks (kept in checkpoints).
+struct ReControlState {
+  bool reached = false;      ///< Re has been in its band at a settled check.
+  int fine_corrections = 0;  ///< Corrections made with Re already in its band.
+};
+
+/// At a check where the flow has settled enough for a correction: the Re on which to correct
+/// the force towards target_re, or 0 to hold it. re_now is the instantaneous Re, re_filtered
+/// that of the mean velocity over the last characteristic time; the band is re_tolerance
+/// (relative), its middle third the aim. Updates *state.
+double finite_re_correction(double re_now, double re_filtered, double target_re,
+                            double re_tolerance, ReControlState* state);
 
 }  // namespace lbm
 }  // namespace draglab

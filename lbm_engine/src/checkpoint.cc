@@ -60,6 +60,8 @@ Json state_json(const LoopState& s) {
   Json j;
   j["step"] = s.step;
   j["adjustments"] = s.adjustments;
+  j["re_reached"] = s.re_control.reached;
+  j["fine_corrections"] = s.re_control.fine_corrections;
   j["averaging"] = s.averaging;
   j["averaging_restarts"] = s.averaging_restarts;
   j["averaging_start"] = s.averaging_start;
@@ -93,6 +95,9 @@ LoopState json_state(const Json& j) {
   LoopState s;
   s.step = j.at("step").get<std::int64_t>();
   s.adjustments = j.at("adjustments").get<int>();
+  // (absent from checkpoints written before the finite-Re hold: counted from the resume on)
+  s.re_control.reached = j.value("re_reached", false);
+  s.re_control.fine_corrections = j.value("fine_corrections", 0);
   s.averaging = j.at("averaging").get<bool>();
   s.averaging_restarts = j.at("averaging_restarts").get<int>();
   s.averaging_start = j.at("averaging_start").get<std::int64_t>();

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "averaging.h"
 #include "draglab/lbm/lbm.h"
 
 namespace draglab {
@@ -48,6 +49,7 @@ struct LoopState {
   double stepping_s = 0.0;  ///< Seconds spent stepping (for MFLUPS).
   double force = 0.0;       ///< The body force now.
   int adjustments = 0;
+  ReControlState re_control;
   bool averaging = false;
   int averaging_restarts = 0;
   std::int64_t averaging_start = 0;

@@ -929,26 +929,33 @@ class RunChecks {
   }
 
   /// The target Re: the force rescaled towards it (exactly in Stokes mode, where the scheme is
-  /// linear in G; once the flow has settled otherwise). kNextCheck after a change.
+  /// linear in G; once the flow has settled otherwise, and held once Re has reached its band:
+  /// finite_re_correction in averaging.h). kNextCheck after a change.
   Next ControlRe() {
     const double target_re = sc_.target_re;
     const double re_ratio = target_re > 0.0 ? loop_.re_lattice / target_re : 1.0;
-    if (target_re > 0.0 && std::abs(re_ratio - 1.0) > options_.re_tolerance / 3.0 &&
-        loop_.adjustments < kMaxAdjustments && loop_.re_lattice > 0.0 &&
-        (sc_.stokes || loop_.relative_change < kAdjustBelowChange)) {
-      const double velocity_factor = 1.0 / re_ratio;
-      double new_force;
+    if (target_re > 0.0 && loop_.adjustments < kMaxAdjustments && loop_.re_lattice > 0.0) {
       if (sc_.stokes) {
-        new_force = loop_.force * velocity_factor;  // exact: the Stokes-mode scheme is linear in G
-      } else {
-        new_force = adjusted_force(loop_.force, loop_.re_lattice, target_re, sc_.phi,
-                                   &loop_.last_log_force, &loop_.last_log_re);
-        loop_.window.clear();
+        if (std::abs(re_ratio - 1.0) > options_.re_tolerance / 3.0) {
+          // exact: the Stokes-mode scheme is linear in G
+          solver_->scale_deviations(1.0 / re_ratio);
+          SetForce(loop_.force / re_ratio);
+          ++loop_.adjustments;
+          return Next::kNextCheck;
+        }
+      } else if (loop_.relative_change < kAdjustBelowChange) {
+        const double judged_re = finite_re_correction(loop_.re_lattice, FilteredRe(), target_re,
+                                                      options_.re_tolerance, &loop_.re_control);
+        if (judged_re > 0.0) {
+          const double new_force = adjusted_force(loop_.force, judged_re, target_re, sc_.phi,
+                                                  &loop_.last_log_force, &loop_.last_log_re);
+          loop_.window.clear();
+          solver_->scale_deviations(1.0 / (judged_re / target_re));
+          SetForce(new_force);
+          ++loop_.adjustments;
+          return Next::kNextCheck;
+        }
       }
-      solver_->scale_deviations(velocity_factor);
-      SetForce(new_force);
-      ++loop_.adjustments;
-      return Next::kNextCheck;
     }
     const bool re_ok = target_re == 0.0 || std::abs(re_ratio - 1.0) <= options_.re_tolerance;
     if (loop_.relative_change < options_.tolerance &&
@@ -956,6 +963,16 @@ class RunChecks {
       return Next::kConverged;
     }
     return Next::kGoOn;
+  }
+
+  /// Re of the mean superficial velocity over the last characteristic time.
+  double FilteredRe() const {
+    const auto& window = loop_.window;
+    const std::size_t n = std::min<std::size_t>(window.size(), kChecksPerTime);
+    double mean_U = 0.0;
+    for (std::size_t k = window.size() - n; k < window.size(); ++k) mean_U += window[k].second;
+    mean_U /= static_cast<double>(n);
+    return mean_U * sc_.d / sc_.nu;
   }
 
   /// The progress line of a steady run (at most every kProgressInterval seconds).
@@ -1211,6 +1228,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     }
     result.steps = step;
     result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
+    result.force_adjustments = loop.adjustments;
 
     using Next = RunChecks::Next;
     if (checks.Health() == Next::kFail || checks.Drag() == Next::kFail) {

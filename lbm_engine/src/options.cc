@@ -201,7 +201,7 @@ std::string RunResult::FullReport() const {
       << format("%.3g", convergence_residual) << ", discretisation "
       << format("%.3g", discretisation_error) << ")\n"
       << "Re (achieved)        " << format("%.6g", re) << (stokes_mode ? "  [Stokes mode]" : "")
-      << "\n"
+      << " (" << force_adjustments << " corrections of the force)\n"
       << "phi / phi_lattice    " << format("%.6g", phi) << " / " << format("%.6g", phi_lattice)
       << "\n"
       << "d (lattice units)    " << format("%.6g", d) << "\n"
@@ -299,6 +299,7 @@ std::string RunResult::ToJson(const RunOptions& o) const {
                       {"averaging_time", averaging_time},
                       {"startup_steps", startup_steps},
                       {"averaging_restarts", averaging_restarts},
+                      {"force_adjustments", force_adjustments},
                       {"precision", to_string(o.precision)},
                       {"narrow_gap_pairs", narrow_gap_pairs},
                       {"smallest_gap_nodes", smallest_gap_nodes},

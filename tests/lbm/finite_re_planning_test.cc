@@ -247,6 +247,35 @@ TEST(TimeAveraging, UnsteadinessIsFluctuationWithoutTrend) {
   EXPECT_FALSE(stationary_fluctuating(oscillating, 50, 0.1));
 }
 
+// The force is corrected towards the target Re until Re reaches its band (1 % here), as before
+// the hold: a steady flow gets the same corrections.
+TEST(ReControl, CorrectsTheApproachAndTheFirstStepsInsideTheBand) {
+  ReControlState state;
+  EXPECT_EQ(finite_re_correction(80.0, 70.0, 100.0, 0.01, &state), 80.0);  // start-up
+  EXPECT_FALSE(state.reached);
+  EXPECT_EQ(finite_re_correction(99.2, 98.0, 100.0, 0.01, &state), 99.2);  // into the middle
+  EXPECT_TRUE(state.reached);
+  EXPECT_EQ(finite_re_correction(99.9, 99.7, 100.0, 0.01, &state), 0.0);  // in the middle third
+  EXPECT_EQ(state.fine_corrections, 1);
+}
+
+// A flow whose Re swings by +-0.8 % about the target (as rr at phi 0.5, d 48, Re 300 and phi
+// 0.3, d 32, Re 1000 do): once reached, the swings get kMaxFineCorrections corrections and then
+// the force is held; an excursion of the instantaneous Re beyond the band is not chased either,
+// while a filtered Re outside the band still is.
+TEST(ReControl, HoldsTheForceOnceReachedSoThatSwingsAreNotChased) {
+  ReControlState state;
+  EXPECT_EQ(finite_re_correction(99.9, 99.0, 100.0, 0.01, &state), 0.0);
+  int corrections = 0;
+  for (int k = 0; k < 40; ++k) {
+    const double swing = k % 2 == 0 ? 100.8 : 99.2;
+    if (finite_re_correction(swing, 100.1, 100.0, 0.01, &state) > 0.0) ++corrections;
+  }
+  EXPECT_EQ(corrections, kMaxFineCorrections);
+  EXPECT_EQ(finite_re_correction(101.3, 100.2, 100.0, 0.01, &state), 0.0);
+  EXPECT_EQ(finite_re_correction(101.3, 101.2, 100.0, 0.01, &state), 101.2);
+}
+
 }  // namespace
 }  // namespace lbm
 }  // namespace draglab

@@ -75,7 +75,10 @@
 // beyond what the chosen operator holds is refused before any stepping (Error(kInvalidArgument),
 // naming the d that would hold); a run that blows up is diagnosed as an instability (where, when,
 // the cell Reynolds number there, the d that would hold). The body force starts from the force
-// balance with the BVK 2007 drag and is rescaled until Re is within re_tolerance of the target.
+// balance with the BVK 2007 drag and is rescaled until Re is within re_tolerance of the target;
+// once it is, the force is held unless the Re of the velocity filtered over one characteristic
+// time leaves the band (with a few corrections inside it), so that a fluctuating flow is not
+// chased (RunResult::force_adjustments counts the corrections).
 //
 // Convergence: characteristic time T = d^2 / (nu (1 + Re)) steps (momentum crossing a diameter by
 // diffusion, or by advection at higher Re); checks every T/10; converged when the relative
@@ -248,6 +251,7 @@ struct RunResult {
   double averaging_time = 0.0;
   std::int64_t startup_steps = 0;
   int averaging_restarts = 0;  ///< Force corrections after averaging began (restarting it).
+  int force_adjustments = 0;   ///< Corrections of the force towards the target Re before that.
   // Additions (engine diagnostics).
   std::vector<std::string> warnings;  ///< Non-fatal findings (Mach above 0.1, boundary fallbacks).
   std::int64_t fluid_nodes = 0;       ///< Fluid nodes updated per step.
