@@ -19,7 +19,7 @@
 
 #include "draglab/consumers/bed_model.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "scene/scene_util.h"
 
 namespace draglab {
@@ -393,237 +393,282 @@ Scene load_scene(const std::string& path) {
   return parse_scene(core::read_text_input(path, "scene file"), path);
 }
 
-bool Scene::IsValid(std::string* error) const {
-  // Where the DEM's keys stand in this file (messages name the section the user wrote).
-  auto dem_at = [this](const char* old_section) {
-    return std::string(dem_table ? "[dem]" : old_section);
-  };
-  if (name.empty()) return fail(error, "[scene] name is missing or empty");
-  for (char c : name) {
+namespace {
+
+/// Where the DEM's keys stand in the scene's file (messages name the section the user wrote).
+std::string dem_at(const Scene& s, const char* old_section) {
+  return std::string(s.dem_table ? "[dem]" : old_section);
+}
+
+/// The scene's name and solver.
+bool name_and_solver_are_valid(const Scene& s, std::string* error) {
+  if (s.name.empty()) return fail(error, "[scene] name is missing or empty");
+  for (char c : s.name) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.')) {
-      return fail(error,
-                  "[scene] name '" + name + "' may contain only letters, digits, '_', '-' and '.'");
+      return fail(error, "[scene] name '" + s.name +
+                             "' may contain only letters, digits, '_', '-' and '.'");
     }
   }
   {
     const std::vector<std::string> models = bed_model_keys();
-    if (std::find(models.begin(), models.end(), solver) == models.end()) {
+    if (std::find(models.begin(), models.end(), s.solver) == models.end()) {
       std::string known;
       for (const std::string& k : models) known += (known.empty() ? "" : ", ") + k;
-      return fail(
-          error, "[scene] solver = '" + solver + "' is not a registered bed model (" + known + ")");
+      return fail(error, "[scene] solver = '" + s.solver + "' is not a registered bed model (" +
+                             known + ")");
     }
   }
+  return true;
+}
+
+/// Geometry, particles and gas: the materials of every model.
+bool materials_are_valid(const Scene& s, std::string* error) {
   // Geometry: a laboratory pseudo-2D bed, millimetres to metres.
-  if (!in_range(geometry.width_m, 0.0, 10.0, true, false, "[geometry] width_m", "m", error) ||
-      !in_range(geometry.height_m, 0.0, 10.0, true, false, "[geometry] height_m", "m", error) ||
-      !in_range(geometry.depth_m, 0.0, 10.0, true, false, "[geometry] depth_m", "m", error)) {
+  if (!in_range(s.geometry.width_m, 0.0, 10.0, true, false, "[geometry] width_m", "m", error) ||
+      !in_range(s.geometry.height_m, 0.0, 10.0, true, false, "[geometry] height_m", "m", error) ||
+      !in_range(s.geometry.depth_m, 0.0, 10.0, true, false, "[geometry] depth_m", "m", error)) {
     return false;
   }
-  const double d = particles.diameter_m;
+  const double d = s.particles.diameter_m;
   // From fine powders (Geldart C, tens of microns) to coarse beads; below a micron the drag laws'
   // minimum fluidization has no root the solvers can find.
   if (!in_range(d, 1e-6, 0.1, false, false, "[particles] diameter_m", "m", error)) return false;
-  if (!in_range(particles.density_kg_m3, 0.0, 30000.0, true, false, "[particles] density_kg_m3",
+  if (!in_range(s.particles.density_kg_m3, 0.0, 30000.0, true, false, "[particles] density_kg_m3",
                 "kg/m^3", error) ||
-      !in_range(particles.restitution, 0.0, 1.0, true, false,
-                dem_at("[particles]") + " restitution", "", error) ||
-      !in_range(particles.friction, 0.0, 1.0, false, false, dem_at("[particles]") + " friction", "",
-                error) ||
-      !in_range(particles.spring_stiffness_n_m, 0.0, 1e9, true, false,
-                dem_at("[particles]") + " spring_stiffness_n_m", "N/m", error)) {
+      !in_range(s.particles.restitution, 0.0, 1.0, true, false,
+                dem_at(s, "[particles]") + " restitution", "", error) ||
+      !in_range(s.particles.friction, 0.0, 1.0, false, false,
+                dem_at(s, "[particles]") + " friction", "", error) ||
+      !in_range(s.particles.spring_stiffness_n_m, 0.0, 1e9, true, false,
+                dem_at(s, "[particles]") + " spring_stiffness_n_m", "N/m", error)) {
     return false;
   }
-  const double min_box = std::min({geometry.width_m, geometry.height_m, geometry.depth_m});
+  const double min_box = std::min({s.geometry.width_m, s.geometry.height_m, s.geometry.depth_m});
   if (d > min_box) {
     return fail(error, "[particles] diameter_m = " + fmt(d) +
                            " does not fit the box: it must be <= the smallest box size " +
                            fmt(min_box) + " m");
   }
-  if (!in_range(gas.density_kg_m3, 0.0, 1000.0, true, false, "[gas] density_kg_m3", "kg/m^3",
+  if (!in_range(s.gas.density_kg_m3, 0.0, 1000.0, true, false, "[gas] density_kg_m3", "kg/m^3",
                 error) ||
-      !in_range(gas.viscosity_pa_s, 0.0, 1.0, true, false, "[gas] viscosity_pa_s", "Pa s", error) ||
-      !in_range(gas.gravity_m_s2, 0.0, 100.0, true, false, "[gas] gravity_m_s2", "m/s^2", error)) {
-    return false;
-  }
-  if (!(particles.density_kg_m3 > gas.density_kg_m3)) {
-    return fail(error, "[particles] density_kg_m3 = " + fmt(particles.density_kg_m3) +
-                           " must exceed [gas] density_kg_m3 = " + fmt(gas.density_kg_m3) +
-                           " (the bed would not settle)");
-  }
-  if (!in_range(eps_mf, 0.26, 0.9, false, true, "[drag] eps_mf", "(random packings: 0.36-0.5)",
+      !in_range(s.gas.viscosity_pa_s, 0.0, 1.0, true, false, "[gas] viscosity_pa_s", "Pa s",
+                error) ||
+      !in_range(s.gas.gravity_m_s2, 0.0, 100.0, true, false, "[gas] gravity_m_s2", "m/s^2",
                 error)) {
     return false;
   }
-  if (!model_tables_are_valid(*this, error)) return false;
-  if (find_bed_model(solver).particle_bed()) {
-    const bool has_count = particles.count > 0;
-    const bool has_height = particles.bed_height_mf_m != 0.0;
-    if (has_count == has_height) {
-      // A 0 typed in the file reads as "not given": say so with the ranges.
-      return fail(
-          error,
-          "[particles] give exactly one of count, in [1, 10000000], and bed_height_mf_m, "
-          "in (0, " +
-              fmt(geometry.height_m) + "] m (the box height)" +
-              (has_count ? std::string(": both are given")
-                         : std::string(": neither has a usable value (count = " +
-                                       std::to_string(particles.count) + ", bed_height_mf_m = " +
-                                       fmt(particles.bed_height_mf_m) + ")")));
+  if (!(s.particles.density_kg_m3 > s.gas.density_kg_m3)) {
+    return fail(error, "[particles] density_kg_m3 = " + fmt(s.particles.density_kg_m3) +
+                           " must exceed [gas] density_kg_m3 = " + fmt(s.gas.density_kg_m3) +
+                           " (the bed would not settle)");
+  }
+  if (!in_range(s.eps_mf, 0.26, 0.9, false, true, "[drag] eps_mf", "(random packings: 0.36-0.5)",
+                error)) {
+    return false;
+  }
+  return true;
+}
+
+/// A particle bed's inventory: a count or a settled height that fits the box.
+bool particle_inventory_is_valid(const Scene& s, std::string* error) {
+  const double d = s.particles.diameter_m;
+  const bool has_count = s.particles.count > 0;
+  const bool has_height = s.particles.bed_height_mf_m != 0.0;
+  if (has_count == has_height) {
+    // A 0 typed in the file reads as "not given": say so with the ranges.
+    return fail(
+        error,
+        "[particles] give exactly one of count, in [1, 10000000], and bed_height_mf_m, "
+        "in (0, " +
+            fmt(s.geometry.height_m) + "] m (the box height)" +
+            (has_count ? std::string(": both are given")
+                       : std::string(": neither has a usable value (count = " +
+                                     std::to_string(s.particles.count) + ", bed_height_mf_m = " +
+                                     fmt(s.particles.bed_height_mf_m) + ")")));
+  }
+  if (has_height && !in_range(s.particles.bed_height_mf_m, 0.0, s.geometry.height_m, true, false,
+                              "[particles] bed_height_mf_m", "m (the box height)", error)) {
+    return false;
+  }
+  if (has_count && s.particles.count > 10000000) {
+    return fail(error, "[particles] count = " + std::to_string(s.particles.count) +
+                           " is outside [1, 10000000]");
+  }
+  if (s.solver == "dpm" && has_height) {
+    // The particle solver holds every particle: the count a bed height makes obeys the cap
+    // of [particles] count (checked in double: a tiny diameter overflows any integer).
+    const double n = (1.0 - s.eps_mf) * s.geometry.width_m * s.geometry.depth_m *
+                     s.particles.bed_height_mf_m /
+                     (std::acos(-1.0) / 6.0 * s.particles.diameter_m * s.particles.diameter_m *
+                      s.particles.diameter_m);
+    if (!(n <= 10000000.0)) {
+      return fail(error, "[particles] bed_height_mf_m = " + fmt(s.particles.bed_height_mf_m) +
+                             " m of diameter_m = " + fmt(s.particles.diameter_m) + " m makes " +
+                             fmt(n) +
+                             " particles, more than the 10000000 the DPM holds (a lower bed, "
+                             "larger particles or a narrower box)");
     }
-    if (has_height && !in_range(particles.bed_height_mf_m, 0.0, geometry.height_m, true, false,
-                                "[particles] bed_height_mf_m", "m (the box height)", error)) {
-      return false;
-    }
-    if (has_count && particles.count > 10000000) {
-      return fail(error, "[particles] count = " + std::to_string(particles.count) +
-                             " is outside [1, 10000000]");
-    }
-    if (solver == "dpm" && has_height) {
-      // The particle solver holds every particle: the count a bed height makes obeys the cap
-      // of [particles] count (checked in double: a tiny diameter overflows any integer).
-      const double n = (1.0 - eps_mf) * geometry.width_m * geometry.depth_m *
-                       particles.bed_height_mf_m /
-                       (std::acos(-1.0) / 6.0 * particles.diameter_m * particles.diameter_m *
-                        particles.diameter_m);
-      if (!(n <= 10000000.0)) {
-        return fail(error, "[particles] bed_height_mf_m = " + fmt(particles.bed_height_mf_m) +
-                               " m of diameter_m = " + fmt(particles.diameter_m) + " m makes " +
-                               fmt(n) +
-                               " particles, more than the 10000000 the DPM holds (a lower bed, "
-                               "larger particles or a narrower box)");
-      }
-    }
-    const double h_mf = bed_height_mf_m();
-    if (h_mf > geometry.height_m) {
-      return fail(error, "[particles] count = " + std::to_string(particles.count) +
-                             " makes a bed " + fmt(h_mf) + " m high at eps_mf = " + fmt(eps_mf) +
-                             ": it does not fit the box ([geometry] height_m = " +
-                             fmt(geometry.height_m) + " m)");
-    }
-    if (h_mf < d) {
-      return fail(error, "[particles] the bed at eps_mf is " + fmt(h_mf) +
-                             " m high, less than one particle diameter (give more particles)");
-    }
-    // Distributor.
-    if (distributor.mode != BackgroundMode::kFixed) {
-      if (!in_range(distributor.umf_factor, 0.0, 10.0, false, false, "[distributor] umf_factor", "",
-                    error)) {
-        return false;
-      }
-    } else if (!in_range(distributor.velocity_m_s, 0.0, 100.0, true, false,
-                         "[distributor] velocity_m_s", "m/s (background = \"fixed\")", error)) {
-      return false;
-    }
-    // Jet.
-    if (!in_range(jet.slot_width_m, 0.0, geometry.width_m, true, false, "[jet] slot_width_m",
-                  "m (0 < slot <= the bed width)", error) ||
-        !in_range(jet.velocity_m_s, 0.0, 300.0, false, false, "[jet] velocity_m_s",
-                  "m/s (incompressible gas: Mach < 0.9)", error) ||
-        !in_range(jet.start_s, 0.0, 1e4, false, false, "[jet] start_s", "s", error) ||
-        !in_range(jet.duration_s, 0.0, 1e4, false, false, "[jet] duration_s", "s", error) ||
-        !in_range(jet.ramp_s, 0.0, 1.0, false, false, "[jet] ramp_s", "s", error)) {
-      return false;
-    }
-    if (jet.center_m != -1.0) {  // -1: the default, the bed's centre line
-      const double half = 0.5 * jet.slot_width_m;
-      if (!in_range(jet.center_m, half, geometry.width_m - half, false, false, "[jet] center_m",
-                    "m (the slot must lie inside the bottom)", error)) {
-        return false;
-      }
-    }
-    // Times.
-    if (!in_range(time.duration_s, 0.0, 1e4, true, false, "[time] duration_s", "s", error) ||
-        !in_range(time.t_ref_s, 0.0, 1e4, false, false, "[time] t_ref_s", "s", error) ||
-        !in_range(time.settle_s, 0.0, 1e4, false, false, dem_at("[time]") + " settle_s", "s",
-                  error) ||
-        !in_range(time.dem_dt_s, 0.0, 1.0, false, false, dem_at("[time]") + " dem_dt_s",
-                  "s (0 = auto)", error) ||
-        !in_range(time.gas_dt_s, 0.0, 1.0, false, false, "[time] gas_dt_s", "s (0 = auto)",
+  }
+  const double h_mf = s.bed_height_mf_m();
+  if (h_mf > s.geometry.height_m) {
+    return fail(error, "[particles] count = " + std::to_string(s.particles.count) +
+                           " makes a bed " + fmt(h_mf) + " m high at eps_mf = " + fmt(s.eps_mf) +
+                           ": it does not fit the box ([geometry] height_m = " +
+                           fmt(s.geometry.height_m) + " m)");
+  }
+  if (h_mf < d) {
+    return fail(error, "[particles] the bed at eps_mf is " + fmt(h_mf) +
+                           " m high, less than one particle diameter (give more particles)");
+  }
+  return true;
+}
+
+/// A particle bed's gas inflow: the distributor's background and the jet.
+bool inflow_is_valid(const Scene& s, std::string* error) {
+  if (s.distributor.mode != BackgroundMode::kFixed) {
+    if (!in_range(s.distributor.umf_factor, 0.0, 10.0, false, false, "[distributor] umf_factor", "",
                   error)) {
       return false;
     }
-    if (time.contact_steps < 20 || time.contact_steps > 1000) {
-      return fail(error, dem_at("[time]") + " contact_steps = " +
-                             std::to_string(time.contact_steps) + " is outside [20, 1000]");
-    }
-    if (jet.start_s + time.t_ref_s > time.duration_s * (1.0 + 1e-12)) {
-      return fail(error, "[time] t_ref_s = " + fmt(time.t_ref_s) + " after the jet start " +
-                             fmt(jet.start_s) + " s is beyond [time] duration_s = " +
-                             fmt(time.duration_s) + " s (t_ref_s <= duration_s - jet.start_s)");
-    }
-    // A positive step so small that the run could never finish is a typo, not a choice.
-    constexpr double kMaxSteps = 1e9;
-    if (time.gas_dt_s > 0.0 && time.duration_s / time.gas_dt_s > kMaxSteps) {
-      return fail(error, "[time] gas_dt_s = " + fmt(time.gas_dt_s) + " s would take " +
-                             fmt(time.duration_s / time.gas_dt_s) +
-                             " gas steps for duration_s (more than 1e9): use 0 = auto, or a step "
-                             ">= duration_s / 1e9 = " +
-                             fmt(time.duration_s / kMaxSteps) + " s");
-    }
-    if (time.dem_dt_s > 0.0 && (time.settle_s + time.duration_s) / time.dem_dt_s > kMaxSteps) {
-      return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) + " s would take " +
-                             fmt((time.settle_s + time.duration_s) / time.dem_dt_s) +
-                             " DEM steps for settle_s + duration_s (more than 1e9): use 0 = auto, "
-                             "or a step >= (settle_s + duration_s) / 1e9 = " +
-                             fmt((time.settle_s + time.duration_s) / kMaxSteps) + " s");
-    }
-    if (time.dem_dt_s > 0.0) {
-      const double limit = contact_time_s(particles) / 20.0;
-      if (time.dem_dt_s > limit) {
-        return fail(error, dem_at("[time]") + " dem_dt_s = " + fmt(time.dem_dt_s) +
-                               " s is above the stability limit t_c/20 = " + fmt(limit) +
-                               " s of the contact model (use 0 = auto, or a smaller step)");
-      }
+  } else if (!in_range(s.distributor.velocity_m_s, 0.0, 100.0, true, false,
+                       "[distributor] velocity_m_s", "m/s (background = \"fixed\")", error)) {
+    return false;
+  }
+  // Jet.
+  if (!in_range(s.jet.slot_width_m, 0.0, s.geometry.width_m, true, false, "[jet] slot_width_m",
+                "m (0 < slot <= the bed width)", error) ||
+      !in_range(s.jet.velocity_m_s, 0.0, 300.0, false, false, "[jet] velocity_m_s",
+                "m/s (incompressible gas: Mach < 0.9)", error) ||
+      !in_range(s.jet.start_s, 0.0, 1e4, false, false, "[jet] start_s", "s", error) ||
+      !in_range(s.jet.duration_s, 0.0, 1e4, false, false, "[jet] duration_s", "s", error) ||
+      !in_range(s.jet.ramp_s, 0.0, 1.0, false, false, "[jet] ramp_s", "s", error)) {
+    return false;
+  }
+  if (s.jet.center_m != -1.0) {  // -1: the default, the bed's centre line
+    const double half = 0.5 * s.jet.slot_width_m;
+    if (!in_range(s.jet.center_m, half, s.geometry.width_m - half, false, false, "[jet] center_m",
+                  "m (the slot must lie inside the bottom)", error)) {
+      return false;
     }
   }
+  return true;
+}
+
+/// A particle bed's times and steps.
+bool times_are_valid(const Scene& s, std::string* error) {
+  if (!in_range(s.time.duration_s, 0.0, 1e4, true, false, "[time] duration_s", "s", error) ||
+      !in_range(s.time.t_ref_s, 0.0, 1e4, false, false, "[time] t_ref_s", "s", error) ||
+      !in_range(s.time.settle_s, 0.0, 1e4, false, false, dem_at(s, "[time]") + " settle_s", "s",
+                error) ||
+      !in_range(s.time.dem_dt_s, 0.0, 1.0, false, false, dem_at(s, "[time]") + " dem_dt_s",
+                "s (0 = auto)", error) ||
+      !in_range(s.time.gas_dt_s, 0.0, 1.0, false, false, "[time] gas_dt_s", "s (0 = auto)",
+                error)) {
+    return false;
+  }
+  if (s.time.contact_steps < 20 || s.time.contact_steps > 1000) {
+    return fail(error, dem_at(s, "[time]") + " contact_steps = " +
+                           std::to_string(s.time.contact_steps) + " is outside [20, 1000]");
+  }
+  if (s.jet.start_s + s.time.t_ref_s > s.time.duration_s * (1.0 + 1e-12)) {
+    return fail(error, "[time] t_ref_s = " + fmt(s.time.t_ref_s) + " after the jet start " +
+                           fmt(s.jet.start_s) + " s is beyond [time] duration_s = " +
+                           fmt(s.time.duration_s) + " s (t_ref_s <= duration_s - jet.start_s)");
+  }
+  // A positive step so small that the run could never finish is a typo, not a choice.
+  constexpr double kMaxSteps = 1e9;
+  if (s.time.gas_dt_s > 0.0 && s.time.duration_s / s.time.gas_dt_s > kMaxSteps) {
+    return fail(error, "[time] gas_dt_s = " + fmt(s.time.gas_dt_s) + " s would take " +
+                           fmt(s.time.duration_s / s.time.gas_dt_s) +
+                           " gas steps for duration_s (more than 1e9): use 0 = auto, or a step "
+                           ">= duration_s / 1e9 = " +
+                           fmt(s.time.duration_s / kMaxSteps) + " s");
+  }
+  if (s.time.dem_dt_s > 0.0 &&
+      (s.time.settle_s + s.time.duration_s) / s.time.dem_dt_s > kMaxSteps) {
+    return fail(error, dem_at(s, "[time]") + " dem_dt_s = " + fmt(s.time.dem_dt_s) +
+                           " s would take " +
+                           fmt((s.time.settle_s + s.time.duration_s) / s.time.dem_dt_s) +
+                           " DEM steps for settle_s + duration_s (more than 1e9): use 0 = auto, "
+                           "or a step >= (settle_s + duration_s) / 1e9 = " +
+                           fmt((s.time.settle_s + s.time.duration_s) / kMaxSteps) + " s");
+  }
+  if (s.time.dem_dt_s > 0.0) {
+    const double limit = contact_time_s(s.particles) / 20.0;
+    if (s.time.dem_dt_s > limit) {
+      return fail(error, dem_at(s, "[time]") + " dem_dt_s = " + fmt(s.time.dem_dt_s) +
+                             " s is above the stability limit t_c/20 = " + fmt(limit) +
+                             " s of the contact model (use 0 = auto, or a smaller step)");
+    }
+  }
+  return true;
+}
+
+/// The grid, the bubble criterion, the outputs and the drag laws.
+bool grid_outputs_and_laws_are_valid(const Scene& s, std::string* error) {
   // Grid: the void fraction needs cells at least one particle wide.
-  if (grid.cells_x < 2 || grid.cells_y < 2) {
+  const double d = s.particles.diameter_m;
+  if (s.grid.cells_x < 2 || s.grid.cells_y < 2) {
     return fail(error, "[grid] cells_x and cells_y must be >= 2 (got " +
-                           std::to_string(grid.cells_x) + ", " + std::to_string(grid.cells_y) +
+                           std::to_string(s.grid.cells_x) + ", " + std::to_string(s.grid.cells_y) +
                            ")");
   }
-  const double dx = geometry.width_m / grid.cells_x, dy = geometry.height_m / grid.cells_y;
+  const double dx = s.geometry.width_m / s.grid.cells_x, dy = s.geometry.height_m / s.grid.cells_y;
   if (dx < d || dy < d) {
-    return fail(
-        error,
-        "[grid] cells of " + fmt(dx) + " x " + fmt(dy) + " m are smaller than a particle (" +
-            fmt(d) +
-            " m): use at most width/d = " + std::to_string(static_cast<int>(geometry.width_m / d)) +
-            " cells_x and height/d = " + std::to_string(static_cast<int>(geometry.height_m / d)) +
-            " cells_y");
+    return fail(error, "[grid] cells of " + fmt(dx) + " x " + fmt(dy) +
+                           " m are smaller than a particle (" + fmt(d) +
+                           " m): use at most width/d = " +
+                           std::to_string(static_cast<int>(s.geometry.width_m / d)) +
+                           " cells_x and height/d = " +
+                           std::to_string(static_cast<int>(s.geometry.height_m / d)) + " cells_y");
   }
   // The bubble criterion is a void fraction of a particle bed (a model whose bed fills the
   // column, the DBM, tracks its bubbles itself).
-  const bool bubble_criterion = find_bed_model(solver).particle_bed();
-  if ((bubble_criterion && !in_range(bubble.eps_threshold, eps_mf, 1.0, true, true,
+  const bool bubble_criterion = find_bed_model(s.solver).particle_bed();
+  if ((bubble_criterion && !in_range(s.bubble.eps_threshold, s.eps_mf, 1.0, true, true,
                                      "[bubble] eps_threshold", "(eps_mf, 1)", error)) ||
-      (bubble_criterion && !in_range(bubble.sample_interval_s, 0.0, time.duration_s, true, false,
-                                     "[bubble] sample_interval_s", "s (0, duration_s]", error)) ||
-      !in_range(outputs.interval_s, 0.0, time.duration_s, false, false, "[outputs] interval_s",
+      (bubble_criterion &&
+       !in_range(s.bubble.sample_interval_s, 0.0, s.time.duration_s, true, false,
+                 "[bubble] sample_interval_s", "s (0, duration_s]", error)) ||
+      !in_range(s.outputs.interval_s, 0.0, s.time.duration_s, false, false, "[outputs] interval_s",
                 "s [0, duration_s]", error)) {
     return false;
   }
-  if (laws.empty()) return fail(error, "[drag] laws is missing or empty (e.g. [\"ergun@1\"])");
+  if (s.laws.empty()) return fail(error, "[drag] laws is missing or empty (e.g. [\"ergun@1\"])");
   std::set<std::string> seen;
-  for (std::size_t i = 0; i < laws.size(); ++i) {
-    if (laws[i].empty() || laws[i].find_first_of(" \t,") != std::string::npos) {
-      return fail(error, "[drag] laws[" + std::to_string(i) + "] = '" + laws[i] +
+  for (std::size_t i = 0; i < s.laws.size(); ++i) {
+    if (s.laws[i].empty() || s.laws[i].find_first_of(" \t,") != std::string::npos) {
+      return fail(error, "[drag] laws[" + std::to_string(i) + "] = '" + s.laws[i] +
                              "' is not a law reference (name@version, e.g. ergun@1)");
     }
-    if (!seen.insert(laws[i]).second) {
-      return fail(error, "[drag] laws lists '" + laws[i] + "' twice");
+    if (!seen.insert(s.laws[i]).second) {
+      return fail(error, "[drag] laws lists '" + s.laws[i] + "' twice");
     }
   }
-  if (dem_table && solver != "dpm") {
+  if (s.dem_table && s.solver != "dpm") {
     return fail(error, "[dem] is read only with solver = \"dpm\" (this scene's solver is \"" +
-                           solver + "\"): remove the table or change the solver");
+                           s.solver + "\"): remove the table or change the solver");
   }
-  if (range_policy != "clamp" && range_policy != "extrapolate" && range_policy != "error") {
-    return fail(error, "[drag] range_policy = '" + range_policy +
+  if (s.range_policy != "clamp" && s.range_policy != "extrapolate" && s.range_policy != "error") {
+    return fail(error, "[drag] range_policy = '" + s.range_policy +
                            "' is not one of clamp, extrapolate, error");
   }
   return true;
+}
+
+}  // namespace
+
+bool Scene::IsValid(std::string* error) const {
+  if (!name_and_solver_are_valid(*this, error) || !materials_are_valid(*this, error) ||
+      !model_tables_are_valid(*this, error)) {
+    return false;
+  }
+  if (find_bed_model(solver).particle_bed() &&
+      (!particle_inventory_is_valid(*this, error) || !inflow_is_valid(*this, error) ||
+       !times_are_valid(*this, error))) {
+    return false;
+  }
+  return grid_outputs_and_laws_are_valid(*this, error);
 }
 
 void Scene::Validate() const {
