@@ -19,7 +19,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/files.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/mpi/world.h"
 
 namespace draglab {

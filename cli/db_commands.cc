@@ -8,7 +8,7 @@
 
 #include "cli/cli_context.h"
 #include "drag_db_version.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace cli {

@@ -10,7 +10,7 @@
 #include "cli/cli_context.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/fitter/fit.h"
 
 namespace draglab {

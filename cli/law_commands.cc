@@ -10,8 +10,8 @@
 #include "cli/cli_context.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/export.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace cli {

@@ -21,7 +21,7 @@
 #include "draglab/arrays/voxelization.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/calibration.h"
 #include "draglab/lbm/case_run.h"
 #include "draglab/lbm/convergence.h"

@@ -25,7 +25,7 @@
 
 #include "cli/cli_context.h"
 #include "drag_db_version.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/mpi/world.h"
 
 namespace draglab {

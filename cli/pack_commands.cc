@@ -17,7 +17,7 @@
 #include "draglab/arrays/packing_io.h"
 #include "draglab/arrays/voxelization.h"
 #include "draglab/core/files.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace cli {

@@ -20,7 +20,7 @@
 #include "cli/regress_report.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/consumer_results.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/bed_results.h"
 #include "draglab/workflows/regress.h"
 

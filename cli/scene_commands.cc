@@ -19,7 +19,7 @@
 #include "draglab/consumers/scene.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/consumer_results.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/bed_results.h"
 #include "draglab/workflows/regress.h"
 

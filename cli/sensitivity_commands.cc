@@ -44,7 +44,7 @@
 #include "draglab/consumers/scene.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/bed_results.h"
 #include "draglab/workflows/sensitivity.h"
 #include "draglab/workflows/studies.h"

@@ -19,7 +19,7 @@
 #include <system_error>
 #include <utility>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab_fuzz {
 

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/arrays/packing.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace arrays {

@@ -6,7 +6,7 @@
 
 #include "draglab/arrays/packing.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace arrays {

@@ -14,7 +14,7 @@
 #include "drag_db_version.h"
 #include "draglab/core/hdf5_file.h"
 #include "draglab/core/isolated.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace arrays {

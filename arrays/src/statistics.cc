@@ -29,7 +29,7 @@
 #include "cell_list.h"
 #include "draglab/arrays/packing.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace arrays {

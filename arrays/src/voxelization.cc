@@ -28,7 +28,7 @@
 
 #include "cell_list.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 #if defined(_OPENMP)
 #include <omp.h>

@@ -35,7 +35,7 @@
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/mpi/communicator.h"
 #include "draglab/mpi/world.h"
 #include "runner_internal.h"

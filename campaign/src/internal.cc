@@ -7,7 +7,7 @@
 
 #include "campaign_internal.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 
 namespace draglab {

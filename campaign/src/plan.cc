@@ -14,7 +14,7 @@
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/voxelization.h"
 #include "draglab/campaign/campaign.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/lbm/resolution.h"
 

@@ -28,7 +28,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/case_run.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/mpi/world.h"

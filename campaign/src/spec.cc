@@ -17,7 +17,7 @@
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace campaign {

@@ -14,7 +14,7 @@
 #include <mutex>
 #include <sstream>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace core {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "draglab/core/files.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace core {

@@ -12,7 +12,7 @@
 #include <exception>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define DRAGLAB_ASAN 1

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace core {

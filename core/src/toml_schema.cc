@@ -1,7 +1,7 @@
 // core/src/toml_schema.cc: see draglab/core/toml_schema.h.
 #include "draglab/core/toml_schema.h"
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace core {

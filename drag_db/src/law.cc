@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

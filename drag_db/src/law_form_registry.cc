@@ -2,8 +2,8 @@
 #include <map>
 #include <mutex>
 
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

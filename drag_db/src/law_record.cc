@@ -6,8 +6,8 @@
 
 #include "drag_db_version.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
+#include "draglab/error.h"
 
 namespace draglab {
 

@@ -17,7 +17,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "fit_internal.h"
 #include "student_t.h"
 

@@ -15,7 +15,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/fitter/fit.h"
 #include "fit_internal.h"
 

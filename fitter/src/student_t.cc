@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace fitter {

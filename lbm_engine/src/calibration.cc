@@ -10,7 +10,7 @@
 
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/voxelization.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace lbm {

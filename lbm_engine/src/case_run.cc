@@ -10,7 +10,7 @@
 
 #include "draglab/arrays/voxelization.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/convergence.h"
 #include "draglab/lbm/fields_io.h"
 #include "draglab/lbm/resolution.h"

@@ -12,7 +12,7 @@
 
 #include "drag_db_version.h"
 #include "draglab/core/files.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace lbm {

@@ -8,7 +8,7 @@
 #include <numeric>
 
 #include "draglab/arrays/voxelization.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/calibration.h"
 
 namespace draglab {

@@ -54,7 +54,7 @@
 #include "drag_db_version.h"
 #include "draglab/core/files.h"
 #include "draglab/core/machine.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/lbm/resolution.h"
 #include "draglab/mpi/world.h"

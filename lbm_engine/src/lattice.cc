@@ -9,7 +9,7 @@
 #include <new>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>

@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 
 namespace draglab {

@@ -1,7 +1,7 @@
 // solver.cc: the AA sweeps (SIMD over nodes), the link pass and the moment sweep.
 #include "solver.h"
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 #include <mpi.h>
 #endif
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/mpi/world.h"
 
 namespace draglab {

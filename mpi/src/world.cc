@@ -15,7 +15,7 @@
 #include <mpi.h>
 #endif
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace mpi {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "draglab/arrays/packing_io.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "support/temp_dir.h"
 
 namespace draglab {

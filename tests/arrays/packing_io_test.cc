@@ -17,7 +17,7 @@
 
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "support/temp_dir.h"
 
 namespace draglab {

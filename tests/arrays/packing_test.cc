@@ -26,7 +26,7 @@
 #include <omp.h>
 #endif
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace arrays {

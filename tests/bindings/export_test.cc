@@ -33,9 +33,9 @@
 #include <vector>
 
 #include "draglab/drag_db/export.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 
 #ifndef DRAGLAB_TEST_C_COMPILER
 #define DRAGLAB_TEST_C_COMPILER "cc"

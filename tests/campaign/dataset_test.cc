@@ -16,7 +16,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace campaign {

@@ -14,7 +14,7 @@
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 
 namespace draglab {

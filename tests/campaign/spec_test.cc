@@ -6,7 +6,7 @@
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace campaign {

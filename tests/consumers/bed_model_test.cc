@@ -19,8 +19,8 @@
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 #include "support/toml_edit.h"
 
 namespace draglab {

@@ -19,7 +19,7 @@
 #include <cmath>
 
 #include "dbm/dbm_closures.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

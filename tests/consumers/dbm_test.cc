@@ -35,7 +35,7 @@
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "gas/mac_operators.h"
 #include "gas/mac_pressure.h"
 

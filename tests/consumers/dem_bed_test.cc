@@ -20,9 +20,9 @@
 #include <cmath>
 
 #include "draglab/consumers/dem.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

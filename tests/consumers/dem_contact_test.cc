@@ -22,7 +22,7 @@
 #include <random>
 
 #include "draglab/consumers/dem.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

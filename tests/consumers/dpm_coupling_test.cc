@@ -61,7 +61,7 @@
 
 #include "draglab/consumers/dpm.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "support/toml_edit.h"
 
 namespace draglab {

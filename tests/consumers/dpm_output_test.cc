@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "io/dpm_output.h"
 
 namespace draglab {

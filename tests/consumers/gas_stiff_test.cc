@@ -21,7 +21,7 @@
 #include <string>
 
 #include "draglab/consumers/gas_phase.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

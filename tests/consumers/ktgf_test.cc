@@ -38,7 +38,7 @@
 #include <string>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "tfm/ktgf.h"
 
 namespace draglab {

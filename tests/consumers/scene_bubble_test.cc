@@ -10,7 +10,7 @@
 #include <cmath>
 
 #include "draglab/consumers/bubble.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

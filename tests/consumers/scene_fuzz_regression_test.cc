@@ -8,7 +8,7 @@
 #include <string>
 
 #include "draglab/consumers/scene.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

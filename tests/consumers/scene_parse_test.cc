@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "draglab/consumers/scene.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "tfm/tfm_scene.h"
 
 namespace draglab {

@@ -25,7 +25,7 @@
 
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

@@ -19,7 +19,7 @@
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "tfm/ktgf.h"
 #include "tfm/tfm.h"
 

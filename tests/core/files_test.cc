@@ -35,7 +35,7 @@
 
 #include "draglab/core/files.h"
 #include "draglab/core/hdf5_file.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "support/temp_dir.h"
 
 namespace draglab {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "draglab/core/isolated.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

@@ -10,7 +10,7 @@
 #include "draglab/core/text.h"
 #include "draglab/core/toml_schema.h"
 #include "draglab/core/xdmf.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

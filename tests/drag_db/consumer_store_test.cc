@@ -33,7 +33,7 @@
 
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "support/temp_dir.h"
 
 namespace draglab {

@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 #include "support/temp_dir.h"
 
 #ifndef DRAGLAB_SQLITE3_SHELL

@@ -18,7 +18,7 @@
 #include <string>
 
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "support/temp_dir.h"
 
 namespace draglab {

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

@@ -24,8 +24,8 @@
 #include "ceres/jet.h"
 #include "codegen/expr.h"
 #include "draglab/drag_db/conventions.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

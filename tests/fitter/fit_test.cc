@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law.h"
+#include "draglab/error.h"
 #include "draglab/fitter/fit.h"
 #include "fit_internal.h"
 

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "student_t.h"
 
 namespace draglab {

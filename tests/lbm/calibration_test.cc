@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/calibration.h"
 
 #ifndef DRAGLAB_DATA_DIR

@@ -20,7 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/calibration.h"
 #include "draglab/lbm/case_run.h"
 #include "draglab/lbm/fields_io.h"

@@ -21,7 +21,7 @@
 #include <fstream>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "validation_support.h"
 
 namespace draglab {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "draglab/arrays/packing.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/convergence.h"
 
 namespace draglab {

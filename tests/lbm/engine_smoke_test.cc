@@ -20,7 +20,7 @@
 #include "d3q19.h"
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/voxelization.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 #include "lattice.h"
 #include "solver.h"

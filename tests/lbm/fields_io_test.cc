@@ -17,7 +17,7 @@
 #include <sstream>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/fields_io.h"
 #include "draglab/lbm/lbm.h"
 #include "support/temp_dir.h"

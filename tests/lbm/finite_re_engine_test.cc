@@ -35,7 +35,7 @@
 #include <string>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/lbm/resolution.h"
 #include "validation_support.h"
 

@@ -25,7 +25,7 @@
 #include <cmath>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "validation_support.h"
 
 namespace draglab {

@@ -13,7 +13,7 @@
 #include <stdexcept>
 
 #include "draglab/core/files.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/convergence_plot.h"
 #include "draglab/workflows/scripts.h"
 #include "support/temp_dir.h"

@@ -15,7 +15,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/files.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/pipeline.h"
 #include "support/temp_dir.h"
 

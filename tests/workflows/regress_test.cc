@@ -38,7 +38,7 @@
 #include <vector>
 
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace workflows {

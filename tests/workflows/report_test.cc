@@ -21,7 +21,7 @@
 #include "draglab/core/files.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/report.h"
 #include "support/temp_dir.h"
 

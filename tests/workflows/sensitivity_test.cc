@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/sensitivity.h"
 
 namespace draglab {

@@ -17,7 +17,7 @@
 #include "draglab/consumers/scene.h"
 #include "draglab/core/files.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/studies.h"
 #include "support/temp_dir.h"
 

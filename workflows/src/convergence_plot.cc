@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "draglab/core/files.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/scripts.h"
 
 namespace draglab {

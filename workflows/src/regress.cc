@@ -16,7 +16,7 @@
 #include "draglab/consumers/bed_model.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace workflows {

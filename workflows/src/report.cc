@@ -20,7 +20,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/fitter/fit.h"
 #include "draglab/workflows/scripts.h"
 

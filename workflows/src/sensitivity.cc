@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace workflows {

@@ -11,7 +11,7 @@
 
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "draglab/workflows/bed_results.h"
 #include "draglab/workflows/scripts.h"
 

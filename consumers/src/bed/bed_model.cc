@@ -11,7 +11,7 @@
 #include "draglab/core/files.h"
 #include "draglab/core/machine.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

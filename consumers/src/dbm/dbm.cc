@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "gas/mac_operators.h"
 #include "gas/mac_pressure.h"
 #include "gas/particle_kernel.h"

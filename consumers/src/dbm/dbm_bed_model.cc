@@ -24,7 +24,7 @@
 #include "dbm/dbm_scene.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

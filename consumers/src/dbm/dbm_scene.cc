@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "scene/scene_util.h"
 
 namespace draglab {

@@ -14,7 +14,7 @@
 #include <stdexcept>
 
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

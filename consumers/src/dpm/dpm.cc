@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "gas/particle_kernel.h"
 
 namespace draglab {

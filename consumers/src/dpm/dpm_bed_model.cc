@@ -14,7 +14,7 @@
 #include "bed/builtin_models.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

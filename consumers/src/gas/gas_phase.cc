@@ -23,7 +23,7 @@
 #include <limits>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "gas/mac_operators.h"
 
 namespace draglab {

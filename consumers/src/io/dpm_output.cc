@@ -21,7 +21,7 @@
 #include "draglab/core/files.h"
 #include "draglab/core/hdf5_file.h"
 #include "draglab/core/xdmf.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace consumers {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "scene/scene_util.h"
 
 namespace draglab {

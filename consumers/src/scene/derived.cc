@@ -5,7 +5,7 @@
 #include <string>
 
 #include "draglab/consumers/scene.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "scene/scene_util.h"
 
 namespace draglab {

@@ -23,7 +23,7 @@
 #include <sstream>
 #include <vector>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "gas/mac_operators.h"
 #include "gas/mac_pressure.h"
 #include "scene/scene_util.h"

@@ -15,7 +15,7 @@
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
 #include "draglab/core/text.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 #include "io/dpm_output.h"
 #include "tfm/tfm.h"
 #include "tfm/tfm_scene.h"

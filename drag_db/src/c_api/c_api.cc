@@ -19,9 +19,9 @@
 
 #include "drag_db_version.h"
 #include "draglab/drag_db/database.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/export.h"
 #include "draglab/drag_db/law.h"
+#include "draglab/error.h"
 
 struct draglab_db {
   std::unique_ptr<draglab::Database> db;

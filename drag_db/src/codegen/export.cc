@@ -20,8 +20,8 @@
 
 #include "codegen/expr.h"
 #include "drag_db_version.h"
-#include "draglab/drag_db/error.h"
 #include "draglab/drag_db/law_form.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

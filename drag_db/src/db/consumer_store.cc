@@ -14,7 +14,7 @@
 #include "draglab/drag_db/consumer_results.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

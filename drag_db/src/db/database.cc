@@ -23,7 +23,7 @@
 #include "db/schema.h"
 #include "db/sqlite_util.h"
 #include "drag_db_version.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 void check_law_name(const std::string& name) {

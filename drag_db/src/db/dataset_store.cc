@@ -20,7 +20,7 @@
 #include "drag_db_version.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/dataset.h"
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace {

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <string>
 
-#include "draglab/drag_db/error.h"
+#include "draglab/error.h"
 
 namespace draglab {
 namespace db {

@@ -1,4 +1,4 @@
-// draglab/drag_db/error.h: the one exception type of the draglab C++ API.
+// draglab/error.h: the one exception type of draglab (its C++ API and every module).
 //
 // Every failure carries an ErrorCode so that the C ABI (draglab.h) can map it to an integer
 // status and the CLI to an exit code (bad input -> 2, everything else -> 1).
