@@ -237,6 +237,69 @@ TEST_F(TfmTest, SedimentingColumnReachesThePackingLimitWithoutOvershoot) {
   EXPECT_GT(dg.packing_limited_cells, 0) << "the limiter, not the solids pressure, stopped them";
 }
 
+// Every step of the sedimenting column above, stage by stage (TfmStepStages), while it
+// settles onto its packed bottom: what each stage guarantees, checked on what it left. Both phases
+// are incompressible, so the mixture volume flux eps u + phi v that the pressure equation makes is
+// divergence-free in every cell (no inflow here); the direct LDLT solve leaves round-off,
+// 1e-10 of the largest solids volume flux. The flux limiter then cuts the solids inflow into
+// cells at the packing limit and hands that volume to the gas on the same face: the mixture
+// flux stays divergence-free and the new phi stays in [0, packing_limit].
+TEST_F(TfmTest, StepStagesKeepTheMixtureFluxDivergenceFreeAndTheLimiterBoundsPhi) {
+  TfmOptions o = column(4, 40, 0.04, 0.2);
+  o.particle_diameter_m = 5e-4;
+  o.initial_solids = 0.3;
+  o.initial_bed_height_m = 0.12;
+  o.initial_theta_m2_s2 = 1e-4;
+  TfmSimulation tfm(o, law("ergun@1"));
+  // Net mixture outflow of the worst cell over the largest solids volume flux a face could
+  // carry (its speed times the face; the mixture flux is what cancels between the phases).
+  auto max_divergence = [&tfm](const TfmStepStages& st) {
+    const Eigen::ArrayXXd &fx = st.mixture_flux_x(), &fz = st.mixture_flux_z();
+    const double scale = std::max(tfm.solids_u().abs().maxCoeff() * tfm.dz(),
+                                  tfm.solids_w().abs().maxCoeff() * tfm.dx());
+    double worst = 0.0;
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const double net = fx(i + 1, j) - fx(i, j) + fz(i, j + 1) - fz(i, j);
+        worst = std::max(worst, std::abs(net) / scale);
+      }
+    return worst;
+  };
+  double worst_projected = 0.0, worst_limited = 0.0, phi_min = 1.0, phi_max = 0.0;
+  int limiting_steps = 0;
+  while (tfm.time() < 0.5) {
+    const long limited_before = tfm.diagnostics().packing_limited_cells;
+    TfmStepStages st(tfm);
+    ASSERT_GT(st.ChooseStep(), 0.0);
+    st.DragCoefficients();
+    st.SolidsStress();
+    st.PredictFaces();
+    st.SolvePressure();
+    st.Project();
+    st.SolidsFluxes();
+    worst_projected = std::max(worst_projected, max_divergence(st));
+    st.ImplicitSolidsPressure();
+    st.LimitSolidsFluxes();
+    st.CorrectLimitedFaces();
+    worst_limited = std::max(worst_limited, max_divergence(st));
+    phi_min = std::min(phi_min, st.new_solids_fraction().minCoeff());
+    phi_max = std::max(phi_max, st.new_solids_fraction().maxCoeff());
+    st.UpdateGranularTemperature();
+    st.Record();
+    if (tfm.diagnostics().packing_limited_cells > limited_before) ++limiting_steps;
+  }
+  EXPECT_GT(tfm.beta().maxCoeff(), 0.0);
+  EXPECT_LT(worst_projected, 1e-10);
+  EXPECT_LT(worst_limited, 1e-10);
+  EXPECT_GE(phi_min, 0.0);
+  EXPECT_LE(phi_max, o.ktgf.packing_limit + 1e-12);
+  EXPECT_GT(limiting_steps, 0) << "the limiter never acted: the check of its bounds is void";
+  std::printf(
+      "[ stages ] %ld steps, %d with the packing limiter; largest relative divergence "
+      "%.2e after the projection, %.2e after the limiter\n",
+      tfm.diagnostics().steps, limiting_steps, worst_projected, worst_limited);
+}
+
 // The same column with Johnson-Jackson friction: the frictional pressure, not the limit, now
 // carries the settled bed. Reference: at rest, the contact pressure at the bottom cell carries
 // the buoyant weight of the solids above its centre, so the bottom phi solves

@@ -550,25 +550,63 @@ void TfmSimulation::AdvanceTo(double t_end) {
 }
 
 double TfmSimulation::StepCapped(double dt_cap) {
-  Impl& m = *impl_;
-  Impl::Step s(opt_, m.nx, m.nz, m.time);
-  m.ChooseStep(s, dt_cap);
-  m.DragCoefficients(s, *law_);
-  m.SolidsStress(s);
-  m.PredictXFaces(s);
-  m.PredictZFaces(s);
-  m.SolvePressure(s);
-  m.Project(s);
-  m.SolidsFluxes(s);
-  if (opt_.solids_pressure == SolidsPressure::kImplicit) m.ImplicitSolidsPressure(s);
-  m.LimitSolidsFluxes(s);
-  m.CorrectLimitedFaces(s);
-  const Array theta_new = opt_.granular_temperature == GranularTemperature::kAlgebraic
-                              ? m.EquilibriumTheta(s)
-                              : m.TransportedTheta(s);
-  m.Record(s, theta_new);
-  return s.dt;
+  TfmStepStages stages(*this, dt_cap);
+  stages.ChooseStep();
+  stages.DragCoefficients();
+  stages.SolidsStress();
+  stages.PredictFaces();
+  stages.SolvePressure();
+  stages.Project();
+  stages.SolidsFluxes();
+  stages.ImplicitSolidsPressure();
+  stages.LimitSolidsFluxes();
+  stages.CorrectLimitedFaces();
+  stages.UpdateGranularTemperature();
+  stages.Record();
+  return stages.dt();
 }
+
+struct TfmStepStages::State {
+  State(const TfmOptions& o, const TfmSimulation::Impl& m) : step(o, m.nx, m.nz, m.time) {}
+  TfmSimulation::Impl::Step step;
+  Array theta_new;
+};
+
+TfmStepStages::TfmStepStages(TfmSimulation& simulation, double dt_cap)
+    : sim_(simulation),
+      dt_cap_(dt_cap),
+      state_(std::make_unique<State>(simulation.opt_, *simulation.impl_)) {}
+TfmStepStages::~TfmStepStages() = default;
+
+double TfmStepStages::ChooseStep() {
+  sim_.impl_->ChooseStep(state_->step, dt_cap_);
+  return state_->step.dt;
+}
+void TfmStepStages::DragCoefficients() { sim_.impl_->DragCoefficients(state_->step, *sim_.law_); }
+void TfmStepStages::SolidsStress() { sim_.impl_->SolidsStress(state_->step); }
+void TfmStepStages::PredictFaces() {
+  sim_.impl_->PredictXFaces(state_->step);
+  sim_.impl_->PredictZFaces(state_->step);
+}
+void TfmStepStages::SolvePressure() { sim_.impl_->SolvePressure(state_->step); }
+void TfmStepStages::Project() { sim_.impl_->Project(state_->step); }
+void TfmStepStages::SolidsFluxes() { sim_.impl_->SolidsFluxes(state_->step); }
+void TfmStepStages::ImplicitSolidsPressure() {
+  if (sim_.opt_.solids_pressure == SolidsPressure::kImplicit)
+    sim_.impl_->ImplicitSolidsPressure(state_->step);
+}
+void TfmStepStages::LimitSolidsFluxes() { sim_.impl_->LimitSolidsFluxes(state_->step); }
+void TfmStepStages::CorrectLimitedFaces() { sim_.impl_->CorrectLimitedFaces(state_->step); }
+void TfmStepStages::UpdateGranularTemperature() {
+  state_->theta_new = sim_.opt_.granular_temperature == GranularTemperature::kAlgebraic
+                          ? sim_.impl_->EquilibriumTheta(state_->step)
+                          : sim_.impl_->TransportedTheta(state_->step);
+}
+void TfmStepStages::Record() { sim_.impl_->Record(state_->step, state_->theta_new); }
+double TfmStepStages::dt() const { return state_->step.dt; }
+const Array& TfmStepStages::mixture_flux_x() const { return state_->step.mix_x; }
+const Array& TfmStepStages::mixture_flux_z() const { return state_->step.mix_z; }
+const Array& TfmStepStages::new_solids_fraction() const { return state_->step.phi_new; }
 
 /// The closures and the time step: the stable step (or the fixed one, checked against it),
 /// capped to land on an output time.

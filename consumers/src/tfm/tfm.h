@@ -35,6 +35,7 @@
 
 #include <Eigen/Core>
 
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -188,12 +189,65 @@ class TfmSimulation {
   double PressureDrop(double z_low, double z_high) const;
 
  private:
+  friend class TfmStepStages;
   /// One step of min(stable, dt_cap) (or the fixed step); returns its length.
   double StepCapped(double dt_cap);
   struct Impl;
   TfmOptions opt_;
   std::shared_ptr<const Law> law_;
   std::unique_ptr<Impl> impl_;
+};
+
+/// One step of a TfmSimulation as its stages, each a call: TfmSimulation::Step runs them all in
+/// this order; a test runs them one by one and looks at what a stage left. A stage called out of
+/// order is a bug of the caller (each reads what the earlier ones computed).
+class TfmStepStages {
+ public:
+  /// Begins a step of at most dt_cap seconds on `simulation` (which it changes from Project on).
+  explicit TfmStepStages(TfmSimulation& simulation,
+                         double dt_cap = std::numeric_limits<double>::infinity());
+  ~TfmStepStages();
+  TfmStepStages(const TfmStepStages&) = delete;
+  TfmStepStages& operator=(const TfmStepStages&) = delete;
+
+  /// The closures and the step (stable, fixed or landing on dt_cap); returns it [s].
+  double ChooseStep();
+  /// beta of every cell from the law (the simulation's beta()).
+  void DragCoefficients();
+  /// The granular stresses at cell centres and corners.
+  void SolidsStress();
+  /// Both phases' face velocities without the new pressure gradient (drag eliminated).
+  void PredictFaces();
+  /// The mixture pressure equation (the new pressure()).
+  void SolvePressure();
+  /// The face velocities with the new pressure gradient (gas_u() ... solids_w()).
+  void Project();
+  /// The solids and mixture volume fluxes of every face.
+  void SolidsFluxes();
+  /// The implicit granular-pressure increment (SolidsPressure::kImplicit; else nothing).
+  void ImplicitSolidsPressure();
+  /// The solids fluxes limited to keep phi in [0, packing_limit] (the gas takes the volume).
+  void LimitSolidsFluxes();
+  /// The limited faces' velocities made consistent with their fluxes.
+  void CorrectLimitedFaces();
+  /// The new granular temperature (transported or algebraic, as the options say).
+  void UpdateGranularTemperature();
+  /// The new state, the time and the diagnostics.
+  void Record();
+
+  double dt() const;
+  /// Mixture volume fluxes [m^2/s per unit depth] through the x-faces ((nx+1) x nz) and z-faces
+  /// (nx x (nz+1)) after SolidsFluxes (and after the limiter, which holds them).
+  const Eigen::ArrayXXd& mixture_flux_x() const;
+  const Eigen::ArrayXXd& mixture_flux_z() const;
+  /// The solids fraction the step leads to (after LimitSolidsFluxes).
+  const Eigen::ArrayXXd& new_solids_fraction() const;
+
+ private:
+  TfmSimulation& sim_;
+  double dt_cap_;
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 }  // namespace consumers
