@@ -256,6 +256,58 @@ TEST(DbmValidation, GasVolumeBalancesWithAndWithoutCoalescence) {
   }
 }
 
+// The same column, step by step and stage by stage (DbmStepStages): each bubble stage keeps
+// the gas balance on its own. InjectBubbles adds exactly flow x dt to the forming and released
+// gas (no start-up ramp here), MoveBubbles and the interactions leave the bubbles' volume alone
+// (coalescence sums volumes), RemoveLeavingBubbles moves what leaves into gas_left_m3; the
+// emulsion stages then hold the convective limit the fixed step was chosen for. 1e-12: the
+// sums of a few hundred bubble volumes in double.
+TEST(DbmValidation, EachBubbleStageKeepsTheGasBalance) {
+  DbmOptions o = Column(6);
+  o.height_m = 0.6;
+  o.nz = 6;
+  o.bubble_diameter_m = 0.03;
+  o.nozzles = square_nozzle_array(3, 0.1, o.width_m, o.depth_m);
+  o.bubble_gas_flow_m3_s = 0.01 * o.width_m * o.depth_m;
+  o.coalescence = true;
+  o.dt_s = 5e-3;
+  DbmSimulation dbm(o);
+  const double tol = 1e-12 * o.bubble_gas_flow_m3_s * 4.0;  // of the gas injected in the run
+  auto gas = [&dbm] { return dbm.gas_in_bubbles_m3() + dbm.gas_forming_m3(); };
+  double worst = 0.0, largest_cfl = 0.0;
+  for (int step = 0; step < 800; ++step) {  // 4 s
+    DbmStepStages st(dbm, o.dt_s);
+    st.SampleEmulsion();
+    double before = gas();
+    st.InjectBubbles();
+    worst = std::max(worst, std::abs(gas() - before - o.bubble_gas_flow_m3_s * o.dt_s));
+    before = gas();
+    st.MoveBubbles();
+    worst = std::max(worst, std::abs(gas() - before));
+    before = gas();
+    const double left_before = dbm.diagnostics().gas_left_m3;
+    st.RemoveLeavingBubbles();
+    worst = std::max(worst, std::abs(gas() + dbm.diagnostics().gas_left_m3 - before - left_before));
+    before = gas();
+    st.BubbleInteractions();
+    worst = std::max(worst, std::abs(gas() - before));
+    st.DepositFractions();
+    st.BubbleMobility();
+    st.PredictEmulsion();
+    st.SolveEmulsionPressure();
+    largest_cfl = std::max(largest_cfl, st.CorrectEmulsionVelocities());
+    st.FollowPressureChange();
+    st.Finish();
+  }
+  const DbmDiagnostics& d = dbm.diagnostics();
+  EXPECT_GT(d.bubbles_left, 10);
+  EXPECT_GT(d.coalescences, 0);
+  EXPECT_LT(worst, tol);
+  EXPECT_LE(largest_cfl, 1.0);
+  std::printf("[ stages ] largest gas imbalance of a stage %.2e m^3, largest CFL %.3f\n", worst,
+              largest_cfl);
+}
+
 TEST(DbmValidation, CollidingBubblesAreSeparatedAndKeepTheirMomentum) {
   // Two bubbles released overlapping, side by side at the same height and velocity: the
   // collision pushes them apart along the line of centres, volume-weighted, so their

@@ -571,43 +571,79 @@ struct DbmSimulation::Projection {
 };
 
 double DbmSimulation::TakeStep(double dt) {
-  Impl& m = *impl_;
-  diag_.min_dt_s = diag_.steps == 0 ? dt : std::min(diag_.min_dt_s, dt);
-  const double t1 = time_ + dt;
+  DbmStepStages stages(*this, dt);
   const auto bubbles_start = std::chrono::steady_clock::now();
-  // Bubbles placed before the first step are the initial state, not a sudden displacement.
-  if (diag_.steps == 0) {
-    DepositFractions(false);
-    m.eps_e = m.eps_e_new;
-  }
-  SampleEmulsion(dt);
-  InjectBubbles(dt);
-  MoveBubbles(dt);
-  RemoveLeavingBubbles();
-  if (opt_.collisions && !opt_.coalescence && bubbles_.size() > 1) CollideBubbles();
-  if (opt_.coalescence && bubbles_.size() > 1) CoalesceBubbles(t1);
+  stages.SampleEmulsion();
+  stages.InjectBubbles();
+  stages.MoveBubbles();
+  stages.RemoveLeavingBubbles();
+  stages.BubbleInteractions();
   diag_.bubble_wall_s += Seconds(bubbles_start);
 
   const auto emulsion_start = std::chrono::steady_clock::now();
-  DepositFractions(true);
-  const std::vector<double> bubble_mobility = BubbleMobility(dt);
-  PredictEmulsion(dt);
-  const Projection projection = ProjectionCoefficients(dt);
-  const Eigen::VectorXd pressure_old = m.pressure;
-  SolveEmulsionPressure(dt, t1, projection);
-  int fastest_cell = 0;
-  const double cfl = CorrectEmulsionVelocities(dt, projection, &fastest_cell);
-  if (opt_.implicit_bubble_pressure && !bubbles_.empty()) {
-    FollowPressureChange(dt, m.pressure - pressure_old, bubble_mobility);
-    DepositFractions(false);
-  }
-  m.eps_e = m.eps_e_new;
-  diag_.max_cfl = std::max(diag_.max_cfl, cfl);
+  stages.DepositFractions();
+  stages.BubbleMobility();
+  stages.PredictEmulsion();
+  stages.SolveEmulsionPressure();
+  stages.CorrectEmulsionVelocities();
+  stages.FollowPressureChange();
   diag_.emulsion_wall_s += Seconds(emulsion_start);
-  time_ = t1;
-  diag_.steps += 1;
-  m.fastest_cell = fastest_cell;
-  return cfl;
+  stages.Finish();
+  return stages.cfl();
+}
+
+struct DbmStepStages::State {
+  std::vector<double> bubble_mobility;
+  DbmSimulation::Projection projection;
+  Eigen::VectorXd pressure_old;
+};
+
+DbmStepStages::DbmStepStages(DbmSimulation& simulation, double dt)
+    : sim_(simulation), dt_(dt), t1_(simulation.time_ + dt), state_(std::make_unique<State>()) {
+  DbmDiagnostics& diag = sim_.diag_;
+  diag.min_dt_s = diag.steps == 0 ? dt : std::min(diag.min_dt_s, dt);
+  if (diag.steps == 0) {
+    sim_.DepositFractions(false);
+    sim_.impl_->eps_e = sim_.impl_->eps_e_new;
+  }
+}
+DbmStepStages::~DbmStepStages() = default;
+
+void DbmStepStages::SampleEmulsion() { sim_.SampleEmulsion(dt_); }
+void DbmStepStages::InjectBubbles() { sim_.InjectBubbles(dt_); }
+void DbmStepStages::MoveBubbles() { sim_.MoveBubbles(dt_); }
+void DbmStepStages::RemoveLeavingBubbles() { sim_.RemoveLeavingBubbles(); }
+void DbmStepStages::BubbleInteractions() {
+  const DbmOptions& o = sim_.opt_;
+  if (o.collisions && !o.coalescence && sim_.bubbles_.size() > 1) sim_.CollideBubbles();
+  if (o.coalescence && sim_.bubbles_.size() > 1) sim_.CoalesceBubbles(t1_);
+}
+void DbmStepStages::DepositFractions() { sim_.DepositFractions(true); }
+void DbmStepStages::BubbleMobility() { state_->bubble_mobility = sim_.BubbleMobility(dt_); }
+void DbmStepStages::PredictEmulsion() { sim_.PredictEmulsion(dt_); }
+void DbmStepStages::SolveEmulsionPressure() {
+  state_->projection = sim_.ProjectionCoefficients(dt_);
+  state_->pressure_old = sim_.impl_->pressure;
+  sim_.SolveEmulsionPressure(dt_, t1_, state_->projection);
+}
+double DbmStepStages::CorrectEmulsionVelocities() {
+  cfl_ = sim_.CorrectEmulsionVelocities(dt_, state_->projection, &fastest_cell_);
+  return cfl_;
+}
+void DbmStepStages::FollowPressureChange() {
+  if (sim_.opt_.implicit_bubble_pressure && !sim_.bubbles_.empty()) {
+    sim_.FollowPressureChange(dt_, sim_.impl_->pressure - state_->pressure_old,
+                              state_->bubble_mobility);
+    sim_.DepositFractions(false);
+  }
+}
+void DbmStepStages::Finish() {
+  DbmSimulation::Impl& m = *sim_.impl_;
+  m.eps_e = m.eps_e_new;
+  sim_.diag_.max_cfl = std::max(sim_.diag_.max_cfl, cfl_);
+  sim_.time_ = t1_;
+  sim_.diag_.steps += 1;
+  m.fastest_cell = fastest_cell_;
 }
 
 /// The bubble and emulsion fractions from the bubbles' mapped volumes (fraction clamps and the

@@ -246,6 +246,7 @@ class DbmSimulation {
   double top_outflow_m3_s() const;
 
  private:
+  friend class DbmStepStages;
   struct Impl;
   DbmOptions opt_;
   BubbleForceModel force_;
@@ -276,6 +277,54 @@ class DbmSimulation {
                             const std::vector<double>& bubble_mobility);
   /// The time averages and bubble samples of the step just taken.
   void Accumulate(double dt);
+};
+
+/// One step of a DbmSimulation as its stages, each a call: DbmSimulation::Step runs them in this
+/// order (the bubbles', then the emulsion's); a test runs them one by one and looks at what a
+/// stage left. A stage called out of order is a bug of the caller.
+class DbmStepStages {
+ public:
+  /// Begins a step of dt seconds on `simulation` (the first step of a run deposits the initial
+  /// bubbles' fractions first: they are the initial state, not a displacement).
+  DbmStepStages(DbmSimulation& simulation, double dt);
+  ~DbmStepStages();
+  DbmStepStages(const DbmStepStages&) = delete;
+  DbmStepStages& operator=(const DbmStepStages&) = delete;
+
+  /// The emulsion velocity and pressure each bubble feels.
+  void SampleEmulsion();
+  /// The nozzles' gas into forming bubbles, released at the bubble diameter.
+  void InjectBubbles();
+  /// Bubble motion (drag implicit) and each bubble's force on the emulsion.
+  void MoveBubbles();
+  /// Bubbles that reached the bed surface leave (their gas counted).
+  void RemoveLeavingBubbles();
+  /// Collisions or coalescence, as the options say.
+  void BubbleInteractions();
+  /// The bubble and emulsion fractions from the bubbles' volumes.
+  void DepositFractions();
+  /// Each bubble's response to a pressure change (the implicit bubble pressure).
+  void BubbleMobility();
+  /// The emulsion momentum without the new pressure.
+  void PredictEmulsion();
+  /// The projection's face coefficients, then the pressure equation.
+  void SolveEmulsionPressure();
+  /// The emulsion velocities with the new pressure; returns the CFL number reached.
+  double CorrectEmulsionVelocities();
+  /// The bubbles follow the pressure change (implicit bubble pressure; else nothing).
+  void FollowPressureChange();
+  /// The new emulsion fraction, the time and the diagnostics.
+  void Finish();
+
+  double cfl() const { return cfl_; }
+
+ private:
+  DbmSimulation& sim_;
+  double dt_, t1_;
+  double cfl_ = 0.0;
+  int fastest_cell_ = 0;
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 }  // namespace consumers
