@@ -233,16 +233,22 @@ TEST(DbmValidation, AMergerDisplacesTheEmulsionNoFasterThanARisingBubble) {
   EXPECT_LT(merger, 2.0 * single) << "merger " << merger << " m^3, single " << single << " m^3";
 }
 
+/// A 0.6 m cube fed by 3 x 3 nozzles of 3 cm bubbles (0.01 m/s of bubble gas), 5 ms steps.
+DbmOptions FedColumn(bool coalescence) {
+  DbmOptions o = Column(6);
+  o.height_m = 0.6;
+  o.nz = 6;
+  o.bubble_diameter_m = 0.03;
+  o.nozzles = square_nozzle_array(3, 0.1, o.width_m, o.depth_m);
+  o.bubble_gas_flow_m3_s = 0.01 * o.width_m * o.depth_m;
+  o.coalescence = coalescence;
+  o.dt_s = 5e-3;
+  return o;
+}
+
 TEST(DbmValidation, GasVolumeBalancesWithAndWithoutCoalescence) {
   for (bool coalescence : {false, true}) {
-    DbmOptions o = Column(6);
-    o.height_m = 0.6;
-    o.nz = 6;
-    o.bubble_diameter_m = 0.03;
-    o.nozzles = square_nozzle_array(3, 0.1, o.width_m, o.depth_m);
-    o.bubble_gas_flow_m3_s = 0.01 * o.width_m * o.depth_m;
-    o.coalescence = coalescence;
-    o.dt_s = 5e-3;
+    const DbmOptions o = FedColumn(coalescence);
     DbmSimulation dbm(o);
     dbm.AdvanceTo(4.0);
     const DbmDiagnostics& d = dbm.diagnostics();
@@ -263,14 +269,7 @@ TEST(DbmValidation, GasVolumeBalancesWithAndWithoutCoalescence) {
 // emulsion stages then hold the convective limit the fixed step was chosen for. 1e-12: the
 // sums of a few hundred bubble volumes in double.
 TEST(DbmValidation, EachBubbleStageKeepsTheGasBalance) {
-  DbmOptions o = Column(6);
-  o.height_m = 0.6;
-  o.nz = 6;
-  o.bubble_diameter_m = 0.03;
-  o.nozzles = square_nozzle_array(3, 0.1, o.width_m, o.depth_m);
-  o.bubble_gas_flow_m3_s = 0.01 * o.width_m * o.depth_m;
-  o.coalescence = true;
-  o.dt_s = 5e-3;
+  const DbmOptions o = FedColumn(true);
   DbmSimulation dbm(o);
   const double tol = 1e-12 * o.bubble_gas_flow_m3_s * 4.0;  // of the gas injected in the run
   auto gas = [&dbm] { return dbm.gas_in_bubbles_m3() + dbm.gas_forming_m3(); };

@@ -81,15 +81,20 @@ class TfmTest : public ::testing::Test {
     o.initial_bed_height_m = 0.0;
     return o;
   }
-  /// The sedimenting column with Johnson-Jackson friction: 4 x 40 cells of 1 x 5 mm, 500 um
-  /// glass at phi = 0.3 up to 0.12 m (0.036 m of solids), theta0 = 1e-4 m^2/s^2.
-  static TfmOptions friction_column() {
+  /// The sedimenting column: 4 x 40 cells of 1 x 5 mm, 500 um glass at phi = 0.3 up to
+  /// 0.12 m (0.036 m of solids), theta0 = 1e-4 m^2/s^2, no inflow.
+  static TfmOptions sedimenting_column() {
     TfmOptions o = column(4, 40, 0.04, 0.2);
     o.particle_diameter_m = 5e-4;
-    o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
     o.initial_solids = 0.3;
     o.initial_bed_height_m = 0.12;
     o.initial_theta_m2_s2 = 1e-4;
+    return o;
+  }
+  /// The same with Johnson-Jackson friction.
+  static TfmOptions friction_column() {
+    TfmOptions o = sedimenting_column();
+    o.ktgf.friction = FrictionModel::kJohnsonJacksonSchaeffer;
     return o;
   }
   /// The bottom cell's phi of that column at rest: its frictional pressure carries the buoyant
@@ -212,11 +217,7 @@ TEST_F(TfmTest, BedAtMinimumFluidizationRestsAndCarriesItsWeight) {
 // the solids volume over the limit, within two cells (the surface row is partly filled);
 // (4) solids mass conserved to round-off (1e-12) and the gas mass balance to 1e-12 kg.
 TEST_F(TfmTest, SedimentingColumnReachesThePackingLimitWithoutOvershoot) {
-  TfmOptions o = column(4, 40, 0.04, 0.2);
-  o.particle_diameter_m = 5e-4;
-  o.initial_solids = 0.3;
-  o.initial_bed_height_m = 0.12;
-  o.initial_theta_m2_s2 = 1e-4;
+  const TfmOptions o = sedimenting_column();
   TfmSimulation tfm(o, law("ergun@1"));
   tfm.AdvanceTo(1.5);
   const TfmDiagnostics& dg = tfm.diagnostics();
@@ -245,11 +246,7 @@ TEST_F(TfmTest, SedimentingColumnReachesThePackingLimitWithoutOvershoot) {
 // cells at the packing limit and hands that volume to the gas on the same face: the mixture
 // flux stays divergence-free and the new phi stays in [0, packing_limit].
 TEST_F(TfmTest, StepStagesKeepTheMixtureFluxDivergenceFreeAndTheLimiterBoundsPhi) {
-  TfmOptions o = column(4, 40, 0.04, 0.2);
-  o.particle_diameter_m = 5e-4;
-  o.initial_solids = 0.3;
-  o.initial_bed_height_m = 0.12;
-  o.initial_theta_m2_s2 = 1e-4;
+  const TfmOptions o = sedimenting_column();
   TfmSimulation tfm(o, law("ergun@1"));
   // Net mixture outflow of the worst cell over the largest solids volume flux a face could
   // carry (its speed times the face; the mixture flux is what cancels between the phases).
@@ -397,11 +394,7 @@ TEST_F(TfmTest, ImplicitSolidsPressureLetsAFrictionalBedRestBeyondTheWaveLimit) 
 // limit, conserves both phases to round-off and settles it to the same height (the solids volume
 // over the limit, within two cells).
 TEST_F(TfmTest, ImplicitSolidsPressureSettlesAColumnToThePackingLimit) {
-  TfmOptions o = column(4, 40, 0.04, 0.2);
-  o.particle_diameter_m = 5e-4;
-  o.initial_solids = 0.3;
-  o.initial_bed_height_m = 0.12;
-  o.initial_theta_m2_s2 = 1e-4;
+  TfmOptions o = sedimenting_column();
   o.solids_pressure = SolidsPressure::kImplicit;
   TfmSimulation tfm(o, law("ergun@1"));
   tfm.AdvanceTo(1.5);
