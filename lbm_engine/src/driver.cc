@@ -938,8 +938,9 @@ class RunChecks {
       if (sc_.stokes) {
         if (std::abs(re_ratio - 1.0) > options_.re_tolerance / 3.0) {
           // exact: the Stokes-mode scheme is linear in G
-          solver_->scale_deviations(1.0 / re_ratio);
-          SetForce(loop_.force / re_ratio);
+          const double velocity_factor = 1.0 / re_ratio;
+          solver_->scale_deviations(velocity_factor);
+          SetForce(loop_.force * velocity_factor);
           ++loop_.adjustments;
           return Next::kNextCheck;
         }
