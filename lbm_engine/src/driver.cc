@@ -232,23 +232,26 @@ std::string diverged_diagnosis(const SparseLattice& lattice, const RunOptions& o
 }
 
 /// The accuracy rules of resolution.h at the run's phi and Re: d below the gap or boundary-layer
-/// bound widens the discretisation estimate by (bound / d)^order (1 for halfway bounce-back, 2
-/// for an interpolated wall: the error's scaling with the nodes across the thinnest layer), and
-/// the run says so.
+/// bound widens the discretisation estimate (widen_for_resolution of error_model.h), and the run
+/// says so.
 void widen_for_resolution(const RunOptions& options, double d, RunResult* result) {
   const ResolutionNeed need =
       resolution_needed(result->phi, result->re, options.collision, result->final_pore_speed_ratio);
   result->resolution_needed = need.d;
-  const double accuracy = std::max(need.gaps, need.boundary_layer);
-  if (d >= accuracy) return;
-  const double order = options.boundary == Boundary::kHalfwayBounceBack ? 1.0 : 2.0;
-  const double factor = std::pow(accuracy / d, order);
-  result->discretisation_error *= factor;
-  result->warnings.push_back(
-      "under-resolved: d = " + fmt("%.4g", d) + " is below " + fmt("%.3g", accuracy) + " (" +
-      (need.boundary_layer > need.gaps ? "the boundary layer" : "the pores") +
-      " span too few nodes; " + need.Summary() + "): the discretisation estimate is widened x" +
-      fmt("%.3g", factor) + "; extrapolate in d");
+  const ResolutionWidening w =
+      widen_for_resolution(result->discretisation_error, d, need, options.boundary);
+  if (w.factor == 1.0) return;
+  result->discretisation_error = w.error;
+  std::string how = "widened x" + fmt("%.3g", w.factor);
+  if (w.error == w.floor) {
+    how = "set to " + fmt("%.3g", 100.0 * w.floor) +
+          " % (the layer's missing nodes squared: below the rule the flow itself can change)";
+  }
+  result->warnings.push_back("under-resolved: d = " + fmt("%.4g", d) + " is below " +
+                             fmt("%.3g", std::max(need.gaps, need.boundary_layer)) + " (" +
+                             (w.boundary_layer ? "the boundary layer" : "the pores") +
+                             " span too few nodes; " + need.Summary() +
+                             "): the discretisation estimate is " + how + "; extrapolate in d");
 }
 
 /// This rank's checkpoint file (RunOptions::checkpoint).
