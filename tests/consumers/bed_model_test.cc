@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dpm/dpm_scene.h"
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
@@ -265,7 +266,7 @@ TEST(BedModel, TimeResolutionHooksSetTheValueThatSetsTheStep) {
   EXPECT_TRUE(dpm.time_resolution().whole_number);
   const Scene finer = dpm.WithTimeResolution(scene, 40);
   EXPECT_EQ(dpm.time_resolution_of(finer), 40.0);
-  EXPECT_EQ(finer.time.dem_dt_s, 0.0);  // so that contact_steps alone sets the DEM step
+  EXPECT_EQ(dem_section(finer).dem_dt_s, 0.0);  // so that contact_steps alone sets the DEM step
   EXPECT_TRUE(finer.IsValid(nullptr));
   EXPECT_FALSE(dpm.WithTimeResolution(scene, 10).IsValid(nullptr));  // below the DEM limit 20
 

@@ -59,6 +59,7 @@
 #include <string>
 #include <vector>
 
+#include "dpm/dpm_scene.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/error.h"
@@ -161,7 +162,7 @@ TEST_F(DpmCouplingTest, FluidizedBedPressureDropEqualsBedWeight) {
   // Frictionless: in a section of 12 x 3 diameters a frictional bed jams and hangs on the walls
   // (Janssen), lifted as a plug; the reference W/A assumes no wall support, and the check is of
   // the gas-particle coupling, not of wall jamming.
-  scene.particles.friction = 0.0;
+  dem_section(scene).friction = 0.0;
   const auto law = ergun();
   const double umf = minimum_fluidization(*law, scene.particles, scene.gas, {}).umf_m_s;
   DpmOptions o;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "dpm/dpm_scene.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/error.h"
 #include "tfm/tfm_scene.h"
@@ -57,8 +58,8 @@ TEST(SceneParse, SeedSceneDeclaresTheSeedBed) {
   EXPECT_DOUBLE_EQ(s.geometry.depth_m, 0.015);
   EXPECT_DOUBLE_EQ(s.particles.diameter_m, 2.5e-3);
   EXPECT_DOUBLE_EQ(s.particles.density_kg_m3, 2526.0);
-  EXPECT_DOUBLE_EQ(s.particles.restitution, 0.97);
-  EXPECT_DOUBLE_EQ(s.particles.friction, 0.1);
+  EXPECT_DOUBLE_EQ(dem_section(s).restitution, 0.97);
+  EXPECT_DOUBLE_EQ(dem_section(s).friction, 0.1);
   EXPECT_DOUBLE_EQ(s.gas.density_kg_m3, 1.2);
   EXPECT_DOUBLE_EQ(s.gas.viscosity_pa_s, 1.8e-5);
   EXPECT_DOUBLE_EQ(s.bed_height_mf_m(), 0.22);
@@ -86,12 +87,12 @@ TEST(SceneParse, TinySceneDeclaresTheTestBed) {
   EXPECT_DOUBLE_EQ(s.geometry.height_m, 0.09);
   EXPECT_DOUBLE_EQ(s.geometry.depth_m, 0.0075);
   EXPECT_DOUBLE_EQ(s.particles.diameter_m, 2.5e-3);
-  EXPECT_DOUBLE_EQ(s.particles.spring_stiffness_n_m, 7000.0);
+  EXPECT_DOUBLE_EQ(dem_section(s).spring_stiffness_n_m, 7000.0);
   EXPECT_DOUBLE_EQ(s.bed_height_mf_m(), 0.02);
   // N = 0.58 * 0.03 * 0.0075 * 0.02 / 8.181e-9 = 319.
   EXPECT_NEAR(static_cast<double>(s.particle_count()), 319.0, 1.0);
-  EXPECT_TRUE(s.dem_table);
-  EXPECT_EQ(s.time.contact_steps, 20);
+  EXPECT_TRUE(dem_section(s).present);
+  EXPECT_EQ(dem_section(s).contact_steps, 20);
   EXPECT_DOUBLE_EQ(s.time.duration_s, 0.06);
   EXPECT_DOUBLE_EQ(s.time.t_ref_s, 0.03);
   EXPECT_EQ(s.grid.cells_x, 4);
@@ -199,15 +200,29 @@ TEST(SceneParse, DemKeysInTheirOldSectionsStillParse) {
                "gas_dt_s = 0.0\nsettle_s = 0.3\ndem_dt_s = 0.0\n"
                "contact_steps = 20");
   const Scene a = parse_scene(old, "new.toml"), b = parse_scene(moved, "old.toml");
-  EXPECT_TRUE(a.dem_table);
-  EXPECT_FALSE(b.dem_table);
-  EXPECT_DOUBLE_EQ(a.particles.restitution, b.particles.restitution);
-  EXPECT_DOUBLE_EQ(a.particles.friction, b.particles.friction);
-  EXPECT_DOUBLE_EQ(a.particles.spring_stiffness_n_m, b.particles.spring_stiffness_n_m);
-  EXPECT_DOUBLE_EQ(a.time.settle_s, b.time.settle_s);
-  EXPECT_EQ(a.time.contact_steps, b.time.contact_steps);
+  const SceneDem &da = dem_section(a), &db = dem_section(b);
+  EXPECT_TRUE(da.present);
+  EXPECT_FALSE(db.present);
+  EXPECT_DOUBLE_EQ(da.restitution, db.restitution);
+  EXPECT_DOUBLE_EQ(da.friction, db.friction);
+  EXPECT_DOUBLE_EQ(da.spring_stiffness_n_m, db.spring_stiffness_n_m);
+  EXPECT_DOUBLE_EQ(da.settle_s, db.settle_s);
+  EXPECT_EQ(da.dem_dt_s, db.dem_dt_s);
+  EXPECT_EQ(da.contact_steps, db.contact_steps);
+  // Other values than the defaults reach the section from the older places too.
+  const Scene c = parse_scene(edit(edit(moved, "particles", "friction", "friction = 0.3"), "time",
+                                   "contact_steps", "contact_steps = 40"),
+                              "old.toml");
+  EXPECT_DOUBLE_EQ(dem_section(c).friction, 0.3);
+  EXPECT_EQ(dem_section(c).contact_steps, 40);
   expect_bad(edit(moved, "particles", "restitution", "restitution = 1.2"),
              {"[particles] restitution"});
+  expect_bad(edit(moved, "particles", "friction", "friction = 1.2"), {"[particles] friction"});
+  expect_bad(edit(moved, "time", "contact_steps", "contact_steps = 10"),
+             {"[time] contact_steps", "[20, 1000]"});
+  // A key in both places is refused, naming both.
+  expect_bad(edit(old, "particles", "bed_height_mf_m", "bed_height_mf_m = 0.22\nfriction = 0.1"),
+             {"friction", "[dem]", "[particles]", "only"});
 }
 
 TEST(SceneParse, EveryBadInputIsNamed) {

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "dpm/dpm_scene.h"
 #include "draglab/core/text.h"
 #include "draglab/error.h"
 #include "gas/particle_kernel.h"
@@ -149,11 +150,12 @@ DemOptions DpmSimulation::MakeDemOptions() const {
   DemOptions d;
   d.box_max = {s.geometry.width_m, s.geometry.height_m, s.geometry.depth_m};
   d.gravity = {0.0, -s.gas.gravity_m_s2, 0.0};
-  d.normal_stiffness = s.particles.spring_stiffness_n_m;
-  d.restitution = d.wall_restitution = s.particles.restitution;
-  d.friction = d.wall_friction = s.particles.friction;
-  d.dt = s.time.dem_dt_s;
-  d.min_steps_per_contact = s.time.contact_steps;
+  const SceneDem& dem = dem_section(s);
+  d.normal_stiffness = dem.spring_stiffness_n_m;
+  d.restitution = d.wall_restitution = dem.restitution;
+  d.friction = d.wall_friction = dem.friction;
+  d.dt = dem.dem_dt_s;
+  d.min_steps_per_contact = dem.contact_steps;
   return d;
 }
 
@@ -315,7 +317,7 @@ const DpmStepDiagnostics& DpmSimulation::Step() {
   if (!std::isfinite(diag.min_void_fraction) || eps_next.maxCoeff() > 1.0 + 1e-12)
     Fail("DPM: the mapped void fraction left (0, 1] at t = " + Num(m.time) +
          " s (non-finite or > 1): the particle state diverged; reduce the DEM step "
-         "(time.contact_steps) or the gas step (time.gas_dt_s)");
+         "([dem] contact_steps) or the gas step ([time] gas_dt_s)");
   for (int j = 0; j < nz; ++j)
     for (int i = 0; i < nx; ++i)
       if (eps_next(i, j) < opt_.min_void_fraction) {

@@ -12,6 +12,7 @@
 
 #include "bed/bed_sampling.h"
 #include "bed/builtin_models.h"
+#include "dpm/dpm_scene.h"
 #include "draglab/consumers/dpm.h"
 #include "draglab/core/text.h"
 #include "draglab/error.h"
@@ -35,13 +36,16 @@ class DpmBedModel : public BedModel {
     return "CFD-DEM: soft-sphere particles in a volume-averaged gas (dpm.h)";
   }
 
+  const SceneTable* scene_table() const override { return &dem_scene_table(); }
+
   BedModelSettings Settings(const Scene& scene) const override {
     // The contact model matters to the DEM only.
-    const double t_c = contact_time_s(scene.particles);
-    const double dem_dt = t_c / scene.time.contact_steps;
+    const double t_c = contact_time_s(scene);
+    const int contact_steps = dem_section(scene).contact_steps;
+    const double dem_dt = t_c / contact_steps;
     BedModelSettings s;
     s.line = "contact time t_c = " + Num(t_c) + " s -> DEM step " + Num(dem_dt) + " s (t_c/" +
-             std::to_string(scene.time.contact_steps) + ")";
+             std::to_string(contact_steps) + ")";
     s.numbers = {{"contact_time_s", t_c}, {"recommended_dem_dt_s", dem_dt}};
     return s;
   }
@@ -67,7 +71,9 @@ class DpmBedModel : public BedModel {
     return {"contact_steps", "DEM steps per contact time (the DEM step is t_c / contact_steps)",
             "[20, 1000]", /*whole_number=*/true, /*larger_is_finer=*/true};
   }
-  double time_resolution_of(const Scene& scene) const override { return scene.time.contact_steps; }
+  double time_resolution_of(const Scene& scene) const override {
+    return dem_section(scene).contact_steps;
+  }
   Scene WithTimeResolution(const Scene& scene, double value) const override {
     // The scene's own check names the range; a value beyond int must not wrap on the way there.
     if (!(std::abs(value) < 1e9)) {
@@ -75,8 +81,8 @@ class DpmBedModel : public BedModel {
                   "[dem] contact_steps = " + core::format_number(value) + " is outside [20, 1000]");
     }
     Scene s = scene;
-    s.time.contact_steps = static_cast<int>(value);
-    s.time.dem_dt_s = 0.0;  // the DEM step follows contact_steps
+    dem_section(s).contact_steps = static_cast<int>(value);
+    dem_section(s).dem_dt_s = 0.0;  // the DEM step follows contact_steps
     return s;
   }
 

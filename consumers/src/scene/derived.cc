@@ -42,8 +42,6 @@ SceneDerived derive_scene(const Scene& scene, const Law& law) {
   r.particle_response_s = rho_p * d * d / (18.0 * mu);
   r.gas_drag_relaxation_s = scene.eps_mf * rho / r.umf.beta_mf;
   r.solids_drag_relaxation_s = (1.0 - scene.eps_mf) * rho_p / r.umf.beta_mf;
-  r.contact_time_s = contact_time_s(scene.particles);
-  r.recommended_dem_dt_s = r.contact_time_s / scene.time.contact_steps;
   const double dx = scene.geometry.width_m / scene.grid.cells_x;
   const double dy = scene.geometry.height_m / scene.grid.cells_y;
   // Fastest gas: the jet's interstitial velocity in the bed, or the background in the bed.
@@ -69,8 +67,7 @@ std::string SceneDerived::BriefReport() const {
     << " m, Ar = " << fmt(archimedes) << ", U_mf = " << fmt(umf.umf_m_s)
     << " m/s (Re_mf = " << fmt(umf.re_mf) << "), background " << fmt(background_m_s)
     << " m/s, St = " << fmt(stokes_number) << ", drag relaxation gas " << fmt(gas_drag_relaxation_s)
-    << " s / solids " << fmt(solids_drag_relaxation_s) << " s, t_c = " << fmt(contact_time_s)
-    << " s, DEM dt " << fmt(recommended_dem_dt_s) << " s, gas dt " << fmt(recommended_gas_dt_s)
+    << " s / solids " << fmt(solids_drag_relaxation_s) << " s, gas dt " << fmt(recommended_gas_dt_s)
     << " s, D* = q/(pi U_mf) = " << fmt(leakage_bubble_diameter_m) << " m";
   return s.str();
 }

@@ -56,23 +56,6 @@ bool as_bool(const toml::node& n, const std::string& field, const std::string& a
   return core::toml_schema::boolean(n, field, at);
 }
 
-void read_contact_steps(Scene& s, const toml::node& n, const std::string& f,
-                        const std::string& at) {
-  const std::int64_t v = as_integer(n, f, at);
-  if (v < 20 || v > 1000) {
-    bad(at + ": " + f + " = " + std::to_string(v) +
-        " is outside [20, 1000] (DEM steps per contact time)");
-  }
-  s.time.contact_steps = static_cast<int>(v);
-}
-
-/// The DEM's keys: read from [dem] (the per-model table), or, in older scene files, from
-/// [particles] (restitution, friction, spring_stiffness_n_m) and [time] (settle_s, dem_dt_s,
-/// contact_steps). A key may stand in one of the two places only.
-const char* const kDemKeys[][2] = {
-    {"restitution", "particles"}, {"friction", "particles"}, {"spring_stiffness_n_m", "particles"},
-    {"settle_s", "time"},         {"dem_dt_s", "time"},      {"contact_steps", "time"}};
-
 template <typename Member>
 Key num(const std::string& name, Member member) {
   return {name, [member](Scene& s, const toml::node& n, const std::string& f,
@@ -122,9 +105,6 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                {num("diameter_m", [](S& s) -> double& { return s.particles.diameter_m; }),
                 num("density_kg_m3", [](S& s) -> double& { return s.particles.density_kg_m3; }),
                 num("restitution", [](S& s) -> double& { return s.particles.restitution; }),
-                num("friction", [](S& s) -> double& { return s.particles.friction; }),
-                num("spring_stiffness_n_m",
-                    [](S& s) -> double& { return s.particles.spring_stiffness_n_m; }),
                 {"count",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
                    s.particles.count = as_integer(n, f, at);
@@ -165,9 +145,6 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
               {"time",
                {num("duration_s", [](S& s) -> double& { return s.time.duration_s; }),
                 num("t_ref_s", [](S& s) -> double& { return s.time.t_ref_s; }),
-                num("settle_s", [](S& s) -> double& { return s.time.settle_s; }),
-                num("dem_dt_s", [](S& s) -> double& { return s.time.dem_dt_s; }),
-                {"contact_steps", read_contact_steps},
                 num("gas_dt_s", [](S& s) -> double& { return s.time.gas_dt_s; })}},
               {"grid",
                {{"cells_x",
@@ -209,14 +186,6 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                    s.outputs.particles = as_bool(n, f, at);
                  }},
                 num("interval_s", [](S& s) -> double& { return s.outputs.interval_s; })}},
-              {"dem",
-               {num("restitution", [](S& s) -> double& { return s.particles.restitution; }),
-                num("friction", [](S& s) -> double& { return s.particles.friction; }),
-                num("spring_stiffness_n_m",
-                    [](S& s) -> double& { return s.particles.spring_stiffness_n_m; }),
-                num("settle_s", [](S& s) -> double& { return s.time.settle_s; }),
-                num("dem_dt_s", [](S& s) -> double& { return s.time.dem_dt_s; }),
-                {"contact_steps", read_contact_steps}}},
               {"drag",
                {{"laws",
                  [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
@@ -238,8 +207,17 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
   return table;
 }
 
+/// A key of a model's table, read into the model's section.
+Key model_key(const SceneTable* table, const SceneKey& key) {
+  return {key.first, [table, read = key.second](Scene& s, const toml::node& n, const std::string& f,
+                                                const std::string& at) {
+            read(s.sections.Get(table->name, table->make), SceneValue(&n, f, at));
+          }};
+}
+
 /// The sections of a scene file: the shared ones, then each registered model's own table
-/// (BedModel::scene_table) before [drag].
+/// (BedModel::scene_table) before [drag]; a model's keys in their older places
+/// (SceneTable::older_places) join those shared tables.
 std::vector<std::pair<std::string, std::vector<Key>>> all_sections() {
   std::vector<std::pair<std::string, std::vector<Key>>> out = sections();
   std::vector<std::pair<std::string, std::vector<Key>>> tables;
@@ -247,11 +225,17 @@ std::vector<std::pair<std::string, std::vector<Key>>> all_sections() {
     const SceneTable* table = find_bed_model(model).scene_table();
     if (table == nullptr) continue;
     std::vector<Key> keys;
-    for (const auto& [name, read] : table->keys) {
-      keys.push_back({name, [table, read = read](Scene& s, const toml::node& n,
-                                                 const std::string& f, const std::string& at) {
-                        read(s.sections.Get(table->name, table->make), SceneValue(&n, f, at));
-                      }});
+    for (const SceneKey& key : table->keys) keys.push_back(model_key(table, key));
+    for (const auto& [name, older] : table->older_places) {
+      const auto key = std::find_if(table->keys.begin(), table->keys.end(),
+                                    [&name = name](const SceneKey& k) { return k.first == name; });
+      const auto shared = std::find_if(
+          out.begin(), out.end(), [&older = older](const auto& s) { return s.first == older; });
+      if (key == table->keys.end() || shared == out.end()) {
+        throw Error(ErrorCode::kInternal, "scene table [" + table->name + "]: " + name +
+                                              " has no key or older table [" + older + "]");
+      }
+      shared->second.push_back(model_key(table, *key));
     }
     tables.push_back({table->name, std::move(keys)});
   }
@@ -259,6 +243,18 @@ std::vector<std::pair<std::string, std::vector<Key>>> all_sections() {
       std::find_if(out.begin(), out.end(), [](const auto& s) { return s.first == "drag"; });
   out.insert(drag, tables.begin(), tables.end());
   return out;
+}
+
+/// A model's table that gives a key the file also gives in its older place: refused.
+void refuse_keys_in_two_places(const SceneTable& table, const toml::table& given,
+                               const toml::table& root, const std::string& at) {
+  for (const auto& [name, older] : table.older_places) {
+    const toml::table* old = root[older].as_table();
+    if (given.contains(name) && old != nullptr && old->contains(name)) {
+      bad(at + ": " + name + " is given in [" + table.name + "] and in [" + older +
+          "]: keep it in [" + table.name + "] only");
+    }
+  }
 }
 
 /// The model tables' checks, for every scene.
@@ -345,7 +341,10 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   ts::Schema names;
   for (const auto& [section, keys] : tables) {
     names.push_back({section, {}});
-    for (const Key& k : keys) names.back().second.push_back(k.name);
+    std::vector<std::string>& listed = names.back().second;
+    for (const Key& k : keys) {
+      if (std::find(listed.begin(), listed.end(), k.name) == listed.end()) listed.push_back(k.name);
+    }
   }
   Scene s;
   s.origin = origin;
@@ -354,20 +353,11 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
                               const std::string& at) {
     for (const std::string& model : bed_model_keys()) {
       const SceneTable* own = find_bed_model(model).scene_table();
-      if (own != nullptr && own->name == section)
-        s.sections.Get(own->name, own->make).present = true;
+      if (own == nullptr || own->name != section) continue;
+      s.sections.Get(own->name, own->make).present = true;
+      refuse_keys_in_two_places(*own, table, root, at);
     }
     s.tables.push_back(section);
-    if (section == "dem") {
-      s.dem_table = true;
-      for (const auto& key : kDemKeys) {
-        const toml::table* old = root[key[1]].as_table();
-        if (table.contains(key[0]) && old && old->contains(key[0])) {
-          bad(at + ": " + key[0] + " is given in [dem] and in [" + key[1] +
-              "]: keep it in [dem] only");
-        }
-      }
-    }
   };
   ts::visit(root, origin, names, on_section, [&](const ts::Entry& e) {
     for (const auto& [section, keys] : tables) {
@@ -394,11 +384,6 @@ Scene load_scene(const std::string& path) {
 }
 
 namespace {
-
-/// Where the DEM's keys stand in the scene's file (messages name the section the user wrote).
-std::string dem_at(const Scene& s, const char* old_section) {
-  return std::string(s.dem_table ? "[dem]" : old_section);
-}
 
 /// The scene's name and solver.
 bool name_and_solver_are_valid(const Scene& s, std::string* error) {
@@ -435,12 +420,8 @@ bool materials_are_valid(const Scene& s, std::string* error) {
   if (!in_range(d, 1e-6, 0.1, false, false, "[particles] diameter_m", "m", error)) return false;
   if (!in_range(s.particles.density_kg_m3, 0.0, 30000.0, true, false, "[particles] density_kg_m3",
                 "kg/m^3", error) ||
-      !in_range(s.particles.restitution, 0.0, 1.0, true, false,
-                dem_at(s, "[particles]") + " restitution", "", error) ||
-      !in_range(s.particles.friction, 0.0, 1.0, false, false,
-                dem_at(s, "[particles]") + " friction", "", error) ||
-      !in_range(s.particles.spring_stiffness_n_m, 0.0, 1e9, true, false,
-                dem_at(s, "[particles]") + " spring_stiffness_n_m", "N/m", error)) {
+      !in_range(s.particles.restitution, 0.0, 1.0, true, false, "[particles] restitution", "",
+                error)) {
     return false;
   }
   const double min_box = std::min({s.geometry.width_m, s.geometry.height_m, s.geometry.depth_m});
@@ -494,21 +475,6 @@ bool particle_inventory_is_valid(const Scene& s, std::string* error) {
     return fail(error, "[particles] count = " + std::to_string(s.particles.count) +
                            " is outside [1, 10000000]");
   }
-  if (s.solver == "dpm" && has_height) {
-    // The particle solver holds every particle: the count a bed height makes obeys the cap
-    // of [particles] count (checked in double: a tiny diameter overflows any integer).
-    const double n = (1.0 - s.eps_mf) * s.geometry.width_m * s.geometry.depth_m *
-                     s.particles.bed_height_mf_m /
-                     (std::acos(-1.0) / 6.0 * s.particles.diameter_m * s.particles.diameter_m *
-                      s.particles.diameter_m);
-    if (!(n <= 10000000.0)) {
-      return fail(error, "[particles] bed_height_mf_m = " + fmt(s.particles.bed_height_mf_m) +
-                             " m of diameter_m = " + fmt(s.particles.diameter_m) + " m makes " +
-                             fmt(n) +
-                             " particles, more than the 10000000 the DPM holds (a lower bed, "
-                             "larger particles or a narrower box)");
-    }
-  }
   const double h_mf = s.bed_height_mf_m();
   if (h_mf > s.geometry.height_m) {
     return fail(error, "[particles] count = " + std::to_string(s.particles.count) +
@@ -558,17 +524,9 @@ bool inflow_is_valid(const Scene& s, std::string* error) {
 bool times_are_valid(const Scene& s, std::string* error) {
   if (!in_range(s.time.duration_s, 0.0, 1e4, true, false, "[time] duration_s", "s", error) ||
       !in_range(s.time.t_ref_s, 0.0, 1e4, false, false, "[time] t_ref_s", "s", error) ||
-      !in_range(s.time.settle_s, 0.0, 1e4, false, false, dem_at(s, "[time]") + " settle_s", "s",
-                error) ||
-      !in_range(s.time.dem_dt_s, 0.0, 1.0, false, false, dem_at(s, "[time]") + " dem_dt_s",
-                "s (0 = auto)", error) ||
       !in_range(s.time.gas_dt_s, 0.0, 1.0, false, false, "[time] gas_dt_s", "s (0 = auto)",
                 error)) {
     return false;
-  }
-  if (s.time.contact_steps < 20 || s.time.contact_steps > 1000) {
-    return fail(error, dem_at(s, "[time]") + " contact_steps = " +
-                           std::to_string(s.time.contact_steps) + " is outside [20, 1000]");
   }
   if (s.jet.start_s + s.time.t_ref_s > s.time.duration_s * (1.0 + 1e-12)) {
     return fail(error, "[time] t_ref_s = " + fmt(s.time.t_ref_s) + " after the jet start " +
@@ -583,23 +541,6 @@ bool times_are_valid(const Scene& s, std::string* error) {
                            " gas steps for duration_s (more than 1e9): use 0 = auto, or a step "
                            ">= duration_s / 1e9 = " +
                            fmt(s.time.duration_s / kMaxSteps) + " s");
-  }
-  if (s.time.dem_dt_s > 0.0 &&
-      (s.time.settle_s + s.time.duration_s) / s.time.dem_dt_s > kMaxSteps) {
-    return fail(error, dem_at(s, "[time]") + " dem_dt_s = " + fmt(s.time.dem_dt_s) +
-                           " s would take " +
-                           fmt((s.time.settle_s + s.time.duration_s) / s.time.dem_dt_s) +
-                           " DEM steps for settle_s + duration_s (more than 1e9): use 0 = auto, "
-                           "or a step >= (settle_s + duration_s) / 1e9 = " +
-                           fmt((s.time.settle_s + s.time.duration_s) / kMaxSteps) + " s");
-  }
-  if (s.time.dem_dt_s > 0.0) {
-    const double limit = contact_time_s(s.particles) / 20.0;
-    if (s.time.dem_dt_s > limit) {
-      return fail(error, dem_at(s, "[time]") + " dem_dt_s = " + fmt(s.time.dem_dt_s) +
-                             " s is above the stability limit t_c/20 = " + fmt(limit) +
-                             " s of the contact model (use 0 = auto, or a smaller step)");
-    }
   }
   return true;
 }
@@ -644,10 +585,6 @@ bool grid_outputs_and_laws_are_valid(const Scene& s, std::string* error) {
     if (!seen.insert(s.laws[i]).second) {
       return fail(error, "[drag] laws lists '" + s.laws[i] + "' twice");
     }
-  }
-  if (s.dem_table && s.solver != "dpm") {
-    return fail(error, "[dem] is read only with solver = \"dpm\" (this scene's solver is \"" +
-                           s.solver + "\"): remove the table or change the solver");
   }
   if (s.range_policy != "clamp" && s.range_policy != "extrapolate" && s.range_policy != "error") {
     return fail(error, "[drag] range_policy = '" + s.range_policy +
@@ -705,16 +642,6 @@ double Scene::jet_center_m() const {
 }
 
 std::string Scene::hash() const { return sha256_hex(source_text); }
-
-double contact_time_s(const SceneParticles& p) {
-  const double d = p.diameter_m;
-  const double m_eff = 0.5 * p.density_kg_m3 * kPi * d * d * d / 6.0;
-  const double k = p.spring_stiffness_n_m;
-  const double log_e = std::log(p.restitution);
-  const double eta =
-      2.0 * std::sqrt(k * m_eff) * std::fabs(log_e) / std::sqrt(kPi * kPi + log_e * log_e);
-  return kPi / std::sqrt(k / m_eff - eta * eta / (4.0 * m_eff * m_eff));
-}
 
 }  // namespace consumers
 }  // namespace draglab

@@ -140,6 +140,10 @@ struct SceneTable {
   std::function<std::unique_ptr<SceneSection>()> make;
   /// The keys, in documentation order, and how each is read into the section.
   std::vector<SceneKey> keys;
+  /// Keys that older scene files give in a shared table, as {key, that table} (the DPM's
+  /// contact keys in [particles]): read into the section from there too. A key may stand in one
+  /// place only; a shared table's own key of that name is read as well.
+  std::vector<std::pair<std::string, std::string>> older_places;
   /// On failure *error names the field and the allowed range.
   std::function<bool(const Scene&, std::string*)> is_valid;
 };

@@ -31,6 +31,11 @@
 namespace draglab {
 namespace consumers {
 
+/// The DEM's linear spring-dashpot normal contact time between two of the scene's particles
+/// (reduced mass m/2; [dem] spring_stiffness_n_m and restitution): t_c = pi / sqrt(k/m_eff -
+/// eta^2/(4 m_eff^2)), eta = 2 sqrt(k m_eff) |ln e| / sqrt(pi^2 + ln^2 e).
+double contact_time_s(const Scene& scene);
+
 /// Run controls on top of the scene (tests and the CLI override a few scene values).
 struct DpmOptions {
   double duration_s = 0.0;  ///< Simulated time after t = 0; 0: the scene's duration, else > 0.

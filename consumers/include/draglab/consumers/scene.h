@@ -42,16 +42,14 @@ struct SceneGeometry {
   double depth_m = 0.0;
 };
 
-/// Monodisperse spheres and their contact model (linear spring-dashpot, Coulomb friction; the
-/// same coefficients for particle-wall contacts). Give exactly one of count and bed_height_mf_m.
+/// Monodisperse spheres. Give exactly one of count and bed_height_mf_m. (The DPM's contact
+/// model is its own table, [dem].)
 struct SceneParticles {
   double diameter_m = 0.0;
   double density_kg_m3 = 0.0;
-  double restitution = 0.97;             ///< Normal restitution coefficient, (0, 1].
-  double friction = 0.1;                 ///< Coulomb friction coefficient, [0, 1].
-  double spring_stiffness_n_m = 7000.0;  ///< Normal spring k_n [N/m] (consumers.md §3.5).
-  std::int64_t count = 0;                ///< Number of particles, or 0: from bed_height_mf_m.
-  double bed_height_mf_m = 0.0;          ///< Bed height at eps_mf, or 0: from count.
+  double restitution = 0.97;     ///< Normal restitution coefficient, (0, 1] (the TFM's default).
+  std::int64_t count = 0;        ///< Number of particles, or 0: from bed_height_mf_m.
+  double bed_height_mf_m = 0.0;  ///< Bed height at eps_mf, or 0: from count.
 };
 
 /// The gas (incompressible in the consumers: Mach << 0.1 at the jet velocities used).
@@ -96,9 +94,6 @@ struct SceneJet {
 struct SceneTime {
   double duration_s = 0.0;  ///< Simulated time after t = 0.
   double t_ref_s = 0.3;     ///< Snapshot time after jet start (the seed's 0.3 s).
-  double settle_s = 0.3;    ///< Settling under gravity (no gas flow) before t = 0.
-  double dem_dt_s = 0.0;    ///< DEM step, or 0: t_c / contact_steps.
-  int contact_steps = 20;   ///< DEM steps per contact time, >= 20.
   double gas_dt_s = 0.0;    ///< Gas step, or 0: recommended_gas_dt_s (SceneDerived).
 };
 
@@ -124,8 +119,8 @@ struct SceneOutputs {
   double interval_s = 0.0;  ///< Output spacing; 0: only the snapshot at t_ref.
 };
 
-/// A bed model's own table of a scene file ([tfm], [dbm]): the model defines its fields in its
-/// folder and reads and checks them through BedModel::scene_table (bed_model.h).
+/// A bed model's own table of a scene file ([dem], [tfm], [dbm]): the model defines its fields in
+/// its folder and reads and checks them through BedModel::scene_table (bed_model.h).
 class SceneSection {
  public:
   virtual ~SceneSection() = default;
@@ -205,9 +200,6 @@ struct Scene {
   SceneSections sections;
   /// The tables the file has (the DBM refuses those of the jet-driven models).
   std::vector<std::string> tables;
-  /// The file has a [dem] table (the DPM's contact and DEM-step keys there; older files keep
-  /// them in [particles] and [time], which messages then name).
-  bool dem_table = false;
   std::vector<std::string> laws;  ///< "name@version" references, at least one.
   double eps_mf = 0.42;           ///< Gas fraction of the bed at minimum fluidization.
   /// Range policy the solver uses for drag evaluations outside a law's validity box during a
@@ -283,19 +275,12 @@ struct SceneDerived {
   double particle_response_s = 0.0;        ///< Stokes response time rho_p d^2 / (18 mu).
   double gas_drag_relaxation_s = 0.0;      ///< eps_mf rho_g / beta at U_mf: gas side.
   double solids_drag_relaxation_s = 0.0;   ///< (1 - eps_mf) rho_p / beta at U_mf.
-  double contact_time_s = 0.0;             ///< Linear spring-dashpot contact time t_c.
-  double recommended_dem_dt_s = 0.0;       ///< t_c / contact_steps.
   double recommended_gas_dt_s = 0.0;       ///< Convective limit 0.5 min(dx, dy) / u_max, u_max the
                                            ///< interstitial jet velocity (or background if larger).
   double jet_area_rate_m2_s = 0.0;         ///< q = v_jet w_slot.
   double leakage_bubble_diameter_m = 0.0;  ///< Davidson-Harrison D* = q / (pi U_mf).
   std::string BriefReport() const;
 };
-
-/// Linear spring-dashpot normal contact time between two equal particles (reduced mass m/2):
-/// t_c = pi / sqrt(k/m_eff - eta^2/(4 m_eff^2)), eta = 2 sqrt(k m_eff) |ln e| / sqrt(pi^2 +
-/// ln^2 e).
-double contact_time_s(const SceneParticles& particles);
 
 /// Derives SceneDerived for `law`; throws as minimum_fluidization does, and Error
 /// (kInvalidArgument) if the scene's explicit time steps exceed their stability limits.
