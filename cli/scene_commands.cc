@@ -15,7 +15,6 @@
 #include "cli/cli_context.h"
 #include "cli/progress.h"
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/consumer_results.h"

@@ -29,6 +29,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
@@ -40,7 +41,6 @@
 #include "cli/cli_context.h"
 #include "cli/progress.h"
 #include "draglab/consumers/bed_model.h"
-#include "draglab/consumers/dpm.h"
 #include "draglab/consumers/scene.h"
 #include "draglab/core/files.h"
 #include "draglab/core/text.h"
@@ -68,21 +68,27 @@ struct SensitivityArgs {
   bool no_figure = false;
   std::string beside;  // --beside OTHER/sensitivity.json: fig5.png, OTHER's panels above these
   bool work_precision = false;
-  std::string law;            // --work-precision --law
-  std::string grids;          // --grids 8x24,12x36
-  std::string contact_steps;  // --contact-steps 20,40 (DPM)
-  std::string cfl;            // --cfl 0.3,0.15 (TFM)
-  std::string dt;             // --dt 5e-3,2.5e-3 (DBM)
+  std::string law;    // --work-precision --law
+  std::string grids;  // --grids 8x24,12x36
+  /// The registered models' time-step options (BedModel::time_resolution), by flag: a list of
+  /// values each (--contact-steps 20,40 for the DPM).
+  std::map<std::string, std::string> time_steps;
 };
 
-/// The command-line flag of each model's time resolution (BedModel::time_resolution().name).
-const std::vector<std::pair<std::string, std::string>> kTimeResolutionFlags = {
-    {"contact_steps", "--contact-steps"}, {"cfl", "--cfl"}, {"dt_s", "--dt"}};
+/// The time-step options of the registered models: each flag with the models that take it.
+std::map<std::string, std::vector<std::string>> time_step_flags() {
+  std::map<std::string, std::vector<std::string>> flags;
+  for (const std::string& key : consumers::bed_model_keys()) {
+    flags[consumers::time_resolution_flag(consumers::find_bed_model(key).time_resolution())]
+        .push_back(key);
+  }
+  return flags;
+}
 
-std::string time_resolution_flag(const std::string& name) {
-  for (const auto& [key, flag] : kTimeResolutionFlags)
-    if (key == name) return flag;
-  return "--" + name;
+std::string joined(const std::vector<std::string>& items, const std::string& separator) {
+  std::string out;
+  for (const std::string& item : items) out += (out.empty() ? "" : separator) + item;
+  return out;
 }
 
 std::string cm(double metres) { return fmt::format("{:.2f}", 100.0 * metres); }
@@ -218,11 +224,16 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (args.law.empty()) throw UsageError("--work-precision needs --law NAME@V (one law)");
     if (args.law.find(',') != std::string::npos)
       throw UsageError("--law: --work-precision takes one NAME@V, got '" + args.law + "'");
-  } else if (!args.law.empty() || !args.grids.empty() || !args.contact_steps.empty() ||
-             !args.cfl.empty() || !args.dt.empty()) {
-    throw UsageError(
-        "--law, --grids, --contact-steps, --cfl and --dt belong to --work-precision (the law "
-        "table takes --laws a@1,b@1)");
+  } else {
+    std::vector<std::string> given;
+    if (!args.law.empty()) given.push_back("--law");
+    if (!args.grids.empty()) given.push_back("--grids");
+    for (const auto& [flag, list] : args.time_steps)
+      if (!list.empty()) given.push_back(flag);
+    if (!given.empty()) {
+      throw UsageError(joined(given, ", ") +
+                       ": these belong to --work-precision (the law table takes --laws a@1,b@1)");
+    }
   }
   if (args.duration_given && !(args.duration_s > 0.0 && std::isfinite(args.duration_s)))
     throw UsageError(
@@ -256,16 +267,12 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     // usage error rather than silently ignored.
     const consumers::TimeResolution step =
         consumers::find_bed_model(scene.solver).time_resolution();
-    for (const auto& [option, list] :
-         {std::pair<std::string, std::string>{"contact_steps", args.contact_steps},
-          {"cfl", args.cfl},
-          {"dt_s", args.dt}}) {
+    for (const auto& [flag, list] : args.time_steps) {
       if (list.empty()) continue;
-      const std::string flag = time_resolution_flag(option);
-      if (option != step.name)
+      if (flag != consumers::time_resolution_flag(step))
         throw UsageError(fmt::format(
             "{}: this scene's model ({}) sets its time step by {} ({}): use {}", flag, scene.solver,
-            step.name, step.description, time_resolution_flag(step.name)));
+            step.name, step.description, consumers::time_resolution_flag(step)));
       for (double v : core::parse_number_list(list, flag)) {
         if (step.whole_number && v != std::floor(v))
           throw UsageError(fmt::format("{}: {} is not a whole number ({}, {})", flag,
@@ -383,22 +390,24 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
   cmd->add_option("--beside", args->beside,
                   "Another study's sensitivity.json (e.g. the DPM's): also draw DIR/fig5.png, its "
                   "panels above this study's, per shared law");
+  const std::map<std::string, std::vector<std::string>> step_flags = time_step_flags();
+  std::vector<std::string> per_model;
+  for (const auto& [flag, models] : step_flags)
+    per_model.push_back(flag + " for " + joined(models, ", ") + " scenes");
   cmd->add_flag("--work-precision", args->work_precision,
-                "Work-precision study of one law (--law) over --grids x the model's time step "
-                "(--contact-steps for dpm scenes, --cfl for tfm scenes, --dt for dbm scenes)");
+                "Work-precision study of one law (--law) over --grids x the model's time step (" +
+                    joined(per_model, "; ") + ")");
   cmd->add_option("--law", args->law, "--work-precision: the law NAME@V");
   cmd->add_option("--grids", args->grids,
                   "--work-precision: grids CXxCY or CXxCYxCZ (CZ: depth cells, 3-D scenes),... "
                   "(default: the scene's), e.g. 8x24,12x36 or 4x10x4,6x15x6");
-  cmd->add_option("--contact-steps", args->contact_steps,
-                  "--work-precision, dpm scenes: DEM steps per contact time, [20, 1000], e.g. "
-                  "20,40 (default: the scene's)");
-  cmd->add_option("--cfl", args->cfl,
-                  "--work-precision, tfm scenes: Courant numbers of the coupled step, (0, 0.5], "
-                  "e.g. 0.3,0.15 (default: the scene's [tfm] cfl)");
-  cmd->add_option("--dt", args->dt,
-                  "--work-precision, dbm scenes: fixed time steps [s], (0, the stability limit], "
-                  "e.g. 5e-3,2.5e-3 (default: the scene's [dbm] dt_s)");
+  for (const auto& [flag, models] : step_flags) {
+    const consumers::TimeResolution t = consumers::find_bed_model(models.front()).time_resolution();
+    cmd->add_option(flag, args->time_steps[flag],
+                    "--work-precision, " + joined(models, ", ") + " scenes: " + t.description +
+                        ", " + t.range + (t.example.empty() ? "" : ", e.g. " + t.example) +
+                        " (default: the scene's " + t.name + ")");
+  }
   cmd->footer(
       "Examples:\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --laws gidaspow@1,vdh2004@1\n"

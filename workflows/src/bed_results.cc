@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "draglab/consumers/dpm.h"
-
 namespace draglab {
 namespace workflows {
 namespace {
@@ -27,7 +25,7 @@ nlohmann::json bubble_json(const consumers::BubbleMetrics& b) {
 nlohmann::json snapshot_json(const consumers::BedSnapshot& s) {
   const auto& f = s.void_fraction;
   return {{"t_s", s.t_s},
-          {"layers", consumers::kInitialLayers},
+          {"layers", s.layers},
           {"x", s.x},
           {"y", s.y},
           {"diameter", s.diameter},
@@ -166,7 +164,7 @@ nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
       // Column arrays: a few hundred samples per run stay readable and small.
       nlohmann::json t = nlohmann::json::array(), d = nlohmann::json::array(),
                      centroid = nlohmann::json::array(), bed = nlohmann::json::array();
-      for (const consumers::DpmSample& smp : r.series) {
+      for (const consumers::BedSample& smp : r.series) {
         t.push_back(smp.t_s);
         d.push_back(smp.bubble_diameter_m);
         centroid.push_back(smp.bubble_centroid_m);

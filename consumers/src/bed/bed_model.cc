@@ -111,6 +111,13 @@ void register_bed_model(std::unique_ptr<BedModel> model) {
   add(r, std::move(model));
 }
 
+std::string time_resolution_flag(const TimeResolution& t) {
+  if (!t.flag.empty()) return t.flag;
+  std::string flag = "--" + t.name;
+  for (char& c : flag) c = c == '_' ? '-' : c;
+  return flag;
+}
+
 std::vector<std::string> bed_model_keys() {
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);

@@ -525,8 +525,13 @@ class DbmBedModel : public BedModel {
   }
 
   TimeResolution time_resolution() const override {
-    return {"dt_s", "the fixed DBM step (bounded by DbmOptions::StableTimeStep)",
-            "(0, the stability limit]", /*whole_number=*/false, /*larger_is_finer=*/false};
+    return {"dt_s",
+            "the fixed DBM step [s] (bounded by DbmOptions::StableTimeStep)",
+            "(0, the stability limit]",
+            /*whole_number=*/false,
+            /*larger_is_finer=*/false,
+            "--dt",
+            "5e-3,2.5e-3"};
   }
   double time_resolution_of(const Scene& scene) const override { return dbm_section(scene).dt_s; }
   Scene WithTimeResolution(const Scene& scene, double value) const override {

@@ -1,7 +1,7 @@
 // DpmSimulation: the coupled CFD-DEM run (draglab/consumers/dpm.h, docs/dpm.md).
 #include "draglab/consumers/dpm.h"
 
-#include "io/dpm_output.h"
+#include "io/bed_output.h"
 
 #include "bed/bed_sampling.h"
 
@@ -269,6 +269,7 @@ DpmSnapshot DpmSimulation::Snapshot() const {
   snap.y = p.y;
   snap.z = p.z;
   snap.diameter = p.diameter;
+  snap.layers = kInitialLayers;
   snap.layer.resize(p.size());
   for (std::size_t n = 0; n < p.size(); ++n) {
     const auto id = static_cast<std::size_t>(p.id[n]);
@@ -456,12 +457,12 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   };
 
   // Files only when the scene asks: every outputs.interval_s, or (interval 0) once at t_ref.
-  std::unique_ptr<DpmOutputWriter> writer;
+  std::unique_ptr<BedOutputWriter> writer;
   if (s.outputs.fields || s.outputs.particles) {
     const std::string dir = !opt_.output_directory.empty() ? opt_.output_directory
                             : !s.outputs.directory.empty() ? s.outputs.directory
                                                            : "out/" + s.name;
-    writer = std::make_unique<DpmOutputWriter>(s, result_.law, dir, s.outputs.fields,
+    writer = std::make_unique<BedOutputWriter>(s, result_.law, dir, s.outputs.fields,
                                                s.outputs.particles);
   }
   double next_output = s.outputs.interval_s > 0.0 ? 0.0 : -1.0;

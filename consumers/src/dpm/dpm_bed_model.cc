@@ -68,8 +68,13 @@ class DpmBedModel : public BedModel {
   }
 
   TimeResolution time_resolution() const override {
-    return {"contact_steps", "DEM steps per contact time (the DEM step is t_c / contact_steps)",
-            "[20, 1000]", /*whole_number=*/true, /*larger_is_finer=*/true};
+    return {"contact_steps",
+            "DEM steps per contact time (the DEM step is t_c / contact_steps)",
+            "[20, 1000]",
+            /*whole_number=*/true,
+            /*larger_is_finer=*/true,
+            "--contact-steps",
+            "20,40"};
   }
   double time_resolution_of(const Scene& scene) const override {
     return dem_section(scene).contact_steps;

@@ -16,7 +16,7 @@
 #include "bed/builtin_models.h"
 #include "draglab/core/text.h"
 #include "draglab/error.h"
-#include "io/dpm_output.h"
+#include "io/bed_output.h"
 #include "tfm/tfm.h"
 #include "tfm/tfm_scene.h"
 
@@ -53,7 +53,7 @@ TfmOptions SceneTfmOptions(const Scene& s, double background_m_s) {
   return o;
 }
 
-/// The two-fluid model's cell fields for the output files (dpm_output.h layout).
+/// The two-fluid model's cell fields for the output files (bed_output.h layout).
 CellFields TfmCellFields(const TfmSimulation& tfm) {
   const TfmOptions& o = tfm.options();
   CellFields c;
@@ -131,7 +131,7 @@ struct TfmSeries {
 /// Runs the model to `duration` through `stops`, sampling the bed (into out: series, snapshot
 /// field, largest bed height) and writing the fields at the output stops.
 TfmSeries SampleRun(TfmSimulation& tfm, const Scene& scene, double duration,
-                    const std::vector<std::pair<double, bool>>& stops, DpmOutputWriter* writer,
+                    const std::vector<std::pair<double, bool>>& stops, BedOutputWriter* writer,
                     const BedProgress& progress, BedResult* out) {
   internal::BedSampler sampler(scene, scene.bed_height_mf_m());
   const double dz = tfm.dz();
@@ -290,7 +290,11 @@ class TfmBedModel : public BedModel {
     return {"cfl",
             "Courant number of the coupled step (the step is also bounded by [tfm] dt_max_s and "
             "the granular pressure wave)",
-            "(0, 0.5]", /*whole_number=*/false, /*larger_is_finer=*/false};
+            "(0, 0.5]",
+            /*whole_number=*/false,
+            /*larger_is_finer=*/false,
+            "--cfl",
+            "0.3,0.15"};
   }
   double time_resolution_of(const Scene& scene) const override { return tfm_section(scene).cfl; }
   Scene WithTimeResolution(const Scene& scene, double value) const override {
@@ -319,10 +323,10 @@ class TfmBedModel : public BedModel {
     m.umf_m_s = derived.umf.umf_m_s;
     m.background_m_s = background;
     m.t_ref_s = scene.time.t_ref_s;
-    std::unique_ptr<DpmOutputWriter> writer;
+    std::unique_ptr<BedOutputWriter> writer;
     if (scene.outputs.fields) {
       const std::string dir = internal::scene_output_directory(scene, options.output_directory);
-      writer = std::make_unique<DpmOutputWriter>(scene, out.law, dir, true, false);
+      writer = std::make_unique<BedOutputWriter>(scene, out.law, dir, true, false);
     }
     TfmSeries s;
     try {

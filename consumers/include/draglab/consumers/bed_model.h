@@ -99,7 +99,14 @@ struct TimeResolution {
   std::string range;            ///< Allowed values, as the scene checks them ("[20, 1000]").
   bool whole_number = false;    ///< Only integers are allowed.
   bool larger_is_finer = true;  ///< Direction of refinement (CFL: smaller is finer).
+  /// The command line's option for a list of values (`sensitivity --work-precision`); empty:
+  /// "--" and the name with '-' for '_'.
+  std::string flag;
+  std::string example;  ///< A list of values for the option's help ("20,40").
 };
+
+/// TimeResolution::flag, or the one made from the name.
+std::string time_resolution_flag(const TimeResolution& t);
 
 /// What `scene check` reports of a model's own settings: one line for people and named numbers
 /// for the JSON output.

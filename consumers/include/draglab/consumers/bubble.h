@@ -94,7 +94,8 @@ struct BedSnapshot {
   double t_s = 0.0;              ///< After jet start [s].
   std::vector<double> x, y, z;   ///< Particle centres [m] (x width, y height, z depth).
   std::vector<double> diameter;  ///< [m].
-  std::vector<int> layer;        ///< Initial layer, 0 (bottom) .. dpm.h kInitialLayers - 1.
+  std::vector<int> layer;        ///< Initial layer, 0 (bottom) .. layers - 1.
+  int layers = 0;                ///< Initial layers the particles are coloured by (0: none).
   GridField2D void_fraction;     ///< Gas fraction (x, height).
   BubbleMetrics bubble;          ///< measure_bubble on void_fraction.
 };

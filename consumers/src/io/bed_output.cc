@@ -1,6 +1,6 @@
 // Gas fields and particles of a DPM run to HDF5 (C API, Debian's libhdf5 1.10) with an XDMF 2
-// index for ParaView's XDMFReader. Layout and axis mapping: dpm_output.h and docs/dpm.md.
-#include "io/dpm_output.h"
+// index for ParaView's XDMFReader. Layout and axis mapping: bed_output.h and docs/dpm.md.
+#include "io/bed_output.h"
 
 #include <hdf5.h>
 #include <unistd.h>
@@ -169,7 +169,7 @@ std::string XdmfText(const std::vector<OutputTime>& outputs, const std::string& 
 
 }  // namespace
 
-struct DpmOutputWriter::Impl {
+struct BedOutputWriter::Impl {
   std::string scene_name, scene_hash, law;
   bool fields = false, particles = false;
   std::string h5_path, xmf_path, h5_name;
@@ -183,7 +183,7 @@ struct DpmOutputWriter::Impl {
               const std::vector<int>* layer_by_id);
 };
 
-DpmOutputWriter::DpmOutputWriter(const Scene& scene, const std::string& law,
+BedOutputWriter::BedOutputWriter(const Scene& scene, const std::string& law,
                                  const std::string& directory, bool fields, bool particles)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
@@ -210,7 +210,7 @@ DpmOutputWriter::DpmOutputWriter(const Scene& scene, const std::string& law,
   if (access(dir.c_str(), W_OK) != 0) Fail(dir, "the output directory is not writable");
 }
 
-DpmOutputWriter::~DpmOutputWriter() {
+BedOutputWriter::~BedOutputWriter() {
   try {
     Finish();
   } catch (...) {
@@ -218,7 +218,7 @@ DpmOutputWriter::~DpmOutputWriter() {
   }
 }
 
-void DpmOutputWriter::Impl::WriteGroup(hid_t file, const OutputTime& o, double t_s,
+void BedOutputWriter::Impl::WriteGroup(hid_t file, const OutputTime& o, double t_s,
                                        const CellFields* cells, const Particles* particles,
                                        const std::vector<int>* layer_by_id) {
   Handle group(H5Gcreate2(file, o.group.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
@@ -285,7 +285,7 @@ CellFields gas_cell_fields(const GasPhase& gas) {
   return c;
 }
 
-void DpmOutputWriter::Write(double t_s, const GasPhase& gas, const Particles& particles,
+void BedOutputWriter::Write(double t_s, const GasPhase& gas, const Particles& particles,
                             const std::vector<int>& layer_by_id) {
   Impl& m = *impl_;
   if (!m.fields && !m.particles) return;
@@ -293,7 +293,7 @@ void DpmOutputWriter::Write(double t_s, const GasPhase& gas, const Particles& pa
   m.Append(t_s, m.fields ? &cells : nullptr, m.particles ? &particles : nullptr, &layer_by_id);
 }
 
-void DpmOutputWriter::WriteFields(double t_s, const CellFields& cells) {
+void BedOutputWriter::WriteFields(double t_s, const CellFields& cells) {
   Impl& m = *impl_;
   if (!m.fields) return;
   if (m.particles) Fail(m.h5_path, "this writer was made for particles too: use Write()");
@@ -307,7 +307,7 @@ void DpmOutputWriter::WriteFields(double t_s, const CellFields& cells) {
   m.Append(t_s, &cells, nullptr, nullptr);
 }
 
-void DpmOutputWriter::Impl::Append(double t_s, const CellFields* cells,
+void BedOutputWriter::Impl::Append(double t_s, const CellFields* cells,
                                    const Particles* particles_in,
                                    const std::vector<int>* layers_in) {
   Impl& m = *this;
@@ -400,7 +400,7 @@ void DpmOutputWriter::Impl::Append(double t_s, const CellFields* cells,
   m.index_current = false;
 }
 
-void DpmOutputWriter::Finish() {
+void BedOutputWriter::Finish() {
   Impl& m = *impl_;
   if (m.index_current || m.outputs.empty()) return;
   // Written whole and renamed into place: ParaView never sees half an index.
@@ -410,14 +410,14 @@ void DpmOutputWriter::Finish() {
   m.index_current = true;
 }
 
-std::vector<std::string> DpmOutputWriter::files() const {
+std::vector<std::string> BedOutputWriter::files() const {
   std::vector<std::string> out;
   if (impl_->h5_created) out.push_back(impl_->h5_path);
   if (impl_->xmf_written) out.push_back(impl_->xmf_path);
   return out;
 }
 
-int DpmOutputWriter::outputs() const { return static_cast<int>(impl_->outputs.size()); }
+int BedOutputWriter::outputs() const { return static_cast<int>(impl_->outputs.size()); }
 
 }  // namespace consumers
 }  // namespace draglab

@@ -1,4 +1,4 @@
-// DPM output files (consumers/dpm_output.h): gas fields and particles in HDF5 with an XDMF 2
+// DPM output files (consumers/src/io/bed_output.h): gas fields and particles in HDF5 with an XDMF 2
 // index for ParaView.
 //
 // Set-up: a 4 x 6 cell gas grid, 0.04 m wide, 0.09 m tall, 5 mm deep (dx = 10 mm, dz = 15 mm, so
@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "draglab/error.h"
-#include "io/dpm_output.h"
+#include "io/bed_output.h"
 
 namespace draglab {
 namespace consumers {
@@ -83,7 +83,7 @@ const std::vector<int> kLayerById = {5, 4, 3, 2, 1};
 std::string FreshDirectory() {
   const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::string dir =
-      ::testing::TempDir() + "/dpm_output_test_" + std::to_string(::getpid()) + "_" + info->name();
+      ::testing::TempDir() + "/bed_output_test_" + std::to_string(::getpid()) + "_" + info->name();
   std::filesystem::remove_all(dir);
   return dir;
 }
@@ -205,7 +205,7 @@ WrittenRun WriteTwoTimes(bool fields, bool particles) {
   gas.SetUniformVelocity(0.3, 1.2);
   Particles p = FiveParticles();
   {
-    DpmOutputWriter writer(TestScene(), "ergun@1", run.dir, fields, particles);
+    BedOutputWriter writer(TestScene(), "ergun@1", run.dir, fields, particles);
     writer.Write(kT0, gas, p, kLayerById);
     gas.Step(0.5 * gas.StableTimeStep(0.5));
     for (std::size_t k = 0; k < p.size(); ++k) p.y[k] += 1e-3;
@@ -391,7 +391,7 @@ TEST(DpmOutputTest, OnlyWhatIsAskedForIsWritten) {
 
 TEST(DpmOutputTest, UnwritableDirectoryIsRefusedNamingThePath) {
   try {
-    DpmOutputWriter writer(TestScene(), "ergun@1", "/proc/x", true, true);
+    BedOutputWriter writer(TestScene(), "ergun@1", "/proc/x", true, true);
     FAIL() << "no error for /proc/x";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
@@ -403,7 +403,7 @@ TEST(DpmOutputTest, UnwritableDirectoryIsRefusedNamingThePath) {
   const std::string file = dir + "/not_a_directory";
   std::ofstream(file) << "x";
   try {
-    DpmOutputWriter writer(TestScene(), "ergun@1", file, true, false);
+    BedOutputWriter writer(TestScene(), "ergun@1", file, true, false);
     FAIL() << "no error for a file used as the directory";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
@@ -419,7 +419,7 @@ TEST(DpmOutputTest, BadWriteLeavesOnlyCompleteOutputTimes) {
   GasPhase gas(SmallGrid());
   SetSolids(gas);
   const Particles p = FiveParticles();
-  DpmOutputWriter writer(TestScene(), "ergun@1", dir, true, true);
+  BedOutputWriter writer(TestScene(), "ergun@1", dir, true, true);
   writer.Write(kT0, gas, p, kLayerById);
   try {
     writer.Write(kT0, gas, p, kLayerById);

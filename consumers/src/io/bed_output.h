@@ -1,4 +1,4 @@
-// io/dpm_output.h: the cell fields of any bed model (the DPM's gas, the
+// io/bed_output.h: the cell fields of any bed model (the DPM's gas, the
 // two-fluid model's two phases) and the DPM's particles to HDF5 with an XDMF index that ParaView
 // opens (only when a scene's [outputs] asks for them).
 //
@@ -12,7 +12,7 @@
 //    attribute cell_size_m = (dx, dz, depth);
 //  - particles (outputs.particles): position (N, 3) [m], velocity (N, 3) [m/s] in the DEM axes
 //    (x width, y height, z depth), diameter (N) [m], id (N, int64), layer (N, int32, the
-//    initial layer, dpm.h kInitialLayers).
+//    initial layer, BedSnapshot::layers).
 // The root carries the attributes scene, scene_hash, law, draglab_version and layout.
 // The XDMF file (<same stem>.xmf, XDMF 2) has two temporal collections, "gas" and "particles"
 // (only those asked for), with one uniform grid per output time: the gas as a 3DCoRectMesh with
@@ -52,16 +52,16 @@ CellFields gas_cell_fields(const GasPhase& gas);
 /// it, so a run that stops early leaves a complete file with every finished output time; a
 /// Write() that fails leaves no group behind. With neither fields nor particles asked for, the
 /// writer creates nothing and Write() does nothing. Not thread-safe (HDF5 is serial here).
-class DpmOutputWriter {
+class BedOutputWriter {
  public:
   /// `directory` is created if missing (empty: the scene's outputs.directory, else
   /// out/<scene name>, as DpmOptions::output_directory). `law` is "name@version". Throws when
   /// the directory cannot be created, is not a directory or is not writable.
-  DpmOutputWriter(const Scene& scene, const std::string& law, const std::string& directory,
+  BedOutputWriter(const Scene& scene, const std::string& law, const std::string& directory,
                   bool fields, bool particles);
-  ~DpmOutputWriter();
-  DpmOutputWriter(const DpmOutputWriter&) = delete;
-  DpmOutputWriter& operator=(const DpmOutputWriter&) = delete;
+  ~BedOutputWriter();
+  BedOutputWriter(const BedOutputWriter&) = delete;
+  BedOutputWriter& operator=(const BedOutputWriter&) = delete;
 
   /// Appends one output time (t_s: time since the background flow started, finite and after
   /// the previous output time). `layer_by_id` maps Particles::id to the initial layer; every
