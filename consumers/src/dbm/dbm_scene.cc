@@ -133,16 +133,7 @@ const SceneTable& dbm_scene_table() {
               scene_key("emulsion_viscosity_pa_s", &SceneDbm::emulsion_viscosity_pa_s),
               scene_key("bubble_density_kg_m3", &SceneDbm::bubble_density_kg_m3),
               scene_key("bubble_diameter_m", &SceneDbm::bubble_diameter_m),
-              {"nozzles_per_side",
-               [](SceneSection& s, const SceneValue& v) {
-                 const std::int64_t n = v.integer();
-                 if (n < 1 || n > 100) {
-                   throw Error(ErrorCode::kInvalidArgument, v.at() + ": " + v.field() + " = " +
-                                                                std::to_string(n) +
-                                                                " is outside [1, 100]");
-                 }
-                 Dbm(s).nozzles_per_side = static_cast<int>(n);
-               }},
+              scene_key("nozzles_per_side", &SceneDbm::nozzles_per_side, 1, 100),
               scene_key("nozzle_pitch_m", &SceneDbm::nozzle_pitch_m),
               scene_key("virtual_mass_coefficient", &SceneDbm::virtual_mass_coefficient),
               scene_key("lift", &SceneDbm::lift),

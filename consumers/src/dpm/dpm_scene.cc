@@ -2,11 +2,9 @@
 #include "dpm/dpm_scene.h"
 
 #include <cmath>
-#include <cstdint>
 #include <string>
 
 #include "draglab/consumers/dpm.h"
-#include "draglab/error.h"
 #include "scene/scene_util.h"
 
 namespace draglab {
@@ -24,8 +22,6 @@ constexpr double kMaxSteps = 1e9;
 /// The DPM holds every particle: the cap of [particles] count, also for the count a bed height
 /// makes.
 constexpr double kMaxParticles = 1e7;
-
-SceneDem& Dem(SceneSection& s) { return static_cast<SceneDem&>(s); }
 
 /// Where a key stands in the scene's file: messages name the table the user wrote.
 std::string at(const SceneDem& d, const char* older_table) {
@@ -100,16 +96,6 @@ bool dem_is_valid(const Scene& s, std::string* error) {
   return s.solver != "dpm" || particle_count_fits(s, error);
 }
 
-void read_contact_steps(SceneSection& s, const SceneValue& v) {
-  const std::int64_t n = v.integer();
-  if (n < 20 || n > 1000) {
-    throw Error(ErrorCode::kInvalidArgument, v.at() + ": " + v.field() + " = " + std::to_string(n) +
-                                                 " is outside [20, 1000] (DEM steps per contact "
-                                                 "time)");
-  }
-  Dem(s).contact_steps = static_cast<int>(n);
-}
-
 }  // namespace
 
 const SceneDem& dem_section(const Scene& scene) { return scene.sections.As<SceneDem>(kTable); }
@@ -126,7 +112,8 @@ const SceneTable& dem_scene_table() {
               scene_key("spring_stiffness_n_m", &SceneDem::spring_stiffness_n_m),
               scene_key("settle_s", &SceneDem::settle_s),
               scene_key("dem_dt_s", &SceneDem::dem_dt_s),
-              {"contact_steps", read_contact_steps}};
+              scene_key("contact_steps", &SceneDem::contact_steps, 20, 1000,
+                        "DEM steps per contact time")};
     t.older_places = {{"restitution", "particles"},
                       {"friction", "particles"},
                       {"spring_stiffness_n_m", "particles"},

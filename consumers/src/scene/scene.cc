@@ -308,6 +308,15 @@ double SceneValue::number_or_default() const {
 }
 
 std::int64_t SceneValue::integer() const { return as_integer(node_of(node_), field_, at_); }
+
+int SceneValue::integer_in(int lo, int hi, const std::string& what) const {
+  const std::int64_t v = integer();
+  if (v < lo || v > hi) {
+    bad(at_ + ": " + field_ + " = " + std::to_string(v) + " is outside [" + std::to_string(lo) +
+        ", " + std::to_string(hi) + "]" + (what.empty() ? "" : " (" + what + ")"));
+  }
+  return static_cast<int>(v);
+}
 std::string SceneValue::text() const { return as_text(node_of(node_), field_, at_); }
 bool SceneValue::boolean() const { return as_bool(node_of(node_), field_, at_); }
 

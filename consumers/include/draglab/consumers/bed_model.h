@@ -125,6 +125,14 @@ SceneKey scene_key(const std::string& name, double T::*member) {
             static_cast<T&>(s).*member = v.number();
           }};
 }
+/// A whole number in [lo, hi], refused as the file is read (`what` names what it counts).
+template <typename T>
+SceneKey scene_key(const std::string& name, int T::*member, int lo, int hi,
+                   const std::string& what = "") {
+  return {name, [member, lo, hi, what](SceneSection& s, const SceneValue& v) {
+            static_cast<T&>(s).*member = v.integer_in(lo, hi, what);
+          }};
+}
 template <typename T>
 SceneKey scene_key(const std::string& name, std::string T::*member) {
   return {name, [member](SceneSection& s, const SceneValue& v) {

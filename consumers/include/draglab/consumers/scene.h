@@ -169,6 +169,8 @@ class SceneValue {
   /// A number that must be >= 0 (its absence selects a default, held as -1).
   double number_or_default() const;
   std::int64_t integer() const;
+  /// A whole number in [lo, hi] (`what`, if given, says what it counts in the message).
+  int integer_in(int lo, int hi, const std::string& what = "") const;
   std::string text() const;
   bool boolean() const;
   /// An array of numbers ("<what> in m" names its elements in the message).
