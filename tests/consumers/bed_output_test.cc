@@ -229,7 +229,7 @@ WrittenRun WriteTwoTimes(bool fields, bool particles) {
   return run;
 }
 
-TEST(DpmOutputTest, FieldsAndParticlesRoundTripThroughHdf5) {
+TEST(BedOutputTest, FieldsAndParticlesRoundTripThroughHdf5) {
   const WrittenRun run = WriteTwoTimes(true, true);
   EXPECT_EQ(run.outputs, 2);
   ASSERT_EQ(run.files.size(), 2u);
@@ -308,7 +308,7 @@ TEST(DpmOutputTest, FieldsAndParticlesRoundTripThroughHdf5) {
   std::filesystem::remove_all(run.dir);
 }
 
-TEST(DpmOutputTest, XdmfIndexFollowsTheParaViewConventionsAndNamesExistingDatasets) {
+TEST(BedOutputTest, XdmfIndexFollowsTheParaViewConventionsAndNamesExistingDatasets) {
   const WrittenRun run = WriteTwoTimes(true, true);
   const std::string x = ReadText(run.xmf);
   ASSERT_FALSE(x.empty()) << run.xmf;
@@ -357,7 +357,7 @@ TEST(DpmOutputTest, XdmfIndexFollowsTheParaViewConventionsAndNamesExistingDatase
   std::filesystem::remove_all(run.dir);
 }
 
-TEST(DpmOutputTest, OnlyWhatIsAskedForIsWritten) {
+TEST(BedOutputTest, OnlyWhatIsAskedForIsWritten) {
   // Particles only: no gas datasets, no gas grid.
   WrittenRun run = WriteTwoTimes(false, true);
   {
@@ -389,7 +389,7 @@ TEST(DpmOutputTest, OnlyWhatIsAskedForIsWritten) {
   EXPECT_FALSE(std::filesystem::exists(run.dir));
 }
 
-TEST(DpmOutputTest, UnwritableDirectoryIsRefusedNamingThePath) {
+TEST(BedOutputTest, UnwritableDirectoryIsRefusedNamingThePath) {
   try {
     BedOutputWriter writer(TestScene(), "ergun@1", "/proc/x", true, true);
     FAIL() << "no error for /proc/x";
@@ -412,7 +412,7 @@ TEST(DpmOutputTest, UnwritableDirectoryIsRefusedNamingThePath) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(DpmOutputTest, BadWriteLeavesOnlyCompleteOutputTimes) {
+TEST(BedOutputTest, BadWriteLeavesOnlyCompleteOutputTimes) {
   // A time that does not advance and a particle id without a layer are refused; the file keeps
   // the complete first output time and the index refers to it alone.
   const std::string dir = FreshDirectory();
@@ -447,7 +447,7 @@ TEST(DpmOutputTest, BadWriteLeavesOnlyCompleteOutputTimes) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(DpmOutputTest, ParaViewOpensTheIndexWhenInstalled) {
+TEST(BedOutputTest, ParaViewOpensTheIndexWhenInstalled) {
   // Optional: ParaView is not installed on CI. Its legacy XDMF reader (XDMFReader, the one the
   // docs tell users to pick) must see both times, the gas as image data spanning the box with
   // the width along x and the height along y, and the five particles with their layers.
