@@ -38,6 +38,15 @@ bool has_consumer_schema(sqlite3* handle) {
   return db::read_schema_version(handle) >= kConsumerSchema;
 }
 
+/// A stored JSON text; a damaged one is a database error naming `what`.
+nlohmann::json parse_stored_json(const std::string& text, const std::string& what) {
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(ErrorCode::kDatabase, what + ": not valid JSON (" + e.what() + ")");
+  }
+}
+
 double json_number(const nlohmann::json& j, const char* key, const std::string& what) {
   if (!j.contains(key) || !j.at(key).is_number()) {
     throw Error(ErrorCode::kDatabase, what + ": field '" + key + "' is missing or not a number");
@@ -152,12 +161,7 @@ std::string ConsumerMetrics::ToJson() const {
 
 ConsumerMetrics ConsumerMetrics::FromJson(const std::string& text) {
   const std::string what = "consumer result metrics";
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(ErrorCode::kDatabase, what + ": not valid JSON (" + e.what() + ")");
-  }
+  const nlohmann::json j = parse_stored_json(text, what);
   ConsumerMetrics m;
   m.umf_m_s = json_number(j, "umf_m_s", what);
   m.background_m_s = json_number(j, "background_m_s", what);
@@ -203,12 +207,7 @@ std::string RegressionTolerances::ToJson() const {
 
 RegressionTolerances RegressionTolerances::FromJson(const std::string& text) {
   const std::string what = "baseline tolerances";
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(ErrorCode::kDatabase, what + ": not valid JSON (" + e.what() + ")");
-  }
+  const nlohmann::json j = parse_stored_json(text, what);
   RegressionTolerances t;
   t.diameter_abs_m = json_number(j, "diameter_abs_m", what);
   t.diameter_rel = json_number(j, "diameter_rel", what);
