@@ -364,6 +364,95 @@ bool resume_from_checkpoint(const std::string& path, const Fingerprint& fingerpr
   return true;
 }
 
+/// RunOptions::checkpoint of one run (every rank its own file): resumes the run from it, rewrites
+/// it when due, and removes it at the end, unless max_steps stopped the run (it can go on from
+/// there). Off when the options name no checkpoint.
+class RunCheckpoint {
+ public:
+  /// What a checkpoint saves: the loop's state and the result's history, Mach and the loop's
+  /// warnings (those from `warnings_from` on), and the solver's state.
+  RunCheckpoint(const RunOptions& options, const mpi::Communicator& group, SolverBase* solver,
+                LoopState* loop, RunResult* result)
+      : options_(options),
+        group_(group),
+        solver_(solver),
+        loop_(loop),
+        result_(result),
+        warnings_from_(result->warnings.size()) {
+    if (options.checkpoint.empty()) return;
+    path_ = checkpoint_file(options, group);
+    const std::string other = checkpoint_of_other_ranks(options.checkpoint, group.size());
+    if (!other.empty()) {
+      throw Error(ErrorCode::kInvalidArgument,
+                  "checkpoint '" + other + "' was written by another number of ranks than " +
+                      std::to_string(group.size()) +
+                      "; remedy: run on the ranks that wrote it, or remove its files (the run "
+                      "then starts afresh)");
+    }
+  }
+
+  bool enabled() const { return !path_.empty(); }
+  const std::string& path() const { return path_; }
+
+  /// Resumes from the file when there is one (the same run only: `fingerprint`).
+  void Resume(const Fingerprint& fingerprint) {
+    fingerprint_ = fingerprint;
+    if (resume_from_checkpoint(path_, fingerprint_, group_, solver_, loop_, result_)) {
+      owned_ = true;
+      saved_step_ = loop_->step;
+    }
+    last_ = Clock::now();
+  }
+
+  /// Saves when checkpoint_interval has passed since the last save (one clock for all ranks).
+  void SaveIfDue() {
+    if (!enabled() || loop_->step <= saved_step_) return;
+    bool due =
+        std::chrono::duration<double>(Clock::now() - last_).count() >= options_.checkpoint_interval;
+    if (group_.size() > 1) due = group_.sum(std::int64_t{due ? 1 : 0}) > 0;
+    if (due) Save();
+  }
+
+  /// max_steps stopped the run: save what is new and keep the file (the run can go on).
+  void KeepForMoreSteps() {
+    if (!enabled()) return;
+    if (loop_->step > saved_step_) Save();
+    keep_ = true;
+  }
+
+  void Save() {
+    loop_->history = result_->history;
+    loop_->mach_max = result_->mach_max;
+    loop_->warnings.assign(result_->warnings.begin() + static_cast<std::ptrdiff_t>(warnings_from_),
+                           result_->warnings.end());
+    on_all_ranks(group_,
+                 [&] { save_run_checkpoint(path_, fingerprint_, *loop_, solver_->state()); });
+    owned_ = true;
+    saved_step_ = loop_->step;
+    ++result_->checkpoints_written;
+    last_ = Clock::now();
+  }
+
+  /// The run ended (converged, or failed other than by max_steps): its file goes.
+  void Finish() {
+    if (owned_ && !keep_) std::remove(path_.c_str());
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  const RunOptions& options_;
+  const mpi::Communicator& group_;
+  SolverBase* solver_;
+  LoopState* loop_;
+  RunResult* result_;
+  std::size_t warnings_from_;
+  std::string path_;
+  Fingerprint fingerprint_;
+  bool owned_ = false, keep_ = false;
+  std::int64_t saved_step_ = 0;
+  Clock::time_point last_ = Clock::now();
+};
+
 /// The force that brings Re to target_re: a secant step in log G against log Re through the last
 /// adjustment (*last_log_force, *last_log_re, updated), or with the BVK estimate's slope at the
 /// first one.
@@ -1090,13 +1179,11 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   double& force = loop.force;
   force = force_for_velocity(target_u, nu, d, phi, target_re);
   result.body_force = force;
-  // RunOptions::checkpoint: removed at the end by the run that resumed from it or wrote it,
-  // unless max_steps stopped the run (it can go on from there).
-  std::string checkpoint_path;
-  bool checkpoint_owned = false, keep_checkpoint = false;
+  // Set once the lattice exists; a failure before has no checkpoint to remove.
+  std::unique_ptr<RunCheckpoint> checkpoint;
 
   auto fail = [&](const std::string& diagnosis) {
-    if (checkpoint_owned && !keep_checkpoint) std::remove(checkpoint_path.c_str());
+    if (checkpoint) checkpoint->Finish();
     result.converged = false;
     result.diagnosis = diagnosis;
     const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -1161,39 +1248,12 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   double& stepping_s = loop.stepping_s;
 
   // Checkpoint: resume from it (the same run only), then rewrite it now and then.
-  const std::size_t loop_warnings_from = result.warnings.size();
   loop.measured_pore_speed_ratio = plan != nullptr && plan->kappa_measured ? plan->kappa : 0.0;
-  Fingerprint fingerprint;
-  std::int64_t saved_step = 0;
-  if (!options.checkpoint.empty()) {
-    checkpoint_path = checkpoint_file(options, group);
-    const std::string other = checkpoint_of_other_ranks(options.checkpoint, group.size());
-    if (!other.empty()) {
-      throw Error(ErrorCode::kInvalidArgument,
-                  "checkpoint '" + other + "' was written by another number of ranks than " +
-                      std::to_string(group.size()) +
-                      "; remedy: run on the ranks that wrote it, or remove its files (the run "
-                      "then starts afresh)");
-    }
-    fingerprint = run_fingerprint(grid, lattice, links, options, settings, result, interval, group);
-    if (resume_from_checkpoint(checkpoint_path, fingerprint, group, solver, &loop, &result)) {
-      checkpoint_owned = true;
-      saved_step = step;
-    }
+  checkpoint = std::make_unique<RunCheckpoint>(options, group, solver, &loop, &result);
+  if (checkpoint->enabled()) {
+    checkpoint->Resume(
+        run_fingerprint(grid, lattice, links, options, settings, result, interval, group));
   }
-  auto last_checkpoint = Clock::now();
-  auto save_checkpoint = [&] {
-    loop.history = result.history;
-    loop.mach_max = result.mach_max;
-    loop.warnings.assign(result.warnings.begin() + static_cast<std::ptrdiff_t>(loop_warnings_from),
-                         result.warnings.end());
-    on_all_ranks(group,
-                 [&] { save_run_checkpoint(checkpoint_path, fingerprint, loop, solver->state()); });
-    checkpoint_owned = true;
-    saved_step = step;
-    ++result.checkpoints_written;
-    last_checkpoint = Clock::now();
-  };
   // A check's stage that stops the run: the fields as they are, then the diagnosis.
   auto stop = [&](const std::string& diagnosis) {
     if (fields != nullptr) solver->fill_fields(fields);
@@ -1201,19 +1261,12 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   };
 
   while (true) {
-    if (!checkpoint_path.empty() && step > saved_step) {
-      bool due = seconds_since(last_checkpoint) >= options.checkpoint_interval;
-      if (group.size() > 1) due = group.sum(std::int64_t{due ? 1 : 0}) > 0;  // one clock for all
-      if (due) save_checkpoint();
-    }
+    checkpoint->SaveIfDue();
     if (step >= options.max_steps) {
-      if (!checkpoint_path.empty()) {
-        if (step > saved_step) save_checkpoint();
-        keep_checkpoint = true;
-      }
+      checkpoint->KeepForMoreSteps();
       result.steps = step;
       result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
-      return stop(not_converged_diagnosis(options, result, loop, checkpoint_path.empty()));
+      return stop(not_converged_diagnosis(options, result, loop, !checkpoint->enabled()));
     }
     // Checks at every multiple of the interval (a resumed run keeps the schedule), the last
     // one cut short at max_steps (rounded up to a pair).
@@ -1225,10 +1278,10 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
     }
     stepping_s += seconds_since(t_step);
     step += 2 * pairs;
-    if (!checkpoint_path.empty() && step % interval != 0) {
+    if (checkpoint->enabled() && step % interval != 0) {
       // Cut short by max_steps: the state before this check, which the run that goes on
       // from it will not make.
-      save_checkpoint();
+      checkpoint->Save();
     }
     result.steps = step;
     result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
@@ -1263,7 +1316,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   normalise_converged(loop, checks.average_F(), checks.average_re(), checks.moments(), body_force,
                       scales, options, grid, &result);
   if (fields != nullptr) solver->fill_fields(fields);
-  if (checkpoint_owned) std::remove(checkpoint_path.c_str());
+  checkpoint->Finish();
   result.wall_s = seconds_since(start);
   if (progress) progress(1.0, "converged after " + std::to_string(step) + " steps");
   return result;
