@@ -14,6 +14,7 @@
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/voxelization.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/text.h"
 #include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/lbm/resolution.h"
@@ -24,18 +25,14 @@ namespace {
 
 constexpr double kMemoryShare = 0.8;
 
-std::string format(const char* fmt, double x) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, fmt, x);
-  return buffer;
-}
+using core::format_fixed;
 
 std::string duration(double seconds) {
-  if (seconds < 120.0) return format("%.0f s", seconds);
-  if (seconds < 7200.0) return format("%.1f min", seconds / 60.0);
-  if (seconds < 2.0 * 86400.0) return format("%.1f h", seconds / 3600.0);
-  if (seconds < 730.0 * 86400.0) return format("%.1f days", seconds / 86400.0);
-  return format("%.1f years", seconds / (365.25 * 86400.0));
+  if (seconds < 120.0) return format_fixed("%.0f s", seconds);
+  if (seconds < 7200.0) return format_fixed("%.1f min", seconds / 60.0);
+  if (seconds < 2.0 * 86400.0) return format_fixed("%.1f h", seconds / 3600.0);
+  if (seconds < 730.0 * 86400.0) return format_fixed("%.1f days", seconds / 86400.0);
+  return format_fixed("%.1f years", seconds / (365.25 * 86400.0));
 }
 
 /// Seconds per fluid-node update on one core: a fixed number of steps of the full (non-linear)
@@ -141,8 +138,8 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
 std::string CampaignPlan::BriefReport() const {
   return std::to_string(units) + " units, predicted " + duration(wall_seconds) + " on " +
          std::to_string(jobs) + " worker" + (jobs == 1 ? "" : "s") + " (" +
-         format("%.3g", core_seconds) + " core-seconds), largest unit " +
-         format("%.2g", largest_unit_memory_bytes / 1073741824.0) + " GiB" +
+         format_fixed("%.3g", core_seconds) + " core-seconds), largest unit " +
+         format_fixed("%.2g", largest_unit_memory_bytes / 1073741824.0) + " GiB" +
          (fits_in_memory ? "" : ": DOES NOT FIT in memory") +
          (refused_units > 0 ? "; " + std::to_string(refused_units) +
                                   " units WILL BE REFUSED (cell Reynolds number: raise d)"
@@ -158,18 +155,19 @@ std::string CampaignPlan::FullReport() const {
          "d needed  resolution\n";
   for (const PlannedPoint& p : points) {
     char line[220];
-    std::snprintf(
-        line, sizeof line, "%-7.3g %-7.4g %-6.4g %-6d %-10s %-12.3g %-9.3g %-11s %-12s %-9.3g %s\n",
-        p.phi, p.re, p.resolution, p.units, p.collision.c_str(), p.fluid_nodes, p.steps,
-        duration(p.unit_seconds).c_str(), format("%.2g GiB", p.memory_bytes / 1073741824.0).c_str(),
-        p.d_needed, p.resolution_verdict.c_str());
+    std::snprintf(line, sizeof line,
+                  "%-7.3g %-7.4g %-6.4g %-6d %-10s %-12.3g %-9.3g %-11s %-12s %-9.3g %s\n", p.phi,
+                  p.re, p.resolution, p.units, p.collision.c_str(), p.fluid_nodes, p.steps,
+                  duration(p.unit_seconds).c_str(),
+                  format_fixed("%.2g GiB", p.memory_bytes / 1073741824.0).c_str(), p.d_needed,
+                  p.resolution_verdict.c_str());
     out << line;
   }
   out << "d needed: the largest of the bounds from the pores' hydraulic diameter, the boundary "
          "layer and the cell Reynolds number the collision holds (lbm/resolution.h); collision "
          "auto runs trt where kappa Re/d is within what trt holds, rr with TRT's wall beyond\n";
   out << "time per fluid-node update (one core, measured): "
-      << format("%.3g", node_update_seconds * 1e9) << " ns\n";
+      << format_fixed("%.3g", node_update_seconds * 1e9) << " ns\n";
   out << BriefReport() << "\n";
   return out.str();
 }

@@ -49,5 +49,11 @@ std::string format_number(double x, int digits) {
   return text;
 }
 
+std::string format_fixed(const char* format, double a, double b, double c, double d) {
+  char text[256];
+  std::snprintf(text, sizeof text, format, a, b, c, d);
+  return text;
+}
+
 }  // namespace core
 }  // namespace draglab

@@ -1,5 +1,6 @@
 // Sangani-Acrivos series for simple-cubic arrays and the hydrodynamic-diameter calibration.
 #include "draglab/lbm/calibration.h"
+#include "draglab/core/text.h"
 
 #include <algorithm>
 #include <chrono>
@@ -52,11 +53,7 @@ void check_phi_range(double phi) {
   }
 }
 
-std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, format, a, b, c, d);
-  return buf;
-}
+using core::format_fixed;
 
 /// An SC array (one sphere per periodic cube) whose edge is a whole number of lattice nodes
 /// near `diameter` (pi/(6 phi))^(1/3); its exact phi follows from that edge.
@@ -159,10 +156,11 @@ double solve_hydrodynamic_diameter(double box_edge, double diameter, double F_me
                                    int* iterations) {
   if (!(box_edge > 0.0) || !(diameter > 0.0) || !(F_measured > 0.0) ||
       !std::isfinite(box_edge * diameter * F_measured)) {
-    throw Error(ErrorCode::kInvalidArgument,
-                fmt("hydrodynamic diameter: box edge (%g), diameter (%g) and measured F (%g) "
-                    "must be finite and > 0",
-                    box_edge, diameter, F_measured));
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        format_fixed("hydrodynamic diameter: box edge (%g), diameter (%g) and measured F (%g) "
+                     "must be finite and > 0",
+                     box_edge, diameter, F_measured));
   }
   // r(x) = x (1 - phi(x)) K(chi(x)) - d F_measured with chi = x/L, phi = pi/6 chi^3: the
   // drag force divided by 3 pi mu U, as the series predicts for diameter x minus as measured.
@@ -181,10 +179,11 @@ double solve_hydrodynamic_diameter(double box_edge, double diameter, double F_me
   double slope = 0.0;
   const double x_max = chi_max * box_edge;
   if (residual(x_max, &slope) < 0.0) {
-    throw Error(ErrorCode::kInvalidArgument,
-                fmt("hydrodynamic diameter: the measured drag (F = %g at d = %g in a box of %g) "
-                    "exceeds the series for any diameter up to phi = %g",
-                    F_measured, diameter, box_edge, kSanganiAcrivosMaxPhi));
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        format_fixed("hydrodynamic diameter: the measured drag (F = %g at d = %g in a box of %g) "
+                     "exceeds the series for any diameter up to phi = %g",
+                     F_measured, diameter, box_edge, kSanganiAcrivosMaxPhi));
   }
   // Newton from x = target (the dilute limit, K -> 1), kept inside (0, x_max] by bisection
   // fallback: r(0) = -target < 0 < r(x_max).
@@ -214,14 +213,16 @@ double solve_hydrodynamic_diameter(double box_edge, double diameter, double F_me
 bool CalibrationOptions::IsValid(std::string* error) const {
   std::string e;
   if (!std::isfinite(diameter) || diameter < 4.0 || diameter > 128.0) {
-    e = fmt("calibration: diameter = %g lattice units is outside [4, 128]", diameter);
+    e = format_fixed("calibration: diameter = %g lattice units is outside [4, 128]", diameter);
   } else if (!std::isfinite(phi) || phi < 0.001 || phi > 0.05) {
-    e = fmt("calibration: phi = %g is outside [0.001, 0.05] (a dilute simple-cubic array)", phi);
+    e = format_fixed("calibration: phi = %g is outside [0.001, 0.05] (a dilute simple-cubic array)",
+                     phi);
   } else if (positions < 1 || positions > 64) {
-    e = fmt("calibration: positions = %g is outside [1, 64]", static_cast<double>(positions));
+    e = format_fixed("calibration: positions = %g is outside [1, 64]",
+                     static_cast<double>(positions));
   } else if (!std::isfinite(check_phi) || check_phi < 0.0 || check_phi > kSanganiAcrivosMaxPhi) {
-    e = fmt("calibration: check phi = %g is outside (0, %g] (0 = no check)", check_phi,
-            kSanganiAcrivosMaxPhi);
+    e = format_fixed("calibration: check phi = %g is outside (0, %g] (0 = no check)", check_phi,
+                     kSanganiAcrivosMaxPhi);
   } else {
     RunOptions r = run;
     r.re = 0.0;
@@ -291,23 +292,25 @@ CalibrationResult calibrate_hydrodynamic_diameter(const CalibrationOptions& opti
 
 std::string CalibrationResult::Report() const {
   std::string s;
-  s += fmt("input diameter d      %.4f lattice units (SC box of %.0f nodes, phi = %.5f)\n",
-           diameter, static_cast<double>(box_nodes), calibration.phi);
-  s += fmt("hydrodynamic d_h      %.4f lattice units, d_h/d = %.5f (%+.2f %%)\n",
-           hydrodynamic_diameter, ratio, 100.0 * (ratio - 1.0));
-  s += fmt("calibration array     F = %.5f with d, series %.5f (%+.2f %%)\n", calibration.F_input,
-           calibration.F_reference, 100.0 * calibration.error_input);
-  s += fmt("                      mean over %g sphere positions (spread %.2f %%)\n",
-           static_cast<double>(calibration.positions), 100.0 * calibration.F_position_spread);
-  s += fmt("effect of d_h         F x %.5f, phi x %.5f\n", 1.0 / ratio, ratio * ratio * ratio);
+  s += format_fixed("input diameter d      %.4f lattice units (SC box of %.0f nodes, phi = %.5f)\n",
+                    diameter, static_cast<double>(box_nodes), calibration.phi);
+  s += format_fixed("hydrodynamic d_h      %.4f lattice units, d_h/d = %.5f (%+.2f %%)\n",
+                    hydrodynamic_diameter, ratio, 100.0 * (ratio - 1.0));
+  s += format_fixed("calibration array     F = %.5f with d, series %.5f (%+.2f %%)\n",
+                    calibration.F_input, calibration.F_reference, 100.0 * calibration.error_input);
+  s += format_fixed("                      mean over %g sphere positions (spread %.2f %%)\n",
+                    static_cast<double>(calibration.positions),
+                    100.0 * calibration.F_position_spread);
+  s += format_fixed("effect of d_h         F x %.5f, phi x %.5f\n", 1.0 / ratio,
+                    ratio * ratio * ratio);
   if (has_check) {
-    s += fmt("check phi = %.4f      with d: F = %.5f, series %.5f (%+.2f %%)\n", check.phi,
-             check.F_input, check.F_reference, 100.0 * check.error_input);
-    s += fmt("                      with d_h: F = %.5f, series at phi_h = %.4f: %.5f",
-             check.F_hydrodynamic, check.phi_hydrodynamic, check.F_reference_hydrodynamic);
-    s += fmt(" (%+.2f %%)\n", 100.0 * check.error_hydrodynamic);
+    s += format_fixed("check phi = %.4f      with d: F = %.5f, series %.5f (%+.2f %%)\n", check.phi,
+                      check.F_input, check.F_reference, 100.0 * check.error_input);
+    s += format_fixed("                      with d_h: F = %.5f, series at phi_h = %.4f: %.5f",
+                      check.F_hydrodynamic, check.phi_hydrodynamic, check.F_reference_hydrodynamic);
+    s += format_fixed(" (%+.2f %%)\n", 100.0 * check.error_hydrodynamic);
   }
-  s += fmt("time                  %.2f s\n", wall_s);
+  s += format_fixed("time                  %.2f s\n", wall_s);
   return s;
 }
 

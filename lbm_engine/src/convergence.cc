@@ -1,5 +1,6 @@
 // Resolution sweeps: error against wall time per scheme, analytical or Richardson reference.
 #include "draglab/lbm/convergence.h"
+#include "draglab/core/text.h"
 
 #include <algorithm>
 #include <chrono>
@@ -15,11 +16,7 @@ namespace draglab {
 namespace lbm {
 namespace {
 
-std::string format(const char* f, double a, double b = 0.0, double c = 0.0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
+using core::format_fixed;
 
 constexpr double kMinOrder = 0.05, kMaxOrder = 8.0;  // orders Richardson may report
 
@@ -96,7 +93,7 @@ RichardsonEstimate three_point(double d1, double F1, double d2, double F2, doubl
     return e;
   }
   if (ratio < g(lo) || ratio > g(hi)) {
-    e.note = format("measured order outside [%g, %g]", lo, hi);
+    e.note = format_fixed("measured order outside [%g, %g]", lo, hi);
     return e;
   }
   for (int i = 0; i < 200 && hi - lo > 1e-12; ++i) {
@@ -142,7 +139,7 @@ RichardsonEstimate least_squares(const std::vector<std::pair<double, double>>& p
   }
   RichardsonEstimate e;
   if (best_p <= kMinOrder + 1e-9 || best_p >= kMaxOrder - 1e-9) {
-    e.note = format("least-squares order at the bound of [%g, %g]", kMinOrder, kMaxOrder);
+    e.note = format_fixed("least-squares order at the bound of [%g, %g]", kMinOrder, kMaxOrder);
     return e;
   }
   double a = std::max(kMinOrder, best_p - 0.05), b = std::min(kMaxOrder, best_p + 0.05);
@@ -158,7 +155,7 @@ RichardsonEstimate least_squares(const std::vector<std::pair<double, double>>& p
   e.ok = true;
   e.order = 0.5 * (a + b);
   fit(e.order, &e.F_inf);
-  e.note = format("least-squares fit over %g points", static_cast<double>(pts.size()));
+  e.note = format_fixed("least-squares fit over %g points", static_cast<double>(pts.size()));
   return e;
 }
 
@@ -220,12 +217,13 @@ bool ConvergenceOptions::IsValid(std::string* error) const {
   } else if (schemes.empty()) {
     e = "convergence: no schemes given";
   } else if (!std::isnan(reference_F) && !(reference_F > 0.0 && std::isfinite(reference_F))) {
-    e = format("convergence: reference F = %g must be finite and > 0", reference_F);
+    e = format_fixed("convergence: reference F = %g must be finite and > 0", reference_F);
   }
   for (double d : resolutions) {
     if (!e.empty()) break;
     if (!std::isfinite(d) || d < 4.0 || d > 256.0) {
-      e = format("convergence: resolution d = %g is outside [4, 256] lattice units per d_ref", d);
+      e = format_fixed("convergence: resolution d = %g is outside [4, 256] lattice units per d_ref",
+                       d);
     }
   }
   if (e.empty()) {
@@ -280,8 +278,8 @@ ConvergenceResult run_convergence(const ConvergenceOptions& options,
       r.checkpoint.clear();                 // several runs: none resumes another's state
       r.use_hydrodynamic_diameter = false;  // a calibrated d_h belongs to one resolution only
       const std::string label = sc.scheme.name() +
-                                format(" d=%g", realised_resolution(options.packing, d)) + " (" +
-                                std::to_string(index) + "/" + std::to_string(count) + ")";
+                                format_fixed(" d=%g", realised_resolution(options.packing, d)) +
+                                " (" + std::to_string(index) + "/" + std::to_string(count) + ")";
       ProgressCallback point_progress;
       if (progress) {
         point_progress = [&, label](double f, const std::string&) {
@@ -353,7 +351,7 @@ ConvergenceResult run_convergence(const ConvergenceOptions& options,
     if (best) {
       result.reference_F = best->richardson.F_inf;
       result.reference_source = "Richardson extrapolation of " + best->scheme.name() +
-                                format(" (order %.2f)", best->richardson.order);
+                                format_fixed(" (order %.2f)", best->richardson.order);
       // Spread over the schemes' limits: meaningful with two or more extrapolations only.
       int extrapolated = 0;
       double spread = 0.0;

@@ -54,6 +54,7 @@
 #include "drag_db_version.h"
 #include "draglab/core/files.h"
 #include "draglab/core/machine.h"
+#include "draglab/core/text.h"
 #include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 #include "draglab/lbm/resolution.h"
@@ -102,11 +103,7 @@ constexpr double kFloatBalanceFloor = 1e-4;  ///< Momentum-balance convergence f
 /// solid flags, with room for its links).
 constexpr double kWholeGridBytesPerNode = 2.0;
 
-std::string fmt(const char* format, double x) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, x);
-  return buffer;
-}
+using core::format_fixed;
 
 /// `dense`: a node index in the whole box.
 std::string node_text(const SparseLattice& lattice, std::int64_t dense) {
@@ -172,12 +169,13 @@ WallScheme choose_wall(const RunOptions& options, double tau, bool stokes, RunRe
     if (stokes || tau >= kCentralWallMinTau) {
       choice = WallInterpolation::kCentral;
       result->wall_reason = stokes ? "Stokes flow: CLI is stable and the more accurate"
-                                   : "tau = " + fmt("%.4g", tau) +
-                                         " >= " + fmt("%g", kCentralWallMinTau) +
+                                   : "tau = " + format_fixed("%.4g", tau) +
+                                         " >= " + format_fixed("%g", kCentralWallMinTau) +
                                          ": CLI is stable there and the more accurate";
     } else {
       choice = WallInterpolation::kBouzidi;
-      result->wall_reason = "tau = " + fmt("%.4g", tau) + " < " + fmt("%g", kCentralWallMinTau) +
+      result->wall_reason = "tau = " + format_fixed("%.4g", tau) + " < " +
+                            format_fixed("%g", kCentralWallMinTau) +
                             ": CLI's negative weight goes unstable near tau = 1/2, BFL's "
                             "non-negative weights do not";
     }
@@ -205,23 +203,25 @@ std::string diverged_diagnosis(const SparseLattice& lattice, const RunOptions& o
       options.boundary == Boundary::kInterpolated &&
               options.interpolation == WallInterpolation::kCentral && tau < kCentralWallMinTau
           ? "the BFL wall (--wall-interpolation auto or bfl: CLI is unstable at tau = " +
-                fmt("%.4g", tau) + " < " + fmt("%g", kCentralWallMinTau) + "), or "
+                format_fixed("%.4g", tau) + " < " + format_fixed("%g", kCentralWallMinTau) +
+                "), or "
           : std::string();
   if (last_max_speed > 0.0 && nu > 0.0) {
     const double cell_re = last_max_speed / nu;
     text += "; at step " + std::to_string(last_check_step) + " the fastest node was " +
-            node_text(lattice, last_max_node) + " (|u| = " + fmt("%.3g", last_max_speed) +
-            "), a cell Reynolds number |u| dx / nu = " + fmt("%.3g", cell_re);
+            node_text(lattice, last_max_node) + " (|u| = " + format_fixed("%.3g", last_max_speed) +
+            "), a cell Reynolds number |u| dx / nu = " + format_fixed("%.3g", cell_re);
     if (std::isfinite(limit)) {
       text += " (" + std::string(to_string(options.collision)) + " has held up to " +
-              fmt("%g", stable) + " in every measured packing and diverged in all beyond " +
-              fmt("%g", limit) + ")";
+              format_fixed("%g", stable) +
+              " in every measured packing and diverged in all beyond " + format_fixed("%g", limit) +
+              ")";
       if (target_re > 0.0) {
         const double d_hold =
             std::ceil(estimated_pore_speed_ratio(result_phi) * target_re / stable);
         text += "; remedy: " + wall_remedy + "--d " +
-                fmt("%g", std::max(d_hold, std::ceil(d) + 1.0)) +
-                " or more (kappa Re / d = " + fmt("%g", stable) + "), or a lower Re";
+                format_fixed("%g", std::max(d_hold, std::ceil(d) + 1.0)) +
+                " or more (kappa Re / d = " + format_fixed("%g", stable) + "), or a lower Re";
         return text;
       }
     }
@@ -242,13 +242,13 @@ void widen_for_resolution(const RunOptions& options, double d, RunResult* result
       widen_for_resolution(result->discretisation_error, d, need, options.boundary);
   if (w.factor == 1.0) return;
   result->discretisation_error = w.error;
-  std::string how = "widened x" + fmt("%.3g", w.factor);
+  std::string how = "widened x" + format_fixed("%.3g", w.factor);
   if (w.error == w.floor) {
-    how = "set to " + fmt("%.3g", 100.0 * w.floor) +
+    how = "set to " + format_fixed("%.3g", 100.0 * w.floor) +
           " % (the layer's missing nodes squared: below the rule the flow itself can change)";
   }
-  result->warnings.push_back("under-resolved: d = " + fmt("%.4g", d) + " is below " +
-                             fmt("%.3g", std::max(need.gaps, need.boundary_layer)) + " (" +
+  result->warnings.push_back("under-resolved: d = " + format_fixed("%.4g", d) + " is below " +
+                             format_fixed("%.3g", std::max(need.gaps, need.boundary_layer)) + " (" +
                              (w.boundary_layer ? "the boundary layer" : "the pores") +
                              " span too few nodes; " + need.Summary() +
                              "): the discretisation estimate is " + how + "; extrapolate in d");
@@ -261,7 +261,7 @@ std::string checkpoint_file(const RunOptions& options, const mpi::Communicator& 
          std::to_string(group.size());
 }
 
-std::string exact(double x) { return fmt("%.17g", x); }
+std::string exact(double x) { return format_fixed("%.17g", x); }
 
 std::string hex(std::uint64_t x) {
   char text[32];
@@ -539,17 +539,19 @@ std::string relaxation_too_close_to_half(const RunOptions& options, const Relaxa
   const double min_gap =
       options.collision == Collision::kRegularized ? kMinTauGapRegularized : kMinTauGap;
   if (r.tau - 0.5 < min_gap) {
-    return "tau = " + fmt("%.6g", r.tau) + " is within " + fmt("%g", min_gap) +
+    return "tau = " + format_fixed("%.6g", r.tau) + " is within " + format_fixed("%g", min_gap) +
            " of 1/2, the stability limit of " + to_string(options.collision) +
-           (options.tau == 0.0 ? " (tau = 1/2 + 3 U d / Re from the Mach budget at Re = " +
-                                     fmt("%g", options.re) + ", d = " + fmt("%g", d) + ")"
-                               : std::string()) +
+           (options.tau == 0.0
+                ? " (tau = 1/2 + 3 U d / Re from the Mach budget at Re = " +
+                      format_fixed("%g", options.re) + ", d = " + format_fixed("%g", d) + ")"
+                : std::string()) +
            "; remedy: raise the resolution d (tau grows with d at fixed Re), lower Re, or "
            "use the regularized collision (rr)";
   }
   if (options.collision == Collision::kTrt && r.tau_minus - 0.5 < kMinTauGap) {
-    return "TRT tau- = " + fmt("%.6g", r.tau_minus) + " (Lambda = " + fmt("%g", options.magic) +
-           ", tau+ = " + fmt("%g", r.tau) +
+    return "TRT tau- = " + format_fixed("%.6g", r.tau_minus) +
+           " (Lambda = " + format_fixed("%g", options.magic) +
+           ", tau+ = " + format_fixed("%g", r.tau) +
            ") is within 1e-3 of 1/2; remedy: lower tau or raise Lambda";
   }
   return "";
@@ -576,9 +578,9 @@ SolverSettings solver_settings(const RunOptions& options, const Relaxation& r, b
       wall_correction > 0.0) {
     settings.wall_correction = wall_correction;
     result->wall_corrected = true;
-    result->wall_reason +=
-        std::string(result->wall_reason.empty() ? "" : "; ") +
-        "rr: reflected values corrected to TRT's wall at Lambda = " + fmt("%g", options.magic);
+    result->wall_reason += std::string(result->wall_reason.empty() ? "" : "; ") +
+                           "rr: reflected values corrected to TRT's wall at Lambda = " +
+                           format_fixed("%g", options.magic);
   }
   return settings;
 }
@@ -620,13 +622,14 @@ Engine build_engine(const arrays::VoxelGrid& grid, const RunOptions& options, Wa
     const double available = core::physical_memory_bytes();
     if (available > 0.0 && needed > 0.9 * available) {
       throw Error(ErrorCode::kInvalidArgument,
-                  "lbm run: the lattice needs about " + fmt("%.3g", needed / 1073741824.0) +
-                      " GiB (" + std::to_string(lattice.num_stored()) + " stored nodes" +
+                  "lbm run: the lattice needs about " +
+                      format_fixed("%.3g", needed / 1073741824.0) + " GiB (" +
+                      std::to_string(lattice.num_stored()) + " stored nodes" +
                       (group.size() > 1 ? " on rank " + std::to_string(group.rank()) + ", " +
-                                              fmt("%g", ranks_here) + " ranks on its node"
+                                              format_fixed("%g", ranks_here) + " ranks on its node"
                                         : std::string()) +
                       "), more than 90 % of this machine's " +
-                      fmt("%.3g", available / 1073741824.0) +
+                      format_fixed("%.3g", available / 1073741824.0) +
                       " GiB; lower the resolution or use --precision float" +
                       (group.size() > 1 ? ", or spread the ranks over more nodes" : ""));
     }
@@ -657,8 +660,8 @@ void record_lattice(const arrays::VoxelGrid& grid, const Engine& engine,
     r.warnings.push_back(
         std::to_string(grid.gaps.narrow_pairs) +
         " sphere pairs have gaps below one lattice spacing (smallest " +
-        fmt("%.3g", grid.gaps.smallest_gap_nodes) + " lattice units) and " +
-        fmt("%.3g", 100.0 * grid.gaps.narrow_fluid_fraction()) +
+        format_fixed("%.3g", grid.gaps.smallest_gap_nodes) + " lattice units) and " +
+        format_fixed("%.3g", 100.0 * grid.gaps.narrow_fluid_fraction()) +
         " % of the fluid nodes lie in gaps one node wide: under-resolved gaps, run as the "
         "literature does (first-order bounce-back there); extrapolate in d for the error");
   }
@@ -818,7 +821,8 @@ class RunChecks {
     if (m_.nonfinite_node >= 0)
       return Fail(Instability("a non-finite population", m_.nonfinite_node));
     if (m_.min_rho <= 0.0)
-      return Fail(Instability("density " + fmt("%.3g", m_.min_rho) + " <= 0", m_.min_rho_node));
+      return Fail(
+          Instability("density " + format_fixed("%.3g", m_.min_rho) + " <= 0", m_.min_rho_node));
     double& mach = loop_.mach;
     mach = std::sqrt(3.0 * m_.max_speed2);
     result_.mach_max = std::max(result_.mach_max, mach);
@@ -826,16 +830,16 @@ class RunChecks {
     if (mach > options_.mach_limit) {
       if (loop_.last_max_speed > 0.0 &&
           std::sqrt(m_.max_speed2) > kBlowUpGrowth * loop_.last_max_speed) {
-        return Fail(Instability("max |u| grew from " + fmt("%.3g", loop_.last_max_speed) + " to " +
-                                    fmt("%.3g", std::sqrt(m_.max_speed2)) + " (Mach " +
-                                    fmt("%.3g", mach) + ") within " + std::to_string(sc_.interval) +
-                                    " steps",
+        return Fail(Instability("max |u| grew from " + format_fixed("%.3g", loop_.last_max_speed) +
+                                    " to " + format_fixed("%.3g", std::sqrt(m_.max_speed2)) +
+                                    " (Mach " + format_fixed("%.3g", mach) + ") within " +
+                                    std::to_string(sc_.interval) + " steps",
                                 m_.max_speed_node));
       }
-      return Fail("Mach number " + fmt("%.3g", mach) + " above the limit " +
-                  fmt("%g", options_.mach_limit) + " at step " + std::to_string(step) + ", " +
-                  node_text(lattice_, m_.max_speed_node) +
-                  " (max |u| = " + fmt("%.3g", std::sqrt(m_.max_speed2)) + ", grown steadily" +
+      return Fail("Mach number " + format_fixed("%.3g", mach) + " above the limit " +
+                  format_fixed("%g", options_.mach_limit) + " at step " + std::to_string(step) +
+                  ", " + node_text(lattice_, m_.max_speed_node) + " (max |u| = " +
+                  format_fixed("%.3g", std::sqrt(m_.max_speed2)) + ", grown steadily" +
                   (sc_.target_re > 0.0 && options_.tau == 0.0
                        ? std::string("); remedy: lower the Mach target (--mach)")
                        : std::string("); remedy: lower tau (the velocity is U = Re nu / d at the "
@@ -847,9 +851,10 @@ class RunChecks {
     if (mach > mach_warning && !loop_.mach_warned) {
       loop_.mach_warned = true;
       result_.warnings.push_back(
-          "Mach number " + fmt("%.3g", mach) + " above " + fmt("%.3g", mach_warning) + " at step " +
-          std::to_string(step) + " (" + node_text(lattice_, m_.max_speed_node) +
-          "): compressibility error of order Ma^2 = " + fmt("%.2g", mach * mach));
+          "Mach number " + format_fixed("%.3g", mach) + " above " +
+          format_fixed("%.3g", mach_warning) + " at step " + std::to_string(step) + " (" +
+          node_text(lattice_, m_.max_speed_node) +
+          "): compressibility error of order Ma^2 = " + format_fixed("%.2g", mach * mach));
     }
     loop_.last_max_speed = std::sqrt(m_.max_speed2);
     loop_.last_max_node = m_.max_speed_node;
@@ -867,9 +872,9 @@ class RunChecks {
     loop_.F_mean = sum_fx_ / static_cast<double>(sc_.bodies) /
                    (3.0 * kPi * sc_.nu * sc_.d * loop_.U) * sc_.mixture;
     if (!std::isfinite(loop_.F_mean)) {
-      return Fail(
-          Instability("a non-finite drag (superficial velocity " + fmt("%.3g", loop_.U) + ")",
-                      m_.max_speed_node));
+      return Fail(Instability(
+          "a non-finite drag (superficial velocity " + format_fixed("%.3g", loop_.U) + ")",
+          m_.max_speed_node));
     }
     auto& window = loop_.window;
     window.push_back({loop_.F_mean, loop_.U});
@@ -956,11 +961,12 @@ class RunChecks {
         std::ceil(options_.average_time * sc_.d / (sc_.target_re * sc_.nu / sc_.d)));
     const std::int64_t step = loop_.step;
     if (step + needed > options_.max_steps) {
-      return Fail("unsteady flow at Re = " + fmt("%.4g", mean_re) + " (F fluctuates by " +
-                  fmt("%.2g", loop_.relative_change) +
+      return Fail("unsteady flow at Re = " + format_fixed("%.4g", mean_re) + " (F fluctuates by " +
+                  format_fixed("%.2g", loop_.relative_change) +
                   " per characteristic time around a "
                   "stationary mean): averaging over average_time = " +
-                  fmt("%g", options_.average_time) + " d/U needs " + std::to_string(needed) +
+                  format_fixed("%g", options_.average_time) + " d/U needs " +
+                  std::to_string(needed) +
                   " more steps, beyond max_steps = " + std::to_string(options_.max_steps) +
                   "; remedy: --max-steps " + std::to_string(step + 2 * needed) + " or more");
     }
@@ -988,8 +994,9 @@ class RunChecks {
     if (averaged_time >= options_.average_time && average_F_.used >= 2 * kMinBlocks) {
       if (std::abs(average_re_.mean / sc_.target_re - 1.0) > options_.re_tolerance) {
         if (loop_.averaging_restarts >= kMaxAveragingRestarts) {
-          return Fail("unsteady flow: the time-averaged Re " + fmt("%.4g", average_re_.mean) +
-                      " stays outside the band of the target " + fmt("%g", sc_.target_re) +
+          return Fail("unsteady flow: the time-averaged Re " +
+                      format_fixed("%.4g", average_re_.mean) +
+                      " stays outside the band of the target " + format_fixed("%g", sc_.target_re) +
                       " after " + std::to_string(loop_.averaging_restarts) +
                       " corrections of the force; remedy: a wider re_tolerance");
         }
@@ -1012,10 +1019,11 @@ class RunChecks {
                             : std::numeric_limits<double>::infinity();
       progress_(
           std::min(1.0, static_cast<double>(loop_.step) / static_cast<double>(options_.max_steps)),
-          "step " + std::to_string(loop_.step) + ": averaging, F = " +
-              fmt("%.6g", average_F_.mean) + " +- " + fmt("%.2g", 100.0 * se) + " % over " +
-              fmt("%.3g", averaged_time) + " d/U, Re = " + fmt("%.4g", average_re_.mean) + ", " +
-              fmt("%.4g", result_.mflups) + " MFLUPS");
+          "step " + std::to_string(loop_.step) +
+              ": averaging, F = " + format_fixed("%.6g", average_F_.mean) + " +- " +
+              format_fixed("%.2g", 100.0 * se) + " % over " + format_fixed("%.3g", averaged_time) +
+              " d/U, Re = " + format_fixed("%.4g", average_re_.mean) + ", " +
+              format_fixed("%.4g", result_.mflups) + " MFLUPS");
     }
     return Next::kNextCheck;
   }
@@ -1077,10 +1085,11 @@ class RunChecks {
       fraction = std::max(
           fraction, std::clamp(std::log(relative_change) / std::log(options_.tolerance), 0.0, 1.0));
     }
-    progress_(std::min(fraction, 1.0),
-              "step " + std::to_string(loop_.step) + ": F = " + fmt("%.6g", loop_.F_mean) +
-                  ", Re = " + fmt("%.4g", loop_.re_lattice) + ", change/T = " +
-                  fmt("%.2g", relative_change) + ", " + fmt("%.4g", result_.mflups) + " MFLUPS");
+    progress_(std::min(fraction, 1.0), "step " + std::to_string(loop_.step) +
+                                           ": F = " + format_fixed("%.6g", loop_.F_mean) +
+                                           ", Re = " + format_fixed("%.4g", loop_.re_lattice) +
+                                           ", change/T = " + format_fixed("%.2g", relative_change) +
+                                           ", " + format_fixed("%.4g", result_.mflups) + " MFLUPS");
   }
 
  private:
@@ -1129,11 +1138,12 @@ std::string not_converged_diagnosis(const RunOptions& options, const RunResult& 
   return "not converged after max_steps = " + std::to_string(options.max_steps) +
          " steps: relative change of F per characteristic time (" +
          std::to_string(result.characteristic_steps) + " steps) is " +
-         fmt("%.3g", loop.relative_change) + ", momentum balance " + fmt("%.3g", loop.balance) +
-         " (tolerance " + fmt("%.3g", options.tolerance) + ")" +
-         (options.re > 0.0
-              ? ", Re = " + fmt("%.5g", loop.re_lattice) + " for target " + fmt("%g", options.re)
-              : std::string()) +
+         format_fixed("%.3g", loop.relative_change) + ", momentum balance " +
+         format_fixed("%.3g", loop.balance) + " (tolerance " +
+         format_fixed("%.3g", options.tolerance) + ")" +
+         (options.re > 0.0 ? ", Re = " + format_fixed("%.5g", loop.re_lattice) + " for target " +
+                                 format_fixed("%g", options.re)
+                           : std::string()) +
          "; remedy: raise max_steps (or loosen the tolerance); at high Re the flow "
          "may be unsteady" +
          (no_checkpoint ? std::string()
@@ -1160,7 +1170,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
   const double d = result.d;
   if (!(phi > 0.0 && phi < 1.0)) {
     throw Error(ErrorCode::kInvalidArgument,
-                "lbm run: solids fraction must be in (0, 1), got " + fmt("%g", phi));
+                "lbm run: solids fraction must be in (0, 1), got " + format_fixed("%g", phi));
   }
   const bool stokes = options.stokes_mode == RunOptions::StokesMode::kOn ||
                       (options.stokes_mode == RunOptions::StokesMode::kAuto && options.re == 0.0);
@@ -1401,11 +1411,12 @@ RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const Run
     }
   }
   if (plan.cell_reynolds > stable_cell_reynolds(quiet.collision)) {
-    r.warnings.push_back("cell Reynolds number kappa Re / d = " + fmt("%.3g", plan.cell_reynolds) +
-                         " is beyond " + fmt("%g", stable_cell_reynolds(quiet.collision)) +
-                         ", where " + to_string(quiet.collision) +
-                         " has held in every measured packing; it may diverge (at --d " +
-                         fmt("%g", plan.d_stable) + " it would not)");
+    r.warnings.push_back(
+        "cell Reynolds number kappa Re / d = " + format_fixed("%.3g", plan.cell_reynolds) +
+        " is beyond " + format_fixed("%g", stable_cell_reynolds(quiet.collision)) + ", where " +
+        to_string(quiet.collision) +
+        " has held in every measured packing; it may diverge (at --d " +
+        format_fixed("%g", plan.d_stable) + " it would not)");
   }
   return finish(r);
 }
@@ -1448,10 +1459,10 @@ double estimated_run_bytes(double nodes, Precision precision) {
 void check_run_size(const arrays::Packing& packing, double resolution, const RunOptions& options,
                     const std::string& field) {
   if (!std::isfinite(resolution) || resolution < kMinResolution || resolution > kMaxResolution) {
-    throw Error(ErrorCode::kInvalidArgument, field + " = " + fmt("%g", resolution) +
-                                                 " is outside [" + fmt("%g", kMinResolution) +
-                                                 ", " + fmt("%g", kMaxResolution) +
-                                                 "] lattice units per diameter");
+    throw Error(ErrorCode::kInvalidArgument,
+                field + " = " + format_fixed("%g", resolution) + " is outside [" +
+                    format_fixed("%g", kMinResolution) + ", " + format_fixed("%g", kMaxResolution) +
+                    "] lattice units per diameter");
   }
   const double gap = options.min_gap_nodes > 0.0
                          ? arrays::min_gap_lattice_units(packing, resolution)
@@ -1460,19 +1471,21 @@ void check_run_size(const arrays::Packing& packing, double resolution, const Run
     const double needed = gap > 0.0 ? resolution * options.min_gap_nodes / gap : 0.0;
     throw Error(
         ErrorCode::kInvalidArgument,
-        field + " = " + fmt("%g", resolution) +
-            " is too low for the gaps: the smallest gap between spheres spans " + fmt("%.3g", gap) +
-            " lattice units, below min_gap_nodes = " + fmt("%g", options.min_gap_nodes) +
+        field + " = " + format_fixed("%g", resolution) +
+            " is too low for the gaps: the smallest gap between spheres spans " +
+            format_fixed("%.3g", gap) +
+            " lattice units, below min_gap_nodes = " + format_fixed("%g", options.min_gap_nodes) +
             (gap > 0.0 && needed <= kMaxResolution
-                 ? "; raise the resolution to at least " + fmt("%.4g", needed) + ", or"
+                 ? "; raise the resolution to at least " + format_fixed("%.4g", needed) + ", or"
                  : std::string(gap > 0.0
-                                   ? " (the resolution it would need, " + fmt("%.4g", needed) +
-                                         ", is beyond the limit " + fmt("%g", kMaxResolution) + ");"
+                                   ? " (the resolution it would need, " +
+                                         format_fixed("%.4g", needed) + ", is beyond the limit " +
+                                         format_fixed("%g", kMaxResolution) + ");"
                                    : "; the spheres touch or overlap;")) +
             " generate the packing with a minimum surface gap of at least " +
-            fmt("%.3g", options.min_gap_nodes / resolution) +
+            format_fixed("%.3g", options.min_gap_nodes / resolution) +
             " diameters (draglab pack --min-gap " +
-            fmt("%.3g", 1.5 * options.min_gap_nodes / resolution) +
+            format_fixed("%.3g", 1.5 * options.min_gap_nodes / resolution) +
             "), or set min_gap_nodes to 0 to run the under-resolved gaps (they are reported, "
             "and a sweep in d estimates their error)");
   }
@@ -1492,13 +1505,13 @@ void check_run_size(const arrays::Packing& packing, double resolution, const Run
   if (memory > 0.0 && bytes > 0.8 * memory) {
     throw Error(
         ErrorCode::kInvalidArgument,
-        field + " = " + fmt("%g", resolution) + " needs about " +
-            fmt("%.1f", bytes / 1073741824.0) + " GiB for " + fmt("%.3g", nodes) +
+        field + " = " + format_fixed("%g", resolution) + " needs about " +
+            format_fixed("%.1f", bytes / 1073741824.0) + " GiB for " + format_fixed("%.3g", nodes) +
             " lattice nodes" +
             (ranks > 1 ? " on this node (" + std::to_string(ranks_on_this_node(options.ranks)) +
                              " of the " + std::to_string(ranks) + " ranks)"
                        : std::string()) +
-            ", more than 80 % of this machine's " + fmt("%.1f", memory / 1073741824.0) +
+            ", more than 80 % of this machine's " + format_fixed("%.1f", memory / 1073741824.0) +
             " GiB; lower " + field + " (or use --precision float" +
             (ranks > 1 ? ", or spread the ranks over more nodes)" : ")"));
   }

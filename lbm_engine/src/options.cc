@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "draglab/core/text.h"
 #include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 
@@ -13,11 +14,7 @@ namespace draglab {
 namespace lbm {
 namespace {
 
-std::string format(const char* fmt, double x) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, fmt, x);
-  return buffer;
-}
+using core::format_fixed;
 
 }  // namespace
 
@@ -118,52 +115,53 @@ bool RunOptions::IsValid(std::string* error) const {
     return fail("precision: unknown (allowed: double, float)");
   }
   if (!(std::isfinite(magic) && magic > 0.0 && magic <= 10.0)) {
-    return fail("magic: TRT Lambda must be in (0, 10], got " + format("%g", magic));
+    return fail("magic: TRT Lambda must be in (0, 10], got " + format_fixed("%g", magic));
   }
   if (!(std::isfinite(re) && re >= 0.0 && re <= kMaxReynolds)) {
-    return fail("re: must be in [0, " + format("%g", kMaxReynolds) + "], got " + format("%g", re));
+    return fail("re: must be in [0, " + format_fixed("%g", kMaxReynolds) + "], got " +
+                format_fixed("%g", re));
   }
   if (!(std::isfinite(tau) && (tau == 0.0 || (tau > 0.5 && tau <= 100.0)))) {
-    return fail("tau: must be 0 (automatic) or in (0.5, 100], got " + format("%g", tau));
+    return fail("tau: must be 0 (automatic) or in (0.5, 100], got " + format_fixed("%g", tau));
   }
   if (stokes_mode != StokesMode::kAuto && stokes_mode != StokesMode::kOn &&
       stokes_mode != StokesMode::kOff) {
     return fail("stokes_mode: unknown value");
   }
   if (!(std::isfinite(re_tolerance) && re_tolerance > 0.0 && re_tolerance <= 0.5)) {
-    return fail("re_tolerance: must be in (0, 0.5], got " + format("%g", re_tolerance));
+    return fail("re_tolerance: must be in (0, 0.5], got " + format_fixed("%g", re_tolerance));
   }
   if (!(std::isfinite(tolerance) && tolerance >= 1e-12 && tolerance <= 0.1)) {
-    return fail("tolerance: must be in [1e-12, 0.1], got " + format("%g", tolerance));
+    return fail("tolerance: must be in [1e-12, 0.1], got " + format_fixed("%g", tolerance));
   }
   if (max_steps < 2) return fail("max_steps: must be >= 2");
   if (!(std::isfinite(mach_limit) && mach_limit > 0.0 && mach_limit <= 1.0)) {
-    return fail("mach_limit: must be in (0, 1], got " + format("%g", mach_limit));
+    return fail("mach_limit: must be in (0, 1], got " + format_fixed("%g", mach_limit));
   }
   if (!(std::isfinite(mach_target) && mach_target > 0.0 && mach_target <= 0.3)) {
-    return fail("mach_target: must be in (0, 0.3], got " + format("%g", mach_target));
+    return fail("mach_target: must be in (0, 0.3], got " + format_fixed("%g", mach_target));
   }
   if (!(std::isfinite(average_tolerance) && average_tolerance >= 1e-4 &&
         average_tolerance <= 0.1)) {
     return fail("average_tolerance: must be in [1e-4, 0.1], got " +
-                format("%g", average_tolerance));
+                format_fixed("%g", average_tolerance));
   }
   if (!(std::isfinite(average_time) && average_time >= 1.0 && average_time <= 1e4)) {
-    return fail("average_time: must be in [1, 10000] d/U, got " + format("%g", average_time));
+    return fail("average_time: must be in [1, 10000] d/U, got " + format_fixed("%g", average_time));
   }
   if (!(std::isfinite(min_gap_nodes) && min_gap_nodes >= 0.0 && min_gap_nodes <= 100.0)) {
-    return fail("min_gap_nodes: must be in [0, 100], got " + format("%g", min_gap_nodes));
+    return fail("min_gap_nodes: must be in [0, 100], got " + format_fixed("%g", min_gap_nodes));
   }
   if (use_hydrodynamic_diameter &&
       !(std::isfinite(hydrodynamic_diameter) && hydrodynamic_diameter > 0.0)) {
     return fail("hydrodynamic_diameter: must be > 0 (lattice units) when it is used, got " +
-                format("%g", hydrodynamic_diameter));
+                format_fixed("%g", hydrodynamic_diameter));
   }
   if (threads < 0 || threads > 4096) return fail("threads: must be in [0, 4096] (0 = all)");
   if (!(std::isfinite(checkpoint_interval) && checkpoint_interval >= 0.0 &&
         checkpoint_interval <= 1e6)) {
     return fail("checkpoint_interval: must be in [0, 1e6] seconds, got " +
-                format("%g", checkpoint_interval));
+                format_fixed("%g", checkpoint_interval));
   }
   return true;
 }
@@ -171,13 +169,14 @@ bool RunOptions::IsValid(std::string* error) const {
 std::string RunResult::BriefReport() const {
   std::ostringstream out;
   if (converged) {
-    out << "F = " << format("%.6g", F) << " (K = " << format("%.6g", K)
-        << ", beta d^2/mu = " << format("%.6g", beta_d2_over_mu) << ") +- "
-        << format("%.2g", error_estimate * 100.0) << " % at Re = " << format("%.4g", re)
-        << ", phi = " << format("%.4g", phi) << ", d = " << format("%.4g", d) << "; " << steps
-        << " steps, " << format("%.3g", wall_s) << " s, " << format("%.4g", mflups) << " MFLUPS";
+    out << "F = " << format_fixed("%.6g", F) << " (K = " << format_fixed("%.6g", K)
+        << ", beta d^2/mu = " << format_fixed("%.6g", beta_d2_over_mu) << ") +- "
+        << format_fixed("%.2g", error_estimate * 100.0) << " % at Re = " << format_fixed("%.4g", re)
+        << ", phi = " << format_fixed("%.4g", phi) << ", d = " << format_fixed("%.4g", d) << "; "
+        << steps << " steps, " << format_fixed("%.3g", wall_s) << " s, "
+        << format_fixed("%.4g", mflups) << " MFLUPS";
   } else {
-    out << "not converged after " << steps << " steps (" << format("%.3g", wall_s)
+    out << "not converged after " << steps << " steps (" << format_fixed("%.3g", wall_s)
         << " s): " << diagnosis;
   }
   return out.str();
@@ -187,52 +186,58 @@ std::string RunResult::FullReport() const {
   std::ostringstream out;
   out << "converged            " << (converged ? "yes" : "no") << "\n";
   if (!diagnosis.empty()) out << "diagnosis            " << diagnosis << "\n";
-  out << "F (drag only)        " << format("%.8g", F) << " +- " << format("%.3g", F_standard_error)
-      << " (spread over " << body_F.size() << " bodies)\n";
+  out << "F (drag only)        " << format_fixed("%.8g", F) << " +- "
+      << format_fixed("%.3g", F_standard_error) << " (spread over " << body_F.size()
+      << " bodies)\n";
   if (unsteady) {
-    out << "unsteady             F +- " << format("%.3g", F_time_error) << ", Re "
-        << format("%.6g", re) << " +- " << format("%.3g", re_standard_error) << " (time means over "
-        << averaging_steps << " steps = " << format("%.3g", averaging_time) << " d/U after "
-        << startup_steps << " steps; " << averaging_restarts << " restarts)\n";
+    out << "unsteady             F +- " << format_fixed("%.3g", F_time_error) << ", Re "
+        << format_fixed("%.6g", re) << " +- " << format_fixed("%.3g", re_standard_error)
+        << " (time means over " << averaging_steps
+        << " steps = " << format_fixed("%.3g", averaging_time) << " d/U after " << startup_steps
+        << " steps; " << averaging_restarts << " restarts)\n";
   }
-  out << "K = F/(1-phi)        " << format("%.8g", K) << "\n"
-      << "beta d^2/mu          " << format("%.8g", beta_d2_over_mu) << "\n"
-      << "error estimate       " << format("%.3g", error_estimate) << " (convergence "
-      << format("%.3g", convergence_residual) << ", discretisation "
-      << format("%.3g", discretisation_error) << ")\n"
-      << "Re (achieved)        " << format("%.6g", re) << (stokes_mode ? "  [Stokes mode]" : "")
-      << " (" << force_adjustments << " corrections of the force)\n"
-      << "phi / phi_lattice    " << format("%.6g", phi) << " / " << format("%.6g", phi_lattice)
-      << "\n"
-      << "d (lattice units)    " << format("%.6g", d) << "\n"
-      << "tau+ / tau-          " << format("%.6g", tau) << " / " << format("%.6g", tau_minus)
-      << "  (nu = " << format("%.6g", nu) << ")\n"
+  out << "K = F/(1-phi)        " << format_fixed("%.8g", K) << "\n"
+      << "beta d^2/mu          " << format_fixed("%.8g", beta_d2_over_mu) << "\n"
+      << "error estimate       " << format_fixed("%.3g", error_estimate) << " (convergence "
+      << format_fixed("%.3g", convergence_residual) << ", discretisation "
+      << format_fixed("%.3g", discretisation_error) << ")\n"
+      << "Re (achieved)        " << format_fixed("%.6g", re)
+      << (stokes_mode ? "  [Stokes mode]" : "") << " (" << force_adjustments
+      << " corrections of the force)\n"
+      << "phi / phi_lattice    " << format_fixed("%.6g", phi) << " / "
+      << format_fixed("%.6g", phi_lattice) << "\n"
+      << "d (lattice units)    " << format_fixed("%.6g", d) << "\n"
+      << "tau+ / tau-          " << format_fixed("%.6g", tau) << " / "
+      << format_fixed("%.6g", tau_minus) << "  (nu = " << format_fixed("%.6g", nu) << ")\n"
       << (pore_speed_ratio > 0.0
-              ? "velocity plan        kappa = u_max/U = " + format("%.4g", pore_speed_ratio) +
+              ? "velocity plan        kappa = u_max/U = " + format_fixed("%.4g", pore_speed_ratio) +
                     (pore_speed_ratio_measured ? " (measured)" : " (estimated)") +
-                    ", Mach target " + format("%g", mach_target) + ", Re_cell = kappa Re/d = " +
-                    format("%.3g", cell_reynolds) + " (limit " + format("%g", cell_reynolds_limit) +
-                    "; at the end max|u|/nu = " + format("%.3g", final_cell_reynolds) + ", kappa " +
-                    format("%.3g", final_pore_speed_ratio) + ")\n"
+                    ", Mach target " + format_fixed("%g", mach_target) +
+                    ", Re_cell = kappa Re/d = " + format_fixed("%.3g", cell_reynolds) + " (limit " +
+                    format_fixed("%g", cell_reynolds_limit) +
+                    "; at the end max|u|/nu = " + format_fixed("%.3g", final_cell_reynolds) +
+                    ", kappa " + format_fixed("%.3g", final_pore_speed_ratio) + ")\n"
               : std::string())
       << "collision            " << to_string(collision)
       << (collision_reason.empty() ? std::string() : " (auto: " + collision_reason + ")") << "\n"
       << "wall                 " << wall
       << (wall_reason.empty() ? std::string() : " (" + wall_reason + ")") << "\n"
-      << "body force           " << format("%.6g", body_force) << "\n"
-      << "superficial U        " << format("%.6g", superficial_velocity) << "\n"
-      << "Mach (max)           " << format("%.4g", mach_max) << "\n"
-      << "momentum balance     " << format("%.3g", momentum_balance_rel) << " (relative)\n"
-      << "mass change          " << format("%.3g", mass_change_rel) << " (relative)\n"
+      << "body force           " << format_fixed("%.6g", body_force) << "\n"
+      << "superficial U        " << format_fixed("%.6g", superficial_velocity) << "\n"
+      << "Mach (max)           " << format_fixed("%.4g", mach_max) << "\n"
+      << "momentum balance     " << format_fixed("%.3g", momentum_balance_rel) << " (relative)\n"
+      << "mass change          " << format_fixed("%.3g", mass_change_rel) << " (relative)\n"
       << "sub-node gaps        " << narrow_gap_pairs << " sphere pairs below one node (smallest "
-      << format("%.3g", smallest_gap_nodes) << "), "
-      << format("%.3g", 100.0 * narrow_gap_fluid_fraction) << " % of fluid nodes in one-node gaps\n"
+      << format_fixed("%.3g", smallest_gap_nodes) << "), "
+      << format_fixed("%.3g", 100.0 * narrow_gap_fluid_fraction)
+      << " % of fluid nodes in one-node gaps\n"
       << "fluid nodes / links  " << fluid_nodes << " / " << boundary_links << " (" << fallback_links
       << " interpolation fallbacks)\n"
       << "steps                " << steps << " (characteristic time " << characteristic_steps
       << " steps)\n"
-      << "wall time            " << format("%.4g", wall_s) << " s, " << format("%.4g", mflups)
-      << " MFLUPS, " << format("%.4g", static_cast<double>(memory_bytes) / 1048576.0) << " MiB"
+      << "wall time            " << format_fixed("%.4g", wall_s) << " s, "
+      << format_fixed("%.4g", mflups) << " MFLUPS, "
+      << format_fixed("%.4g", static_cast<double>(memory_bytes) / 1048576.0) << " MiB"
       << (ranks > 1 ? " on " + std::to_string(ranks) + " ranks" : std::string()) << "\n";
   if (resumed_from_step > 0 || checkpoints_written > 0) {
     out << "checkpoint           "
@@ -245,9 +250,9 @@ std::string RunResult::FullReport() const {
     out << "history (last points): step, F, Re, relative change per characteristic time\n";
     const std::size_t first = history.size() > 10 ? history.size() - 10 : 0;
     for (std::size_t i = first; i < history.size(); ++i) {
-      out << "  " << history[i].step << "  " << format("%.10g", history[i].F) << "  "
-          << format("%.6g", history[i].re) << "  " << format("%.3g", history[i].relative_change)
-          << "\n";
+      out << "  " << history[i].step << "  " << format_fixed("%.10g", history[i].F) << "  "
+          << format_fixed("%.6g", history[i].re) << "  "
+          << format_fixed("%.3g", history[i].relative_change) << "\n";
     }
   }
   return out.str();

@@ -1,5 +1,6 @@
 // resolution.cc: see draglab/lbm/resolution.h.
 #include "draglab/lbm/resolution.h"
+#include "draglab/core/text.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,11 +18,7 @@ constexpr double kCs = 0.57735026918962576;  // 1/sqrt(3)
 constexpr double kTrtMaxCellReynolds = 35.0;
 constexpr double kTrtStableCellReynolds = 23.0;
 
-std::string fmt(const char* format, double x) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, format, x);
-  return buffer;
-}
+using core::format_fixed;
 
 }  // namespace
 
@@ -54,28 +51,30 @@ CollisionChoice choose_collision(double phi, double re, double d, Collision requ
   }
   const double kappa = estimated_pore_speed_ratio(phi);
   const double cell_re = kappa * re / d;
-  const std::string what = "kappa Re / d = " + fmt("%.3g", kappa) + " x " + fmt("%g", re) + " / " +
-                           fmt("%.4g", d) + " = " + fmt("%.3g", cell_re);
+  const std::string what = "kappa Re / d = " + format_fixed("%.3g", kappa) + " x " +
+                           format_fixed("%g", re) + " / " + format_fixed("%.4g", d) + " = " +
+                           format_fixed("%.3g", cell_re);
   if (cell_re <= kTrtStableCellReynolds) {
-    return {Collision::kTrt, what + " <= " + fmt("%g", kTrtStableCellReynolds) +
+    return {Collision::kTrt, what + " <= " + format_fixed("%g", kTrtStableCellReynolds) +
                                  ", where TRT has held in every measured packing: TRT, whose "
                                  "wall is exact at Lambda 3/16"};
   }
   return {Collision::kRegularized,
-          what + " > " + fmt("%g", kTrtStableCellReynolds) +
+          what + " > " + format_fixed("%g", kTrtStableCellReynolds) +
               ", beyond what TRT holds in every measured packing (it would need --d " +
-              fmt("%g", std::ceil(kappa * re / kTrtStableCellReynolds)) +
+              format_fixed("%g", std::ceil(kappa * re / kTrtStableCellReynolds)) +
               "): rr, which holds it, with TRT's wall correction (its remaining wall error is "
               "in error_estimate)"};
 }
 
 std::string VelocityPlan::Summary() const {
-  std::string s = "kappa = u_max/U = " + fmt("%.3g", kappa) +
+  std::string s = "kappa = u_max/U = " + format_fixed("%.3g", kappa) +
                   (kappa_measured ? " (measured)" : " (estimated from phi)") + ", Ma target " +
-                  fmt("%g", mach_target) + " -> U = " + fmt("%.4g", velocity) +
-                  ", tau = " + fmt("%.5g", tau) +
-                  ", Re_cell = kappa Re/d = " + fmt("%.3g", cell_reynolds);
-  if (std::isfinite(cell_reynolds_limit)) s += " (limit " + fmt("%g", cell_reynolds_limit) + ")";
+                  format_fixed("%g", mach_target) + " -> U = " + format_fixed("%.4g", velocity) +
+                  ", tau = " + format_fixed("%.5g", tau) +
+                  ", Re_cell = kappa Re/d = " + format_fixed("%.3g", cell_reynolds);
+  if (std::isfinite(cell_reynolds_limit))
+    s += " (limit " + format_fixed("%g", cell_reynolds_limit) + ")";
   return s;
 }
 
@@ -108,17 +107,19 @@ VelocityPlan plan_velocity(double phi, double re, double d, Collision collision,
 std::string cell_reynolds_refusal(const VelocityPlan& plan, double re, double d,
                                   Collision collision) {
   if (plan.within_limit()) return std::string();
-  return "the cell Reynolds number kappa Re / d = " + fmt("%.3g", plan.kappa_stability) + " x " +
-         fmt("%g", re) + " / " + fmt("%.4g", d) + " = " + fmt("%.3g", plan.cell_reynolds) +
+  return "the cell Reynolds number kappa Re / d = " + format_fixed("%.3g", plan.kappa_stability) +
+         " x " + format_fixed("%g", re) + " / " + format_fixed("%.4g", d) + " = " +
+         format_fixed("%.3g", plan.cell_reynolds) +
          " (kappa = u_max/U at finite Re, estimated from phi) is beyond what " +
-         to_string(collision) + " holds (" + fmt("%g", plan.cell_reynolds_limit) +
+         to_string(collision) + " holds (" + format_fixed("%g", plan.cell_reynolds_limit) +
          ": it diverges there whatever the velocity); " + "remedy: --d " +
-         fmt("%g", plan.d_stable) + " or more, or a lower Re";
+         format_fixed("%g", plan.d_stable) + " or more, or a lower Re";
 }
 
 std::string ResolutionNeed::Summary() const {
-  return "d >= " + fmt("%.3g", d) + " (gaps " + fmt("%.3g", gaps) + ", boundary layer " +
-         fmt("%.3g", boundary_layer) + ", stability " + fmt("%.3g", stability) + ")";
+  return "d >= " + format_fixed("%.3g", d) + " (gaps " + format_fixed("%.3g", gaps) +
+         ", boundary layer " + format_fixed("%.3g", boundary_layer) + ", stability " +
+         format_fixed("%.3g", stability) + ")";
 }
 
 ResolutionNeed resolution_needed(double phi, double re, Collision collision, double kappa) {

@@ -22,5 +22,10 @@ std::vector<double> parse_number_list(const std::string& text, const std::string
 /// x with `digits` significant digits (printf %g): the numbers of messages and tables.
 std::string format_number(double x, int digits = 6);
 
+/// Numbers in a printf format of a message that needs one ("%.3g", "%.1f %%", "%g x %g"); up to
+/// four, passed as doubles (the format must read them so). Plain numbers take format_number.
+std::string format_fixed(const char* format, double a, double b = 0.0, double c = 0.0,
+                         double d = 0.0);
+
 }  // namespace core
 }  // namespace draglab
