@@ -129,8 +129,19 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
     if (dataset.id.empty()) dataset.id = dataset.hash.substr(0, 12);
   }
   std::vector<fitter::FitPoint> points;
-  for (const DatasetPoint& p : dataset.points)
-    points.push_back({p.phi, p.re, p.F, p.F_uncertainty});
+  bool per_species = false;
+  for (const DatasetPoint& p : dataset.points) {
+    points.push_back({p.phi, p.re, p.F, p.F_uncertainty, {}});
+    if (p.y > 0.0) {
+      points.back().extra = {p.y};
+      per_species = true;
+    }
+  }
+  if (per_species && args.compare_forms) {
+    throw UsageError(
+        "--compare-forms refits the monodisperse forms; this dataset holds size classes (y): "
+        "the fit's table compares it with the polydisperse literature laws");
+  }
   ctx.info(fmt::format("fitting {} to {} points of dataset {} ({})", options.form, points.size(),
                        dataset.id, dataset.name));
   const fitter::FitResult fit = fitter::fit_law(points, options);
@@ -149,12 +160,16 @@ void run_fit(const CliContext& ctx, const FitArgs& args) {
   comparisons.push_back(compare("fit (" + fit.form + ")", [&] {
     std::vector<double> rel;
     for (const fitter::FitPoint& p : points) {
-      rel.push_back(find_law_form(fit.form).F(p.phi, p.re, nullptr, fit.values.data()) / p.F - 1.0);
+      rel.push_back(
+          find_law_form(fit.form).F(p.phi, p.re, p.extra_data(), fit.values.data()) / p.F - 1.0);
     }
     return rel;
   }()));
   if (db) {
-    for (const char* ref : {"vdh2004@1", "bvk2007@1", "ergun@1"}) {
+    const std::vector<const char*> refs =
+        per_species ? std::vector<const char*>{"bvk2007_poly@1", "vdh2005_poly@1", "hys2010@1"}
+                    : std::vector<const char*>{"vdh2004@1", "bvk2007@1", "ergun@1"};
+    for (const char* ref : refs) {
       try {
         const auto law = db->load(ref, RangePolicy::kExtrapolate);
         comparisons.push_back(compare(ref, fitter::relative_errors(*law, points)));

@@ -1,5 +1,6 @@
 // Packing basics: names of distributions and lattices, Packing geometry, option checks and the
 // generation summary.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -104,6 +105,29 @@ Vec3 Packing::separation(std::size_t i, std::size_t j) const {
   return d;
 }
 
+BidisperseCounts bidisperse_counts(int n, double size_ratio, double large_volume_fraction) {
+  const double r3 = size_ratio * size_ratio * size_ratio;
+  const double s = large_volume_fraction;
+  const double x = s / (r3 * (1.0 - s) + s);
+  BidisperseCounts c;
+  c.large = static_cast<int>(std::min<long long>(n, std::llround(x * n)));
+  c.small = n - c.large;
+  const double v_large = c.large * r3;
+  c.large_volume_fraction = v_large > 0.0 ? v_large / (v_large + c.small) : 0.0;
+  return c;
+}
+
+int bidisperse_min_spheres(double size_ratio, double large_volume_fraction) {
+  for (int n = 2; n <= 10000000; ++n) {
+    const BidisperseCounts c = bidisperse_counts(n, size_ratio, large_volume_fraction);
+    if (c.large >= 1 && c.small >= 1 &&
+        std::fabs(c.large_volume_fraction - large_volume_fraction) <= kBidisperseShareTolerance) {
+      return n;
+    }
+  }
+  return 0;
+}
+
 bool RandomPackingOptions::IsValid(std::string* error) const {
   if (!(phi > 0.0 && phi <= kMaxRandomPhi)) {
     return fail(error, "phi = " + format_number(phi) + " is outside (0, " +
@@ -121,6 +145,22 @@ bool RandomPackingOptions::IsValid(std::string* error) const {
     if (!in_closed(large_volume_fraction, 0.0, 1.0)) {
       return fail(error, "large_volume_fraction = " + format_number(large_volume_fraction) +
                              " is outside [0, 1]");
+    }
+  }
+  if (distribution == SizeDistribution::kBidisperse && large_volume_fraction > 0.0 &&
+      large_volume_fraction < 1.0) {
+    const BidisperseCounts c = bidisperse_counts(n, size_ratio, large_volume_fraction);
+    if (c.large < 1 || c.small < 1 ||
+        std::fabs(c.large_volume_fraction - large_volume_fraction) > kBidisperseShareTolerance) {
+      const int need = bidisperse_min_spheres(size_ratio, large_volume_fraction);
+      return fail(error, "n = " + std::to_string(n) + " spheres split into " +
+                             std::to_string(c.large) + " large and " + std::to_string(c.small) +
+                             " small ones at size_ratio " + format_number(size_ratio) +
+                             ", a large volume share of " + format_number(c.large_volume_fraction) +
+                             " for the " + format_number(large_volume_fraction) +
+                             " asked (both sizes, within " +
+                             format_number(kBidisperseShareTolerance) +
+                             "): use n >= " + std::to_string(need));
     }
   }
   if (distribution == SizeDistribution::kLognormal &&

@@ -114,20 +114,14 @@ std::vector<double> draw_diameters(const RandomPackingOptions& o, Random* rng,
   std::vector<double> d(n, 1.0);
   switch (o.distribution) {
     case SizeDistribution::kBidisperse: {
-      // Number fraction x of large spheres from the volume share s: x R^3 / (x R^3 + 1 - x) = s.
-      const double r3 = o.size_ratio * o.size_ratio * o.size_ratio;
-      const double s = o.large_volume_fraction;
-      const double x = s / (r3 * (1.0 - s) + s);
-      const std::size_t n_large =
-          std::min(n, static_cast<std::size_t>(std::llround(x * static_cast<double>(n))));
+      const BidisperseCounts counts = bidisperse_counts(o.n, o.size_ratio, o.large_volume_fraction);
+      const std::size_t n_large = static_cast<std::size_t>(counts.large);
       for (std::size_t i = 0; i < n_large; ++i) d[i] = o.size_ratio;  // Large spheres first.
-      const double v_large = static_cast<double>(n_large) * r3;
       (*info)["n_large"] = n_large;
       (*info)["n_small"] = n - n_large;
       (*info)["size_ratio"] = o.size_ratio;
-      (*info)["large_volume_fraction_requested"] = s;
-      (*info)["large_volume_fraction_achieved"] =
-          v_large / (v_large + static_cast<double>(n - n_large));
+      (*info)["large_volume_fraction_requested"] = o.large_volume_fraction;
+      (*info)["large_volume_fraction_achieved"] = counts.large_volume_fraction;
       break;
     }
     case SizeDistribution::kLognormal: {

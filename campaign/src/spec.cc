@@ -156,6 +156,22 @@ bool CampaignSpec::IsValid(std::string* error) const {
                            "' needs at least 2 [lbm] resolutions (3 for the measured order of "
                            "richardson); with one resolution use extrapolation = \"finest\"");
   }
+  if (distribution == "bi" && box_size == 0.0 && large_fraction > 0.0 && large_fraction < 1.0) {
+    const arrays::BidisperseCounts c =
+        arrays::bidisperse_counts(spheres, size_ratio, large_fraction);
+    if (c.large < 1 || c.small < 1 ||
+        std::fabs(c.large_volume_fraction - large_fraction) > arrays::kBidisperseShareTolerance) {
+      return fail(error,
+                  "[packing] spheres = " + std::to_string(spheres) + " split into " +
+                      std::to_string(c.large) + " large and " + std::to_string(c.small) +
+                      " small at size_ratio " + format_number(size_ratio) +
+                      ": a large volume share of " + format_number(c.large_volume_fraction) +
+                      ", not the large_fraction " + format_number(large_fraction) +
+                      " asked (within " + format_number(arrays::kBidisperseShareTolerance) +
+                      "); use spheres >= " +
+                      std::to_string(arrays::bidisperse_min_spheres(size_ratio, large_fraction)));
+    }
+  }
   // The padded spheres must be packable.
   const double gap = internal::effective_min_gap(*this);
   for (double p : phi) {

@@ -182,6 +182,18 @@ def bvk2007_poly(phi, re, y):
     return bvk2007_mono(phi, re) * (eps * y + phi * y * y + 0.064 * eps * y ** 3)
 
 
+def vdh2005_poly(phi, re, y):
+    return vdh2005(phi, re) * ((1.0 - phi) * y + phi * y * y)
+
+
+def hys2010(phi, re, y):
+    # MFiX DRAG_HYS: F_YS = 1/EPg + (F_D_BVK - 1/EPg)(a_YS Y_i + (1 - a_YS) Y_i^2), with the
+    # Stokes part at zero slip (MFiX sets F_D_BVK = 0 there) and no lubrication cross term.
+    eps = 1.0 - phi
+    a = 1.0 - 2.66 * phi + 9.096 * phi ** 2 - 11.338 * phi ** 3
+    return 1.0 / eps + (bvk2007_mono(phi, re) - 1.0 / eps) * (a * y + (1.0 - a) * y * y)
+
+
 def tenneti2011(phi, re):
     # Total-force TGS form; drag-only F = (1 - phi) F_TGS (waLBerla reading).
     eps = 1.0 - phi
@@ -231,6 +243,10 @@ def rows():
         for re in [0.0, 10.0, 100.0, 1000.0]:
             for y in [0.25, 0.5, 1.0, 2.0, 4.0]:
                 add("bvk2007_poly", phi, re, y, bvk2007_poly(phi, re, y))
+                add("hys2010", phi, re, y, hys2010(phi, re, y))
+    for phi in [0.1, 0.3, 0.5, 0.6]:
+        for y in [0.25, 0.5, 1.0, 2.0, 4.0]:
+            add("vdh2005_poly", phi, 0.0, y, vdh2005_poly(phi, 0.0, y))
     for phi in [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]:
         for re in [0.0, 1.0, 10.0, 100.0, 300.0]:
             add("tenneti2011", phi, re, None, tenneti2011(phi, re))
@@ -245,13 +261,15 @@ def main():
     w("# slip), phi = 1 - eps. beta-form laws are evaluated dimensionally (beta/phi with mu = 1.8e-5 Pa s,\n")
     w("# rho = 1.2 kg/m^3, d = 0.5 mm) and converted by beta = 18 mu phi eps F / d^2; total-force laws\n")
     w("# (hill_koch_ladd with Re_a = Re/2, tenneti2011) by F = (1 - phi) K. y = d_i/<d> (Sauter) for\n")
-    w("# bvk2007_poly, with Re based on <d>; empty for monodisperse laws. Values: 12 significant digits.\n")
+    w("# the polydisperse laws, with Re based on <d>; empty for monodisperse laws. Values: 12 significant digits.\n")
     w("# Formula sources: Schiller-Naumann 1933 (Re_p <= 1000: 24(1+0.15 Re^0.687), else 0.44 Re);\n")
     w("# Ergun 1952; Wen-Yu 1966 (eps^-2.65 in beta); Ding-Gidaspow 1990 (Ergun for eps <= 0.8);\n")
     w("# Lathouwers-Bellan arctan blend (MFiX DRAG_GIDASPOW_BLEND); Syamlal-O'Brien 1988 (C1 = 0.8,\n")
     w("# D1 = 2.65, interstitial Re); Di Felice 1994 and Rong-Dong-Yu 2013 (Dalla Valle C_d);\n")
     w("# Hill-Koch-Ladd 2001 as in MFiX DRAG_KOCH_HILL (17.14); van der Hoef et al. 2005 (Stokes);\n")
-    w("# Beetstra et al. 2007 polydisperse factor (1-phi)y + phi y^2 + 0.064 (1-phi) y^3;\n")
+    w("# Beetstra et al. 2007 polydisperse factor (1-phi)y + phi y^2 + 0.064 (1-phi) y^3; van der Hoef\n")
+    w("# et al. 2005's (1-phi)y + phi y^2; Yin-Sundaresan as in MFiX DRAG_HYS (1/eps + (F_BVK - 1/eps)\n")
+    w("# (a y + (1-a) y^2), a = 1 - 2.66 phi + 9.096 phi^2 - 11.338 phi^3, no lubrication term);\n")
     w("# Tenneti-Garg-Subramaniam 2011 (phi^3 in the last bracket, drag-only F = (1-phi) F_TGS).\n")
     w("law,phi,Re,y,F\n")
     for law, phi, re, y, value in rows():

@@ -127,18 +127,31 @@ const LawForm& fit_form(const std::string& key) {
     throw Error(ErrorCode::kInvalidArgument,
                 "form '" + key + "' is unknown (known forms: " + law_form_keys() + ")");
   }
-  if (form->num_extra_inputs > 0) {
-    throw Error(ErrorCode::kInvalidArgument,
-                "form '" + key +
-                    "' needs extra inputs (polydisperse); the fitter fits (phi, Re) "
-                    "forms only");
-  }
   return *form;
 }
 
-void validate_points(const std::vector<FitPoint>& points) {
+void validate_points(const std::vector<FitPoint>& points, const LawForm& form) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     const FitPoint& p = points[i];
+    if (static_cast<int>(p.extra.size()) != form.num_extra_inputs) {
+      std::string names;
+      for (const ExtraInputSpec& e : form.description.validity.extra) {
+        names += (names.empty() ? "" : ", ") + e.name;
+      }
+      throw Error(ErrorCode::kInvalidArgument,
+                  fmt::format("data point {} (phi = {}, Re = {}) has {} extra input(s); form {} "
+                              "takes {}{}",
+                              i + 1, p.phi, p.re, p.extra.size(), form.key(), form.num_extra_inputs,
+                              names.empty() ? std::string() : " (" + names + ")"));
+    }
+    for (double e : p.extra) {
+      if (!std::isfinite(e) || e <= 0.0) {
+        throw Error(ErrorCode::kInvalidArgument,
+                    fmt::format("data point {} (phi = {}, Re = {}): extra input {} must be finite "
+                                "and > 0",
+                                i + 1, p.phi, p.re, e));
+      }
+    }
     auto bad = [&](const char* field, double value, const char* range) {
       throw Error(ErrorCode::kInvalidArgument,
                   fmt::format("data point {} (phi = {}, Re = {}): {} = {} must be {}", i + 1, p.phi,
@@ -153,12 +166,14 @@ void validate_points(const std::vector<FitPoint>& points) {
 
 double value_of(double x) { return x; }
 double value_of(const AutoDiffScalar& x) { return x.a; }
-double eval_F(const LawForm& f, double phi, double re, const double* p) {
-  return f.F(phi, re, nullptr, p);
+double eval_F(const LawForm& f, double phi, double re, const std::vector<double>& extra,
+              const double* p) {
+  return f.F(phi, re, extra.empty() ? nullptr : extra.data(), p);
 }
 AutoDiffScalar eval_F(const LawForm& f, const AutoDiffScalar& phi, const AutoDiffScalar& re,
-                      const AutoDiffScalar* p) {
-  return f.F_autodiff(phi, re, nullptr, p);
+                      const std::vector<double>& extra, const AutoDiffScalar* p) {
+  std::vector<AutoDiffScalar> jets(extra.begin(), extra.end());
+  return f.F_autodiff(phi, re, jets.empty() ? nullptr : jets.data(), p);
 }
 
 /// r = (F(phi, Re; x) - F_i)/sigma_i over the scaled free variables z (one parameter block).
@@ -170,7 +185,7 @@ struct PointResidual {
     std::vector<T> p(model->params.size());
     for (std::size_t k = 0; k < p.size(); ++k) p[k] = T(model->params[k]);
     for (int j = 0; j < model->num_free(); ++j) p[model->free_index[j]] = z[0][j] * model->scale[j];
-    const T F = eval_F(*model->form, T(point.phi), T(point.re), p.data());
+    const T F = eval_F(*model->form, T(point.phi), T(point.re), point.extra, p.data());
     residual[0] = (F - point.F) / point.sigma;
     return std::isfinite(value_of(F));
   }
@@ -259,7 +274,8 @@ std::vector<std::string> undetermined_parameters(const Model& m,
   Eigen::MatrixXd J(points.size(), n);
   std::vector<double> g(n);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    internal::model_F_gradient(m, z.data(), points[i].phi, points[i].re, g.data());
+    internal::model_F_gradient(m, z.data(), points[i].phi, points[i].re, points[i].extra_data(),
+                               g.data());
     for (int j = 0; j < n; ++j) J(i, j) = std::isfinite(g[j]) ? g[j] / points[i].sigma : 0.0;
   }
   std::vector<bool> flagged(n, false);
@@ -331,7 +347,9 @@ int parameter_index(const LawForm& form, const std::string& name_or_alias) {
 std::vector<double> relative_errors(const Law& law, const std::vector<FitPoint>& points) {
   std::vector<double> errors;
   errors.reserve(points.size());
-  for (const FitPoint& p : points) errors.push_back(law.F(p.phi, p.re) / p.F - 1.0);
+  for (const FitPoint& p : points) {
+    errors.push_back(law.F(p.phi, p.re, p.extra_data()) / p.F - 1.0);
+  }
   return errors;
 }
 
@@ -386,7 +404,7 @@ FitResult fit_requested(const std::vector<FitPoint>& points, const FitOptions& o
   }
   const int num_free = model.num_free();
 
-  validate_points(points);
+  validate_points(points, form);
   const int num_points = static_cast<int>(points.size());
   if (num_points < num_free + 1) {
     throw Error(ErrorCode::kInvalidArgument,
@@ -465,7 +483,7 @@ FitResult fit_requested(const std::vector<FitPoint>& points, const FitOptions& o
   auto residual_stats = [&](const std::vector<double>& zz) {
     double chi2 = 0.0, sum_rel2 = 0.0, max_rel = 0.0;
     for (const FitPoint& p : points) {
-      const double F = internal::model_F(model, zz.data(), p.phi, p.re);
+      const double F = internal::model_F(model, zz.data(), p.phi, p.re, p.extra_data());
       chi2 += std::pow((F - p.F) / p.sigma, 2);
       const double rel = std::fabs(F / p.F - 1.0);
       sum_rel2 += rel * rel;
@@ -558,7 +576,8 @@ FitResult fit_requested(const std::vector<FitPoint>& points, const FitOptions& o
             solve_lsq(fit_model, train, options.loss, options.loss_scale, zf, false);
         if (!s.converged) ++failed;
         for (const FitPoint& p : test) {
-          sum_rel2 += std::pow(internal::model_F(fit_model, zf.data(), p.phi, p.re) / p.F - 1.0, 2);
+          sum_rel2 += std::pow(
+              internal::model_F(fit_model, zf.data(), p.phi, p.re, p.extra_data()) / p.F - 1.0, 2);
         }
       }
       result.cv_rms_rel_err = std::sqrt(sum_rel2 / num_points);

@@ -29,12 +29,15 @@ struct Model {
   std::vector<double> params_at(const double* z) const;  ///< All parameters with free = scale*z.
 };
 
-/// F(phi, Re) of the model at free variables z.
-double model_F(const Model& m, const double* z, double phi, double re);
+/// F(phi, Re) of the model at free variables z; `extra` holds the form's extra inputs (null if
+/// it has none).
+double model_F(const Model& m, const double* z, double phi, double re, const double* extra);
 /// F and dF/dz_j (num_free values) by automatic differentiation (Jets in chunks of 4).
-double model_F_gradient(const Model& m, const double* z, double phi, double re, double* grad);
+double model_F_gradient(const Model& m, const double* z, double phi, double re, const double* extra,
+                        double* grad);
 /// dF/dRe at (phi, re) for the full parameter vector (automatic differentiation).
-double dF_dRe(const LawForm& form, const double* params, double phi, double re);
+double dF_dRe(const LawForm& form, const double* params, double phi, double re,
+              const double* extra);
 
 /// Ceres' robust loss rho(s) of the squared residual s (rho = s without loss); *drho = rho'(s).
 double robust_rho(RobustLoss loss, double scale, double s, double* drho);
@@ -48,6 +51,10 @@ double lsq_cost(const Model& m, const std::vector<FitPoint>& points, RobustLoss 
 struct ConstraintGrid {
   std::vector<double> phi;
   std::vector<double> re;
+  /// Values of the form's extra inputs at which the grid is checked: the data's smallest and
+  /// largest of each (one empty set for a form without extra inputs).
+  std::vector<std::vector<double>> extra_sets{{}};
+  std::size_t nodes() const { return phi.size() * re.size() * extra_sets.size(); }
 };
 ConstraintGrid constraint_grid(const LawForm& form, const std::vector<FitPoint>& points);
 /// "" if F > 0 and dF/dRe >= 0 hold at every grid node, else where they do not.

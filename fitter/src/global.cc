@@ -110,7 +110,7 @@ void data_constraints(unsigned m, double* c, unsigned n, const double* y, double
   std::vector<double> g(nz);
   for (unsigned i = 0; i < m / 2; ++i) {
     const FitPoint& pt = (*d->points)[i];
-    const double F = model_F_gradient(*d->model, y, pt.phi, pt.re, g.data());
+    const double F = model_F_gradient(*d->model, y, pt.phi, pt.re, pt.extra_data(), g.data());
     const double rel = F / pt.F - 1.0;
     c[2 * i] = rel - t;
     c[2 * i + 1] = -rel - t;
@@ -137,30 +137,33 @@ void grid_constraints(unsigned m, double* c, unsigned n, const double* y, double
   std::vector<double> g(nz), zp(y, y + nz), zm(y, y + nz);
   const std::vector<double> params = model.params_at(y);
   unsigned k = 0;
-  for (double phi : d->grid->phi) {
-    for (double re : d->grid->re) {
-      const double F = model_F_gradient(model, y, phi, re, g.data());
-      c[k] = -F;
-      const double slope = dF_dRe(*model.form, params.data(), phi, re);
-      c[k + 1] = -slope;
-      if (grad) {
-        double* gF = grad + k * n;
-        double* gS = grad + (k + 1) * n;
-        for (unsigned j = 0; j < nz; ++j) {
-          gF[j] = -g[j];
-          const double h = 1e-6 * std::max(1.0, std::fabs(y[j]));
-          zp[j] = y[j] + h;
-          zm[j] = y[j] - h;
-          const std::vector<double> pp = model.params_at(zp.data()),
-                                    pm = model.params_at(zm.data());
-          gS[j] =
-              -(dF_dRe(*model.form, pp.data(), phi, re) - dF_dRe(*model.form, pm.data(), phi, re)) /
-              (2.0 * h);
-          zp[j] = zm[j] = y[j];
+  for (const std::vector<double>& extra_set : d->grid->extra_sets) {
+    const double* extra = extra_set.empty() ? nullptr : extra_set.data();
+    for (double phi : d->grid->phi) {
+      for (double re : d->grid->re) {
+        const double F = model_F_gradient(model, y, phi, re, extra, g.data());
+        c[k] = -F;
+        const double slope = dF_dRe(*model.form, params.data(), phi, re, extra);
+        c[k + 1] = -slope;
+        if (grad) {
+          double* gF = grad + k * n;
+          double* gS = grad + (k + 1) * n;
+          for (unsigned j = 0; j < nz; ++j) {
+            gF[j] = -g[j];
+            const double h = 1e-6 * std::max(1.0, std::fabs(y[j]));
+            zp[j] = y[j] + h;
+            zm[j] = y[j] - h;
+            const std::vector<double> pp = model.params_at(zp.data()),
+                                      pm = model.params_at(zm.data());
+            gS[j] = -(dF_dRe(*model.form, pp.data(), phi, re, extra) -
+                      dF_dRe(*model.form, pm.data(), phi, re, extra)) /
+                    (2.0 * h);
+            zp[j] = zm[j] = y[j];
+          }
+          gF[nz] = gS[nz] = 0.0;
         }
-        gF[nz] = gS[nz] = 0.0;
+        k += 2;
       }
-      k += 2;
     }
   }
   (void)m;
@@ -169,7 +172,7 @@ void grid_constraints(unsigned m, double* c, unsigned n, const double* y, double
 double max_relative_error(const Model& m, const std::vector<FitPoint>& points, const double* z) {
   double worst = 0.0;
   for (const FitPoint& pt : points) {
-    worst = std::max(worst, std::fabs(model_F(m, z, pt.phi, pt.re) / pt.F - 1.0));
+    worst = std::max(worst, std::fabs(model_F(m, z, pt.phi, pt.re, pt.extra_data()) / pt.F - 1.0));
   }
   return worst;
 }
@@ -192,7 +195,7 @@ bool minimax_fit(const Model& m, const std::vector<FitPoint>& points, const Cons
   nlopt_add_inequality_mconstraint(opt, m_data, data_constraints, &data, tol_data.data());
   std::vector<double> tol_grid;
   if (grid) {
-    const unsigned m_grid = 2 * static_cast<unsigned>(grid->phi.size() * grid->re.size());
+    const unsigned m_grid = 2 * static_cast<unsigned>(grid->nodes());
     tol_grid.assign(m_grid, 1e-12);
     nlopt_add_inequality_mconstraint(opt, m_grid, grid_constraints, &data, tol_grid.data());
   }

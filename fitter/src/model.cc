@@ -24,25 +24,42 @@ std::vector<double> Model::params_at(const double* z) const {
   return p;
 }
 
-double model_F(const Model& m, const double* z, double phi, double re) {
-  const std::vector<double> p = m.params_at(z);
-  return m.form->F(phi, re, nullptr, p.data());
+namespace {
+
+/// The extra inputs as constants of the automatic derivatives.
+std::vector<AutoDiffScalar> extra_jets(const LawForm& form, const double* extra) {
+  std::vector<AutoDiffScalar> jets;
+  for (int k = 0; k < form.num_extra_inputs; ++k) jets.emplace_back(extra[k]);
+  return jets;
 }
 
-double model_F_gradient(const Model& m, const double* z, double phi, double re, double* grad) {
+const AutoDiffScalar* data_or_null(const std::vector<AutoDiffScalar>& v) {
+  return v.empty() ? nullptr : v.data();
+}
+
+}  // namespace
+
+double model_F(const Model& m, const double* z, double phi, double re, const double* extra) {
+  const std::vector<double> p = m.params_at(z);
+  return m.form->F(phi, re, extra, p.data());
+}
+
+double model_F_gradient(const Model& m, const double* z, double phi, double re, const double* extra,
+                        double* grad) {
   constexpr int kStride = 4;  // AutoDiffScalar = ceres::Jet<double, 4>
   const int n = m.num_free();
   std::vector<AutoDiffScalar> p(m.params.size());
   const std::vector<double> values = m.params_at(z);
   const AutoDiffScalar phi_jet(phi), re_jet(re);
-  double F = m.form->F(phi, re, nullptr, values.data());
+  const std::vector<AutoDiffScalar> extra_jet = extra_jets(*m.form, extra);
+  double F = m.form->F(phi, re, extra, values.data());
   for (int first = 0; first < n; first += kStride) {
     for (std::size_t k = 0; k < values.size(); ++k) p[k] = AutoDiffScalar(values[k]);
     const int count = std::min(kStride, n - first);
     for (int c = 0; c < count; ++c) {
       p[m.free_index[first + c]] = AutoDiffScalar(values[m.free_index[first + c]], c);
     }
-    const AutoDiffScalar f = m.form->F_autodiff(phi_jet, re_jet, nullptr, p.data());
+    const AutoDiffScalar f = m.form->F_autodiff(phi_jet, re_jet, data_or_null(extra_jet), p.data());
     F = f.a;
     // dF/dz = dF/dx * scale.
     for (int c = 0; c < count; ++c) grad[first + c] = f.v[c] * m.scale[first + c];
@@ -50,11 +67,13 @@ double model_F_gradient(const Model& m, const double* z, double phi, double re, 
   return F;
 }
 
-double dF_dRe(const LawForm& form, const double* params, double phi, double re) {
+double dF_dRe(const LawForm& form, const double* params, double phi, double re,
+              const double* extra) {
   std::vector<AutoDiffScalar> p(form.num_parameters);
   for (int k = 0; k < form.num_parameters; ++k) p[k] = AutoDiffScalar(params[k]);
-  const AutoDiffScalar f =
-      form.F_autodiff(AutoDiffScalar(phi), AutoDiffScalar(re, 0), nullptr, p.data());
+  const std::vector<AutoDiffScalar> extra_jet = extra_jets(form, extra);
+  const AutoDiffScalar f = form.F_autodiff(AutoDiffScalar(phi), AutoDiffScalar(re, 0),
+                                           data_or_null(extra_jet), p.data());
   return f.v[0];
 }
 
@@ -87,8 +106,8 @@ double lsq_cost(const Model& m, const std::vector<FitPoint>& points, RobustLoss 
   if (grad) std::fill(grad, grad + n, 0.0);
   double cost = 0.0;
   for (const FitPoint& pt : points) {
-    const double F =
-        grad ? model_F_gradient(m, z, pt.phi, pt.re, g.data()) : model_F(m, z, pt.phi, pt.re);
+    const double F = grad ? model_F_gradient(m, z, pt.phi, pt.re, pt.extra_data(), g.data())
+                          : model_F(m, z, pt.phi, pt.re, pt.extra_data());
     const double r = (F - pt.F) / pt.sigma;
     double drho = 1.0;
     cost += 0.5 * robust_rho(loss, loss_scale, r * r, &drho);
@@ -118,6 +137,16 @@ ConstraintGrid constraint_grid(const LawForm& form, const std::vector<FitPoint>&
   }
   ConstraintGrid grid;
   for (int i = 0; i < kNodes; ++i) grid.phi.push_back(lo + (hi - lo) * i / (kNodes - 1.0));
+  if (form.num_extra_inputs > 0 && !points.empty()) {
+    std::vector<double> smallest = points.front().extra, largest = points.front().extra;
+    for (const FitPoint& p : points) {
+      for (std::size_t k = 0; k < p.extra.size() && k < smallest.size(); ++k) {
+        smallest[k] = std::min(smallest[k], p.extra[k]);
+        largest[k] = std::max(largest[k], p.extra[k]);
+      }
+    }
+    grid.extra_sets = {smallest, largest};
+  }
   double rlo = std::max({box.re.min, re_lo - re_pad, 0.0}),
          rhi = std::min(box.re.max, re_hi + re_pad);
   if (rlo > rhi) {
@@ -144,24 +173,31 @@ std::string check_constraints(const LawForm& form, const double* params,
                               const ConstraintGrid& grid) {
   int negative_F = 0, decreasing = 0;
   std::string first_negative, first_decreasing;
-  for (double phi : grid.phi) {
-    for (double re : grid.re) {
-      const double F = form.F(phi, re, nullptr, params);
-      if (!(F > 0.0)) {
-        if (negative_F++ == 0)
-          first_negative = fmt::format("phi = {:.3g}, Re = {:.3g} (F = {:.4g})", phi, re, F);
-      }
-      const double slope = dF_dRe(form, params, phi, re);
-      // Tolerance: rounding of the automatic derivative (relative 1e-12 of F per unit Re).
-      if (!(slope >= -1e-12 * std::fabs(F))) {
-        if (decreasing++ == 0) {
-          first_decreasing =
-              fmt::format("phi = {:.3g}, Re = {:.3g} (dF/dRe = {:.4g})", phi, re, slope);
+  for (const std::vector<double>& extra_set : grid.extra_sets) {
+    const double* extra = extra_set.empty() ? nullptr : extra_set.data();
+    const std::string at_extra =
+        extra_set.empty() ? std::string() : fmt::format(", y = {:.3g}", extra_set[0]);
+    for (double phi : grid.phi) {
+      for (double re : grid.re) {
+        const double F = form.F(phi, re, extra, params);
+        if (!(F > 0.0)) {
+          if (negative_F++ == 0) {
+            first_negative =
+                fmt::format("phi = {:.3g}, Re = {:.3g}{} (F = {:.4g})", phi, re, at_extra, F);
+          }
+        }
+        const double slope = dF_dRe(form, params, phi, re, extra);
+        // Tolerance: rounding of the automatic derivative (relative 1e-12 of F per unit Re).
+        if (!(slope >= -1e-12 * std::fabs(F))) {
+          if (decreasing++ == 0) {
+            first_decreasing = fmt::format("phi = {:.3g}, Re = {:.3g}{} (dF/dRe = {:.4g})", phi, re,
+                                           at_extra, slope);
+          }
         }
       }
     }
   }
-  const std::size_t nodes = grid.phi.size() * grid.re.size();
+  const std::size_t nodes = grid.nodes();
   std::string report;
   if (negative_F > 0) {
     report +=

@@ -1,6 +1,7 @@
 // FitResult reports and the draft law record of a fit.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -119,6 +120,16 @@ LawRecord fitted_record(const FitResult& result, const FitOptions& options, cons
                             [](const FitPoint& a, const FitPoint& b) { return a.re < b.re; });
     record.validity.phi = {phi_lo->phi, phi_hi->phi};
     record.validity.re = {re_lo->re, re_hi->re};
+    // A polydisperse form's extra inputs: the range the data cover.
+    for (std::size_t k = 0; k < record.validity.extra.size(); ++k) {
+      double lo = std::numeric_limits<double>::max(), hi = -lo;
+      for (const FitPoint& p : points) {
+        if (k >= p.extra.size()) continue;
+        lo = std::min(lo, p.extra[k]);
+        hi = std::max(hi, p.extra[k]);
+      }
+      if (lo <= hi) record.validity.extra[k].range = {lo, hi};
+    }
   }
   record.provenance.kind = "fitted";
   record.provenance.citation = "draglab fit of " + form.description.title;

@@ -311,6 +311,21 @@ TEST(RandomPackingOptions, BadInputNamesTheFieldAndTheLimit) {
   o.size_ratio = 2.0;
   o.large_volume_fraction = 1.2;
   expect_invalid(o, {"large_volume_fraction", "[0, 1]"});
+  // Ratio 4 at a large volume share of 0.25 needs about 190 small spheres per large one: 40
+  // spheres hold no large sphere, 200 hold one (share 0.25 would need 0.5 of one).
+  o.size_ratio = 4.0;
+  o.large_volume_fraction = 0.25;
+  o.n = 40;
+  expect_invalid(o, {"n = 40", "0 large and 40 small",
+                     "use n >= " + std::to_string(bidisperse_min_spheres(4.0, 0.25))});
+  EXPECT_GT(bidisperse_min_spheres(4.0, 0.25), 100);
+  const BidisperseCounts reachable =
+      bidisperse_counts(bidisperse_min_spheres(4.0, 0.25), 4.0, 0.25);
+  EXPECT_GE(reachable.large, 1);
+  EXPECT_NEAR(reachable.large_volume_fraction, 0.25, kBidisperseShareTolerance);
+  o.n = bidisperse_min_spheres(4.0, 0.25);
+  std::string ok_error;
+  EXPECT_TRUE(o.IsValid(&ok_error)) << ok_error;
 
   o = good;
   o.distribution = SizeDistribution::kLognormal;

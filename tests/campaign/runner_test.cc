@@ -337,7 +337,7 @@ TEST(CampaignRunner, BidisperseUnitsRecordEachSizeClassForTheSpeciesExport) {
   spec.phi = {0.2};
   spec.re = {0};
   spec.realizations = 2;
-  spec.spheres = 12;
+  spec.spheres = 24;  // 3 large and 21 small: a large volume share of 0.53 (12 cannot reach 0.5)
   spec.distribution = "bi";
   spec.size_ratio = 2.0;
   spec.large_fraction = 0.5;

@@ -132,6 +132,22 @@ TEST(CampaignSpec, ContradictionsAreRefused) {
   EXPECT_NE(twice.find("[grid] re lists 20 twice"), std::string::npos) << twice;
 }
 
+TEST(CampaignSpec, ABidisperseShareTheSpheresCannotReachIsRefused) {
+  // Ratio 4 at a large volume share of 0.25: about 190 small spheres per large one.
+  const std::string few = parse_error(
+      edit("spheres = 16",
+           "spheres = 40\ndistribution = \"bi\"\nsize_ratio = 4\nlarge_fraction = 0.25"));
+  EXPECT_NE(few.find("[packing] spheres = 40 split into 0 large and 40 small"), std::string::npos)
+      << few;
+  EXPECT_NE(few.find("use spheres >= "), std::string::npos) << few;
+  // Where the share is reachable the spec parses.
+  const CampaignSpec ok = parse_campaign_spec_text(
+      edit("spheres = 16",
+           "spheres = 400\ndistribution = \"bi\"\nsize_ratio = 4\nlarge_fraction = 0.25"),
+      "spec.toml");
+  EXPECT_EQ(ok.spheres, 400);
+}
+
 TEST(CampaignSpec, OtherRangesAndTypes) {
   EXPECT_NE(parse_error(edit("realizations = 2", "realizations = 0"))
                 .find("[grid] realizations = 0 is outside [1, 100]"),

@@ -103,6 +103,41 @@ TEST(DatasetStore, RoundTripIsExactAndStoringTwiceReturnsTheSameDataset) {
   EXPECT_THROW(load_dataset(db, "0000000"), Error);
 }
 
+TEST(DatasetStore, PerSpeciesPointsCarryTheirSizeRatio) {
+  // Points of a polydisperse campaign's size classes share (phi, Re) and differ in y; y is part
+  // of the identity, and a dataset without y keeps the hash it had before y existed (y is written
+  // only where it is set).
+  Dataset species = sample();
+  const std::string without_y = dataset_hash(species.points);
+  for (std::size_t i = 0; i < species.points.size(); ++i) species.points[i].y = 0.75 + 0.1 * i;
+  EXPECT_NE(dataset_hash(species.points), without_y);
+  species.points[1].phi = species.points[0].phi;
+  species.points[1].re_target = species.points[0].re_target;  // same point, another size class
+  TempDir dir;
+  Database db(dir.file("d.db"));
+  const Dataset stored = store_dataset(db, species);
+  const Dataset loaded = load_dataset(db, stored.id);
+  for (std::size_t i = 0; i < species.points.size(); ++i) {
+    EXPECT_EQ(loaded.points[i].y, species.points[i].y);
+  }
+  Dataset copy = species;
+  copy.hash = dataset_hash(copy.points);
+  copy.id = copy.hash.substr(0, 12);
+  write_dataset_csv(copy, dir.file("species.csv"));
+  const Dataset back = read_dataset_csv(dir.file("species.csv"));
+  EXPECT_EQ(back.hash, copy.hash);
+  // The same size class twice is refused, naming y; y must be positive in every row.
+  species.points[1].y = species.points[0].y;
+  EXPECT_THROW(store_dataset(db, species), Error);
+  std::ofstream(dir.file("bad.csv")) << "phi,re,F,F_uncertainty,y\n0.3,0,5,0.1,0.8\n0.3,0,6,0.1,\n";
+  try {
+    read_dataset_csv(dir.file("bad.csv"));
+    ADD_FAILURE() << "a row without y accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("column 'y'"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DatasetStore, RowsAreImmutableForEveryClient) {
   TempDir dir;
   const std::string path = dir.file("d.db");

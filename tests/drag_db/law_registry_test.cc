@@ -366,8 +366,8 @@ INSTANTIATE_TEST_SUITE_P(LawForms, LawFormTest, ::testing::ValuesIn(all_law_form
 TEST(LawRegistry, HoldsTheLiteratureLibrary) {
   for (const char* key :
        {"bvk2007", "bvk2007_poly", "di_felice", "ergun", "gidaspow", "gidaspow_blend",
-        "hill_koch_ladd", "rong2013", "schiller_naumann", "syamlal_obrien", "tang2015",
-        "tenneti2011", "vdh2004", "vdh2005", "wen_yu"}) {
+        "hill_koch_ladd", "hys2010", "rong2013", "schiller_naumann", "syamlal_obrien", "tang2015",
+        "tenneti2011", "vdh2004", "vdh2005", "vdh2005_poly", "wen_yu"}) {
     EXPECT_NO_THROW(find_law_form(key)) << key;
   }
   const std::vector<const LawForm*> forms = all_law_forms();

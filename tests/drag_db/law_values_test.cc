@@ -231,9 +231,9 @@ TEST(LawValues, IndependentPythonEvaluation) {
     ++per_law[law];
   }
   // Every law without values in the dossier's tables is covered here.
-  for (const char* law :
-       {"schiller_naumann", "gidaspow", "gidaspow_blend", "syamlal_obrien", "di_felice", "rong2013",
-        "hill_koch_ladd", "bvk2007_poly", "vdh2005", "tenneti2011", "wen_yu"}) {
+  for (const char* law : {"schiller_naumann", "gidaspow", "gidaspow_blend", "syamlal_obrien",
+                          "di_felice", "rong2013", "hill_koch_ladd", "bvk2007_poly", "vdh2005",
+                          "vdh2005_poly", "hys2010", "tenneti2011", "wen_yu"}) {
     EXPECT_GE(per_law[law], 5) << law;
   }
 }

@@ -44,7 +44,7 @@ std::vector<FitPoint> synthetic(
   std::vector<FitPoint> points;
   for (const auto& [phi, re] : grid) {
     const double F = form.F(phi, re, nullptr, params.data());
-    points.push_back({phi, re, F * (1.0 + rel_sigma * gauss(rng)), rel_sigma * F});
+    points.push_back({phi, re, F * (1.0 + rel_sigma * gauss(rng)), rel_sigma * F, {}});
   }
   return points;
 }
@@ -93,6 +93,58 @@ TEST(Fit, RecoversVdh2004ParametersWithinIntervals) {
   EXPECT_TRUE(r.constraints_checked);
   EXPECT_TRUE(r.constraints_satisfied) << r.constraint_report;
   EXPECT_FALSE(r.FullReport().empty());
+}
+
+TEST(Fit, RecoversAPolydisperseSizeFactorFromPerSpeciesPoints) {
+  // Per-species Stokes points as the bidisperse campaign gives them: phi 0.1..0.6, each with the
+  // two size classes of three mixtures (y from ratios 1.5, 2, 4), made by bvk2007_polyfit with
+  // p_a, p_b, g away from their defaults, 2 % noise. The fit sees y as the form's extra input.
+  const LawForm& form = find_law_form("bvk2007_polyfit");
+  const std::vector<double> truth =
+      with("bvk2007_polyfit", {{"p_a", 1.15}, {"p_b", 0.85}, {"g", 0.02}});
+  std::mt19937 rng(36);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<FitPoint> points;
+  for (double phi : {0.1, 0.2, 0.3, 0.4, 0.5, 0.6}) {
+    for (double y : {0.83, 1.25, 0.75, 1.5, 0.45, 1.8}) {
+      const double F = form.F(phi, 0.0, &y, truth.data());
+      points.push_back({phi, 0.0, F * (1.0 + 0.02 * gauss(rng)), 0.02 * F, {y}});
+    }
+  }
+  FitOptions options;
+  options.form = "bvk2007_polyfit";
+  options.free = {"p_a", "p_b", "g"};
+  const FitResult r = fit_law(points, options);
+  ASSERT_TRUE(r.converged);
+  for (const char* name : {"p_a", "p_b", "g"}) {
+    const int k = parameter_index(form, name);
+    EXPECT_LE(r.ci95_low[k], truth[k]) << name;
+    EXPECT_GE(r.ci95_high[k], truth[k]) << name;
+    EXPECT_LT(std::fabs(r.values[k] - truth[k]), 4.0 * sd(r, k)) << name;
+  }
+  EXPECT_NEAR(r.rms_rel_err, 0.02, 0.008);
+  EXPECT_TRUE(r.constraints_satisfied) << r.constraint_report;
+  // The stored record keeps the range of y the data cover.
+  const LawRecord record = fitted_record(r, options, "poly_refit", "id", "hash", points);
+  ASSERT_EQ(record.validity.extra.size(), 1u);
+  EXPECT_EQ(record.validity.extra[0].range.min, 0.45);
+  EXPECT_EQ(record.validity.extra[0].range.max, 1.8);
+
+  // Points without y for a form that needs it, and with y for one that does not: refused, naming
+  // the point and the input.
+  std::vector<FitPoint> without = points;
+  without[3].extra.clear();
+  try {
+    fit_law(without, options);
+    ADD_FAILURE() << "no error for a point without y";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(std::string(e.what()).find("data point 4"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("takes 1 (y)"), std::string::npos) << e.what();
+  }
+  FitOptions mono;
+  mono.form = "bvk2007";
+  EXPECT_THROW(fit_law(points, mono), Error);
 }
 
 TEST(Fit, IntervalsCoverTheTruthAtAbout95Percent) {
@@ -399,7 +451,7 @@ TEST(Fit, CommittedQuickDatasetReproducesItsIdAndRefitsDetermined) {
   EXPECT_EQ(d.id, "a0b7cdab6cd4");
   ASSERT_EQ(d.points.size(), 20u);
   std::vector<FitPoint> points;
-  for (const DatasetPoint& p : d.points) points.push_back({p.phi, p.re, p.F, p.F_uncertainty});
+  for (const DatasetPoint& p : d.points) points.push_back({p.phi, p.re, p.F, p.F_uncertainty, {}});
   FitOptions options;
   options.cv_folds = 5;
   const FitResult r = fit_law(points, options);

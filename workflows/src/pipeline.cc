@@ -32,7 +32,7 @@ double seconds_since(Clock::time_point start) {
 std::vector<fitter::FitPoint> fit_points(const Dataset& dataset) {
   std::vector<fitter::FitPoint> points;
   for (const DatasetPoint& p : dataset.points)
-    points.push_back({p.phi, p.re, p.F, p.F_uncertainty});
+    points.push_back({p.phi, p.re, p.F, p.F_uncertainty, {}});
   return points;
 }
 

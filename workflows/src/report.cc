@@ -453,7 +453,7 @@ ReportSummary write_report(const Database& db, const ReportOptions& options,
   // Forms refitted and laws as published on the same points (the seed's comparison of forms).
   std::vector<fitter::FitPoint> fit_points;
   for (const DatasetPoint& p : in.dataset.points)
-    fit_points.push_back({p.phi, p.re, p.F, p.F_uncertainty});
+    fit_points.push_back({p.phi, p.re, p.F, p.F_uncertainty, {}});
   std::vector<const Law*> published;
   for (const ReportLaw& rl : in.laws) {
     if (rl.role == "reference") published.push_back(rl.law.get());

@@ -4,6 +4,7 @@
 #include <sqlite3.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -58,6 +60,9 @@ nlohmann::json canonical_points(const std::vector<DatasetPoint>& points, bool wi
                      {"F_at_resolution", at},
                      {"order", exact(p.order)},
                      {"extrapolation", p.extrapolation}});
+    // Only per-species points carry y: the text, and the hash, of every other dataset is as
+    // before.
+    if (p.y > 0.0) array.back()["y"] = exact(p.y);
     if (with_timing) array.back()["wall_s"] = exact(p.wall_s);
   }
   return array;
@@ -83,6 +88,7 @@ std::vector<DatasetPoint> points_from_json(const std::string& text) {
     p.order = number_of(j.at("order"));
     p.extrapolation = j.at("extrapolation").get<std::string>();
     p.wall_s = number_of(j.at("wall_s"));
+    if (j.contains("y")) p.y = number_of(j.at("y"));
     points.push_back(p);
   }
   return points;
@@ -177,15 +183,17 @@ void validate_point(const DatasetPoint& p, const std::string& where) {
 /// not) would be fitted as independent measurements.
 void check_unique_points(const std::vector<DatasetPoint>& points,
                          const std::vector<std::string>& where) {
-  std::map<std::pair<double, double>, std::size_t> seen;
+  std::map<std::tuple<double, double, double>, std::size_t> seen;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const auto key = std::make_pair(points[i].phi, points[i].re_target);
+    const auto key = std::make_tuple(points[i].phi, points[i].re_target, points[i].y);
     const auto [it, inserted] = seen.emplace(key, i);
     if (!inserted) {
+      const std::string y = points[i].y > 0.0 ? ", y = " + exact(points[i].y) : "";
       throw Error(ErrorCode::kInvalidArgument,
                   where[i] + ": (phi, re_target) = (" + exact(points[i].phi) + ", " +
-                      exact(points[i].re_target) + ") already given at " + where[it->second] +
-                      " (F = " + exact(points[it->second].F) + " there, " + exact(points[i].F) +
+                      exact(points[i].re_target) + ")" + y + " already given at " +
+                      where[it->second] + " (F = " + exact(points[it->second].F) + " there, " +
+                      exact(points[i].F) +
                       " here): one row per point (combine repeated measurements first)");
     }
   }
@@ -353,7 +361,8 @@ Dataset read_dataset_csv(const std::string& path) {
                                                           "F_at_resolution",
                                                           "order",
                                                           "extrapolation",
-                                                          "wall_s"};
+                                                          "wall_s",
+                                                          "y"};
       for (std::size_t c = 0; c < header.size(); ++c) {
         if (!column.emplace(header[c], c).second) {
           throw Error(ErrorCode::kInvalidArgument,
@@ -365,7 +374,7 @@ Dataset read_dataset_csv(const std::string& path) {
                       where + ": unknown column '" + header[c] +
                           "' (required: phi,re,F,F_uncertainty; optional: re_target, "
                           "F_standard_error, F_discretisation_error, realizations, resolutions, "
-                          "F_at_resolution, order, extrapolation, wall_s)");
+                          "F_at_resolution, order, extrapolation, wall_s, y)");
         }
       }
       for (const char* required : {"phi", "re", "F", "F_uncertainty"}) {
@@ -374,7 +383,7 @@ Dataset read_dataset_csv(const std::string& path) {
                       where + ": the header has no column '" + required +
                           "' (required: phi,re,F,F_uncertainty; optional: re_target, "
                           "F_standard_error, F_discretisation_error, realizations, resolutions, "
-                          "F_at_resolution, order, extrapolation, wall_s)");
+                          "F_at_resolution, order, extrapolation, wall_s, y)");
         }
       }
       continue;
@@ -435,6 +444,14 @@ Dataset read_dataset_csv(const std::string& path) {
     p.order = number("order", 0.0);
     if (column.count("extrapolation")) p.extrapolation = cells[column["extrapolation"]];
     p.wall_s = number("wall_s", 0.0);
+    if (column.count("y")) {
+      p.y = number("y", NAN);
+      if (!(p.y > 0.0 && p.y <= 100.0)) {
+        throw Error(ErrorCode::kInvalidArgument,
+                    where + ", column 'y': " + exact(p.y) +
+                        " is outside (0, 100] (d_i/<d> of a size class; every row needs one)");
+      }
+    }
     validate_point(p, where);
     dataset.points.push_back(p);
     row_where.push_back(where);
@@ -458,8 +475,11 @@ std::string dataset_csv_text(const Dataset& dataset, const std::vector<std::stri
     std::istringstream lines(line);
     for (std::string part; std::getline(lines, part);) out << "# " << part << "\n";
   }
+  const bool per_species = std::any_of(dataset.points.begin(), dataset.points.end(),
+                                       [](const DatasetPoint& p) { return p.y > 0.0; });
   out << "phi,re_target,re,F,F_standard_error,F_discretisation_error,F_uncertainty,realizations,"
-         "resolutions,F_at_resolution,order,extrapolation,wall_s\n";
+         "resolutions,F_at_resolution,order,extrapolation,wall_s"
+      << (per_species ? ",y" : "") << '\n';
   auto joined = [](const std::vector<double>& v) {
     std::string s;
     for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ";" : "") + exact(v[i]);
@@ -470,7 +490,9 @@ std::string dataset_csv_text(const Dataset& dataset, const std::vector<std::stri
         << ',' << exact(p.F_standard_error) << ',' << exact(p.F_discretisation_error) << ','
         << exact(p.F_uncertainty) << ',' << p.realizations << ',' << joined(p.resolutions) << ','
         << joined(p.F_at_resolution) << ',' << exact(p.order) << ',' << p.extrapolation << ','
-        << exact(p.wall_s) << '\n';
+        << exact(p.wall_s);
+    if (per_species) out << ',' << exact(p.y);
+    out << '\n';
   }
   return out.str();
 }

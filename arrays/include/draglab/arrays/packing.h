@@ -87,6 +87,19 @@ struct RandomPackingOptions {
   bool IsValid(std::string* error) const;
 };
 
+/// How a bidisperse packing of n spheres splits: the number fraction x of large spheres solves
+/// x R^3 / (x R^3 + 1 - x) = s for the asked volume share s, rounded to whole spheres.
+struct BidisperseCounts {
+  int large = 0, small = 0;
+  double large_volume_fraction = 0.0;  ///< What the whole spheres achieve.
+};
+BidisperseCounts bidisperse_counts(int n, double size_ratio, double large_volume_fraction);
+
+/// The fewest spheres whose split keeps both sizes and the achieved large volume share within
+/// kBidisperseShareTolerance of the asked one (0 if none up to 10^7).
+int bidisperse_min_spheres(double size_ratio, double large_volume_fraction);
+constexpr double kBidisperseShareTolerance = 0.05;
+
 /// What a random generation did. Iterations and sweeps are totals over all attempts; the other
 /// fields describe the returned (last) attempt.
 struct GenerationSummary {

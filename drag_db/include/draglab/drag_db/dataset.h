@@ -35,6 +35,10 @@ struct DatasetPoint {
   double order = 0.0;                   ///< Convergence order used (0: none / not measured).
   std::string extrapolation;            ///< "richardson", "inverse_d" or "finest".
   double wall_s = 0.0;                  ///< Total LBM run time of the point's units.
+  /// A size class of a polydisperse packing: y = d_i/<d> (Sauter mean), F its own drag F_i
+  /// normalised with d_i, Re on <d>; 0 for a mixture or monodisperse point. Fits of polydisperse
+  /// forms take it as their extra input.
+  double y = 0.0;
 };
 
 struct Dataset {
@@ -65,9 +69,9 @@ Dataset load_dataset(const Database& db, const std::string& id_or_prefix);
 std::vector<Dataset> list_datasets(const Database& db);
 
 /// CSV with a header line; columns phi,re,F,F_uncertainty are required (re_target defaults to
-/// re, the other fields to 0/empty), '#' lines are comments. Throws Error(kInvalidArgument)
-/// naming the line and column for malformed input (non-numeric, phi outside (0, 0.74], Re < 0,
-/// F <= 0, uncertainty <= 0).
+/// re, the other fields to 0/empty; y, if given, must be > 0 in every row), '#' lines are comments.
+/// Throws Error(kInvalidArgument) naming the line and column for malformed input (non-numeric, phi
+/// outside (0, 0.74], Re < 0, F <= 0, uncertainty <= 0).
 Dataset read_dataset_csv(const std::string& path);
 /// The CSV text of every field of the points (resolutions joined with ';'), after a header of
 /// '#' lines: id, hash and conventions, then each `provenance` line (multi-line entries split).

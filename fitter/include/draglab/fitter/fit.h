@@ -34,6 +34,9 @@ struct FitPoint {
   double re = 0.0;
   double F = 0.0;
   double sigma = 0.0;
+  /// The form's extra inputs, one value each (polydisperse forms: y = d_i/<d>); empty otherwise.
+  std::vector<double> extra;
+  const double* extra_data() const { return extra.empty() ? nullptr : extra.data(); }
 };
 
 enum class Objective { kLeastSquares, kMinimax };
