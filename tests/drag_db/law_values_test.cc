@@ -337,5 +337,24 @@ TEST(LawValues, PolydisperseFormAtUnitSizeRatio) {
   }
 }
 
+TEST(LawValues, PolydisperseFormsReduceToEachOther) {
+  // The fitting form at its defaults is Beetstra et al.'s factor, and without the y^3 terms van
+  // der Hoef et al.'s (which at Re = 0 is vdh2005_poly); HYS at y = 1 is bvk2007 itself.
+  const std::vector<double> no_cubic = with("bvk2007_polyfit", {{"c0", 0.0}, {"c1", 0.0}});
+  for (double phi : {0.1, 0.35, 0.6}) {
+    for (double y : {0.3, 0.8, 1.0, 2.5, 4.0}) {
+      for (double re : {0.0, 10.0, 500.0}) {
+        const double poly = eval("bvk2007_poly", phi, re, {}, &y);
+        EXPECT_NEAR(eval("bvk2007_polyfit", phi, re, {}, &y), poly, 1e-14 * poly);
+      }
+      const double vdh = eval("vdh2005_poly", phi, 0.0, {}, &y);
+      EXPECT_NEAR(eval("bvk2007_polyfit", phi, 0.0, no_cubic, &y), vdh, 1e-14 * vdh);
+    }
+    const double one = 1.0;
+    EXPECT_NEAR(eval("hys2010", phi, 10.0, {}, &one), eval("bvk2007", phi, 10.0),
+                1e-14 * eval("bvk2007", phi, 10.0));
+  }
+}
+
 }  // namespace
 }  // namespace draglab
