@@ -140,11 +140,18 @@ void run_check(const CliContext& ctx, const SceneArgs& args) {
   }
   std::cout << fmt::format("scene {} ({}): valid, solver {} ({})\n", scene.name, scene.origin,
                            scene.solver, consumers::find_bed_model(scene.solver).description());
+  std::string sizes = "d = " + format_number(scene.particles.diameter_m) + " m";
+  if (scene.polydisperse()) {
+    sizes = "Sauter mean d = " + format_number(scene.particles.diameter_m) + " m of";
+    for (std::size_t i = 0; i < scene.particles.diameters_m.size(); ++i) {
+      sizes += (i ? ", " : " ") + format_number(scene.particles.diameters_m[i]) + " m (volume " +
+               format_number(scene.particles.volume_fractions[i]) + ")";
+    }
+  }
   std::cout << fmt::format(
-      "  particles: {} of d = {} m (H_mf = {} m at eps_mf = {}); Ar = {}; Stokes response {} s\n",
-      first.particle_count, format_number(scene.particles.diameter_m),
-      format_number(first.bed_height_mf_m, 4), scene.eps_mf, format_number(first.archimedes, 4),
-      format_number(first.particle_response_s, 3));
+      "  particles: {} of {} (H_mf = {} m at eps_mf = {}); Ar = {}; Stokes response {} s\n",
+      first.particle_count, sizes, format_number(first.bed_height_mf_m, 4), scene.eps_mf,
+      format_number(first.archimedes, 4), format_number(first.particle_response_s, 3));
   std::cout << "  " << model_settings.line << "\n";
   // Scenes without a jet (the DBM's nozzles are in its settings line) have no jet line.
   if (scene.jet.slot_width_m > 0.0) {

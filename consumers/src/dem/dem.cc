@@ -855,6 +855,16 @@ bool SettleOptions::IsValid(std::string* error) const {
   if (!(diameter > 0.0) || !std::isfinite(diameter)) {
     return fail("diameter = " + Num(diameter) + " m: must be > 0");
   }
+  if (!diameters.empty() && diameters.size() != static_cast<std::size_t>(n)) {
+    return fail("diameters has " + std::to_string(diameters.size()) +
+                " values for n = " + std::to_string(n) + " particles");
+  }
+  for (std::size_t i = 0; i < diameters.size(); ++i) {
+    if (!(diameters[i] > 0.0) || !std::isfinite(diameters[i])) {
+      return fail("diameters[" + std::to_string(i) + "] = " + Num(diameters[i]) +
+                  " m: must be > 0");
+    }
+  }
   if (!(density > 0.0) || !std::isfinite(density)) {
     return fail("density = " + Num(density) + " kg/m^3: must be > 0");
   }
@@ -894,15 +904,25 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
       std::fabs(options.gravity[2]) > 1e-12 * g) {
     Fail("DemOptions.gravity: settle_particles needs gravity along -y");
   }
-  const double d = settle.diameter;
+  // Several sizes: the hash cell and the column margins take the largest, the insertion volume and
+  // the kinetic-energy scale the mean particle.
+  const bool sized = !settle.diameters.empty();
+  const auto diameter_of = [&](std::size_t i) {
+    return sized ? settle.diameters[i] : settle.diameter;
+  };
+  const double d =
+      sized ? *std::max_element(settle.diameters.begin(), settle.diameters.end()) : settle.diameter;
   const double lx = options.box_max[0] - options.box_min[0];
   const double lz = options.box_max[2] - options.box_min[2];
   if (lx < d || lz < d) {
     Fail("SettleOptions.diameter = " + Num(d) + " m: wider than the box cross-section");
   }
+  double solids = 0.0;
+  for (int i = 0; sized && i < settle.n; ++i) solids += kPi / 6.0 * std::pow(diameter_of(i), 3);
   // Insertion column: cross-section of the box, height from the target insertion fraction; it
   // may extend above the box top (the real top wall applies after settling).
-  const double vp = kPi / 6.0 * d * d * d;
+  const double vp = sized ? solids / settle.n : kPi / 6.0 * d * d * d;
+  const double d_mean = sized ? std::cbrt(6.0 * vp / kPi) : d;
   const double cross = lx * lz;
   const double column = std::max(d, settle.n * vp / (settle.insertion_solids_fraction * cross));
   DemOptions run = options;
@@ -910,16 +930,13 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
   // Random sequential insertion on a coarse hash grid (cell = d): reject overlaps.
   std::mt19937_64 rng(settle.seed);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
-  const double r = 0.5 * d, gap = 0.01 * d;
-  const double lo[3] = {options.box_min[0] + (options.periodic[0] ? 0.0 : r + gap),
-                        options.box_min[1] + r + gap,
-                        options.box_min[2] + (options.periodic[2] ? 0.0 : r + gap)};
-  const double hi[3] = {options.box_max[0] - (options.periodic[0] ? 0.0 : r + gap),
-                        options.box_min[1] + column + r,
-                        options.box_max[2] - (options.periodic[2] ? 0.0 : r + gap)};
+  const double gap = 0.01 * d;
   const double len[3] = {lx, 0.0, lz};
   const int hx = std::max(1, static_cast<int>(lx / d)), hz = std::max(1, static_cast<int>(lz / d));
-  const int hy = std::max(1, static_cast<int>((hi[1] - lo[1]) / d) + 1);
+  // Hash rows from the lowest centre of the largest particle (smaller ones start a little lower:
+  // row 0).
+  const double y0 = options.box_min[1] + 0.5 * d + gap;
+  const int hy = std::max(1, static_cast<int>((column - gap) / d) + 1);
   const double cx = lx / hx, cz = lz / hz;
   std::vector<std::vector<int>> hash(static_cast<std::size_t>(hx) * hy * hz);
   Particles parts;
@@ -931,10 +948,17 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
            "particles do not fit at insertion_solids_fraction " +
            Num(settle.insertion_solids_fraction) + " in the box cross-section");
     }
+    const double di = diameter_of(parts.size()), r = 0.5 * di;
+    const double lo[3] = {options.box_min[0] + (options.periodic[0] ? 0.0 : r + gap),
+                          options.box_min[1] + r + gap,
+                          options.box_min[2] + (options.periodic[2] ? 0.0 : r + gap)};
+    const double hi[3] = {options.box_max[0] - (options.periodic[0] ? 0.0 : r + gap),
+                          options.box_min[1] + column + r,
+                          options.box_max[2] - (options.periodic[2] ? 0.0 : r + gap)};
     const double q[3] = {lo[0] + (hi[0] - lo[0]) * u01(rng), lo[1] + (hi[1] - lo[1]) * u01(rng),
                          lo[2] + (hi[2] - lo[2]) * u01(rng)};
     const int ix = std::min(hx - 1, static_cast<int>((q[0] - options.box_min[0]) / cx));
-    const int iy = std::min(hy - 1, static_cast<int>((q[1] - lo[1]) / d));
+    const int iy = std::clamp(static_cast<int>((q[1] - y0) / d), 0, hy - 1);
     const int iz = std::min(hz - 1, static_cast<int>((q[2] - options.box_min[2]) / cz));
     bool free = true;
     for (int oz = -1; oz <= 1 && free; ++oz) {
@@ -955,7 +979,8 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
             for (int a : {0, 2}) {
               if (options.periodic[a]) dd[a] -= len[a] * std::round(dd[a] / len[a]);
             }
-            if (dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2] < (d + gap) * (d + gap)) free = false;
+            const double reach = 0.5 * (di + parts.diameter[j]) + gap;
+            if (dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2] < reach * reach) free = false;
           }
         }
       }
@@ -963,12 +988,12 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
     if (!free) continue;
     hash[(static_cast<std::size_t>(iz) * hy + iy) * hx + ix].push_back(
         static_cast<int>(parts.size()));
-    parts.add(q[0], q[1], q[2], d, settle.density);
+    parts.add(q[0], q[1], q[2], di, settle.density);
   }
   DemSystem dem(run, std::move(parts));
   dem.sort_particles();
   const double m = settle.density * vp;
-  const double ke_scale = m * g * d;
+  const double ke_scale = m * g * d_mean;
   // Fall time from the column top plus relaxation; check every ~1 ms of simulated time.
   const double check = std::max(dem.time_step(), 1e-3);
   // Progress (for the ETA; the stop criterion is the kinetic energy alone): 30 % for the free

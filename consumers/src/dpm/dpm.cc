@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -113,11 +114,63 @@ const DemSystem& DpmSimulation::dem() const {
   return *impl_->dem;
 }
 double DpmSimulation::time() const { return impl_->time; }
+const std::vector<double>& DpmSimulation::drag_coefficients() const { return impl_->c; }
+
+namespace internal {
+
+std::vector<double> class_diameters(const Scene& scene, int n) {
+  // Whole particles per class from the number fractions (largest remainders), the largest class
+  // first: random sequential insertion places the large spheres while there is room. Every
+  // particle's position is drawn over the whole insertion column, so the bed starts mixed.
+  const std::vector<double> f = scene.number_fractions();
+  const std::vector<double>& d = scene.particles.diameters_m;
+  std::vector<int> count(f.size());
+  std::vector<std::pair<double, std::size_t>> remainder;
+  int assigned = 0;
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    count[k] = static_cast<int>(std::floor(f[k] * n));
+    assigned += count[k];
+    remainder.push_back({f[k] * n - count[k], k});
+  }
+  std::sort(remainder.begin(), remainder.end(), std::greater<>());
+  for (std::size_t r = 0; assigned < n; ++r, ++assigned) ++count[remainder[r].second];
+  std::vector<std::size_t> order(f.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&d](std::size_t a, std::size_t b) { return d[a] > d[b]; });
+  std::vector<double> out;
+  out.reserve(static_cast<std::size_t>(n));
+  for (std::size_t k : order) out.insert(out.end(), count[k], d[k]);
+  return out;
+}
+
+double segregation_index(const Particles& p, double floor_y) {
+  if (p.size() == 0) return 0.0;
+  const auto [lo, hi] = std::minmax_element(p.diameter.begin(), p.diameter.end());
+  if (*lo == *hi) return 0.0;
+  double small = 0.0, large = 0.0, all = 0.0;
+  std::size_t n_small = 0, n_large = 0;
+  for (std::size_t n = 0; n < p.size(); ++n) {
+    const double h = p.y[n] - floor_y;
+    all += h;
+    if (p.diameter[n] == *lo) small += h, ++n_small;
+    if (p.diameter[n] == *hi) large += h, ++n_large;
+  }
+  all /= static_cast<double>(p.size());
+  return all > 0.0 ? (small / n_small - large / n_large) / all : 0.0;
+}
+
+}  // namespace internal
 
 double DpmSimulation::bed_weight_n() const {
   const double n = impl_->dem ? static_cast<double>(impl_->dem->particles().size())
                               : static_cast<double>(scene_.particle_count());
-  return n * scene_.particle_mass_kg() * scene_.gas.gravity_m_s2 *
+  double mass = n * scene_.particle_mass_kg();
+  if (scene_.polydisperse() && impl_->dem) {
+    const Particles& p = impl_->dem->particles();
+    mass = 0.0;
+    for (std::size_t k = 0; k < p.size(); ++k) mass += p.mass(k);
+  }
+  return mass * scene_.gas.gravity_m_s2 *
          (1.0 - scene_.gas.density_kg_m3 / scene_.particles.density_kg_m3);
 }
 
@@ -133,6 +186,7 @@ void DpmSimulation::Settle(const DpmProgress& progress) {
   }
   so.n = static_cast<int>(count);
   so.diameter = s.particles.diameter_m;
+  if (s.polydisperse()) so.diameters = internal::class_diameters(s, so.n);
   so.density = s.particles.density_kg_m3;
   so.seed = s.seed;
   so.kinetic_energy_tolerance = opt_.settle_kinetic_tolerance;
@@ -326,6 +380,22 @@ const DpmStepDiagnostics& DpmSimulation::Step() {
         ++result_.void_fraction_clamps;
       }
 
+  // Beds of several sizes: the local Sauter mean, sum d^3 / sum d^2 with the same kernel, is the
+  // <d> a polydisperse law takes (y = d_i/<d>, Re on <d>) and the diameter a monodisperse law
+  // is evaluated at (the mixture's beta, shared by volume).
+  const bool sizes = scene_.polydisperse();
+  const bool per_class_law = law_->num_extra_inputs() > 0;
+  Eigen::ArrayXXd d3, d2;
+  if (sizes) {
+    d3 = Eigen::ArrayXXd::Zero(nx, nz);
+    d2 = Eigen::ArrayXXd::Zero(nx, nz);
+    for (std::size_t n = 0; n < np; ++n) {
+      const double d = p.diameter[n];
+      Deposit(d3, tents[n], d * d * d);
+      Deposit(d2, tents[n], d * d);
+    }
+  }
+
   // 2. Per particle: eps and gas velocity at the centre (transpose of the mapping), beta, c_p.
   m.c.assign(np, 0.0);
   Eigen::ArrayXXd csum = Eigen::ArrayXXd::Zero(nx, nz), cux = csum, cuz = csum;
@@ -334,8 +404,14 @@ const DpmStepDiagnostics& DpmSimulation::Step() {
     const double eps_p = std::min(1.0, Interpolate(eps_next, t));
     const double sx = Interpolate(ugx, t) - p.vx[n], sz = Interpolate(ugz, t) - p.vy[n];
     const double slip = std::hypot(sx, sz);
-    // dga = beta / phi: c_p = beta V_p / (1 - eps) without the 0/0 at eps = 1.
-    m.c[n] = law_->dga(eps_p, mu, rho_g, slip, p.diameter[n]) * p.volume(n);
+    if (!sizes && !per_class_law) {
+      // dga = beta / phi: c_p = beta V_p / (1 - eps) without the 0/0 at eps = 1.
+      m.c[n] = law_->dga(eps_p, mu, rho_g, slip, p.diameter[n]) * p.volume(n);
+    } else {
+      const double d_mean = sizes ? Interpolate(d3, t) / Interpolate(d2, t) : p.diameter[n];
+      m.c[n] = per_class_law ? law_->particle_drag(eps_p, mu, rho_g, slip, p.diameter[n], d_mean)
+                             : law_->dga(eps_p, mu, rho_g, slip, d_mean) * p.volume(n);
+    }
     for (int a = 0; a < 2; ++a)
       for (int b = 0; b < 2; ++b) {
         const double cw = m.c[n] * t.wx[a] * t.wz[b];
@@ -421,7 +497,12 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
   const int nx = s.grid.cells_x;
   const double area = s.geometry.width_m * s.geometry.depth_m;
   const double g = s.gas.gravity_m_s2, rho_g = s.gas.density_kg_m3;
-  const double particle_mass = static_cast<double>(result_.particles) * s.particle_mass_kg();
+  double particle_mass = static_cast<double>(result_.particles) * s.particle_mass_kg();
+  if (s.polydisperse()) {
+    particle_mass = 0.0;
+    const Particles& parts = m.dem->particles();
+    for (std::size_t k = 0; k < parts.size(); ++k) particle_mass += parts.mass(k);
+  }
   internal::BedSampler sampler(s, settled_height_);
 
   // Vertical momentum of gas + particles [kg m/s].
@@ -480,6 +561,8 @@ DpmResult DpmSimulation::Run(const DpmProgress& progress) {
       const internal::BedSampler::Taken taken =
           sampler.Take(m.time, m.eps, m.gas->PressureDrop(0.5 * m.gas->dz(), s.geometry.height_m));
       result_.series.push_back(taken.sample);
+      result_.series.back().segregation_index =
+          internal::segregation_index(m.dem->particles(), 0.0);
       if (opt_.jet && taken.nearest_to_ref) {
         result_.bubble_at_t_ref = taken.bubble.found;
         result_.bubble_diameter_m = taken.sample.bubble_diameter_m;

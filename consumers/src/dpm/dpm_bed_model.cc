@@ -37,6 +37,7 @@ class DpmBedModel : public BedModel {
   }
 
   const SceneTable* scene_table() const override { return &dem_scene_table(); }
+  bool polydisperse() const override { return true; }
 
   BedModelSettings Settings(const Scene& scene) const override {
     // The contact model matters to the DEM only.
@@ -168,7 +169,8 @@ std::string dpm_result_json(const DpmResult& r) {
                       {"bubble_diameter_m", s.bubble_diameter_m},
                       {"bubble_centroid_m", s.bubble_centroid_m},
                       {"bed_height_m", s.bed_height_m},
-                      {"pressure_drop_pa", s.pressure_drop_pa}});
+                      {"pressure_drop_pa", s.pressure_drop_pa},
+                      {"segregation_index", s.segregation_index}});
   }
   nlohmann::json j = {{"solver", "dpm"},
                       {"scene", r.scene},

@@ -128,7 +128,8 @@ const SceneTable& dem_scene_table() {
 
 double contact_time_s(const Scene& scene) {
   const SceneDem& d = dem_section(scene);
-  const double m_eff = 0.5 * scene.particle_mass_kg();
+  // The lightest pair has the shortest contact (a bed of several sizes: two of the smallest).
+  const double m_eff = 0.5 * scene.smallest_particle_mass_kg();
   const double k = d.spring_stiffness_n_m;
   const double log_e = std::log(d.restitution);
   const double eta = 2.0 * std::sqrt(k * m_eff) * std::fabs(log_e) /

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "draglab/consumers/bed_model.h"
 #include "draglab/consumers/scene.h"
@@ -33,6 +34,21 @@ SceneDem& dem_section(Scene& scene);
 
 /// [dem]'s keys, their older places and checks.
 const SceneTable& dem_scene_table();
+
+struct Particles;
+
+namespace internal {
+
+/// The n particles' diameters of a bed of size classes: whole particles per class from the
+/// number fractions (largest remainders), the largest class first (the insertion order; positions
+/// are drawn over the whole column, so the bed starts mixed).
+std::vector<double> class_diameters(const Scene& scene, int n);
+
+/// (mean centre height of the smallest size - that of the largest) / mean height of all, heights
+/// above floor_y; 0 for one size (bubble.h, BedSample::segregation_index).
+double segregation_index(const Particles& particles, double floor_y);
+
+}  // namespace internal
 
 }  // namespace consumers
 }  // namespace draglab

@@ -145,13 +145,24 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   // Monodisperse particles: every polydispersity input y_i = d_i/<d> is 1.
   std::vector<double> extra(static_cast<std::size_t>(law.num_extra_inputs()), 1.0);
   const double* extra_ptr = extra.empty() ? nullptr : extra.data();
+  // Size classes (d = their Sauter mean <d>): a per-size law's drag of the whole bed is
+  // F = sum_i x_i F_i(phi, Re, y_i)/y_i^2 (beta = sum_i beta_i, beta_i = 18 mu eps phi_i
+  // F_i/d_i^2); a monodisperse law is taken at <d>.
+  const bool classes = !particles.diameters_m.empty() && law.num_extra_inputs() == 1;
+  auto bed_F = [&](double re) {
+    if (!classes) return law.F(phi, re, extra_ptr);
+    double F = 0.0;
+    for (std::size_t i = 0; i < particles.diameters_m.size(); ++i) {
+      const double y = particles.diameters_m[i] / d;
+      F += particles.volume_fractions[i] * law.F(phi, re, &y) / (y * y);
+    }
+    return F;
+  };
 
   const double ar = rho * (rho_p - rho) * g * d * d * d / (mu * mu);
   const double target = eps * ar;
   // Scaled residual (18 Re F - eps Ar)/(eps Ar): O(1), negative at Re = 0.
-  auto residual = [&](double re) {
-    return (18.0 * re * law.F(phi, re, extra_ptr) - target) / target;
-  };
+  auto residual = [&](double re) { return (18.0 * re * bed_F(re) - target) / target; };
 
   // Bracket: the first sign change on a log grid over the law's Re range (the residual of a
   // physical law grows monotonically with Re; the scan also copes with one that does not).
@@ -203,7 +214,7 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   r.eps_mf = eps;
   r.archimedes = ar;
   r.umf_m_s = r.re_mf * mu / (rho * d);
-  r.F_mf = law.F(phi, r.re_mf, extra_ptr);
+  r.F_mf = bed_F(r.re_mf);
   r.beta_mf = 18.0 * phi * eps * r.F_mf * mu / (d * d);
   r.residual = residual(r.re_mf);
   return r;

@@ -113,8 +113,16 @@ const std::vector<std::pair<std::string, std::vector<Key>>>& sections() {
                          " is outside [1, 10000000]");
                    }
                  }},
-                num("bed_height_mf_m",
-                    [](S& s) -> double& { return s.particles.bed_height_mf_m; })}},
+                num("bed_height_mf_m", [](S& s) -> double& { return s.particles.bed_height_mf_m; }),
+                {"diameters_m",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.particles.diameters_m = SceneValue(&n, f, at).numbers("diameters in m");
+                 }},
+                {"volume_fractions",
+                 [](S& s, const toml::node& n, const std::string& f, const std::string& at) {
+                   s.particles.volume_fractions =
+                       SceneValue(&n, f, at).numbers("volume shares in (0, 1]");
+                 }}}},
               {"gas",
                {num("density_kg_m3", [](S& s) -> double& { return s.gas.density_kg_m3; }),
                 num("viscosity_pa_s", [](S& s) -> double& { return s.gas.viscosity_pa_s; }),
@@ -342,6 +350,55 @@ const char* to_string(BackgroundMode mode) {
   return "fixed";
 }
 
+namespace {
+
+/// Size classes: checked as written, then diameter_m becomes their Sauter mean.
+void set_size_classes(Scene& s, const std::string& origin) {
+  SceneParticles& p = s.particles;
+  if (p.diameters_m.empty() && p.volume_fractions.empty()) return;
+  if (p.diameter_m != 0.0) {
+    bad(origin +
+        ": [particles] give diameter_m (one size) or diameters_m with volume_fractions "
+        "(size classes), not both");
+  }
+  if (p.diameters_m.size() != p.volume_fractions.size()) {
+    bad(origin + ": [particles] diameters_m has " + std::to_string(p.diameters_m.size()) +
+        " values and volume_fractions " + std::to_string(p.volume_fractions.size()) +
+        ": give one volume share per size class");
+  }
+  if (p.diameters_m.size() < 2 || p.diameters_m.size() > 8) {
+    bad(origin + ": [particles] diameters_m has " + std::to_string(p.diameters_m.size()) +
+        " size classes, outside [2, 8] (one size: diameter_m)");
+  }
+  double sum = 0.0, inverse = 0.0;
+  for (std::size_t i = 0; i < p.diameters_m.size(); ++i) {
+    const std::string at = "[" + std::to_string(i) + "]";
+    if (!(p.diameters_m[i] >= 1e-6 && p.diameters_m[i] <= 0.1)) {
+      bad(origin + ": [particles] diameters_m" + at + " = " + fmt(p.diameters_m[i]) +
+          " m is outside [1e-06, 0.1] m");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (p.diameters_m[j] == p.diameters_m[i]) {
+        bad(origin + ": [particles] diameters_m lists " + fmt(p.diameters_m[i]) +
+            " m twice (each size class once)");
+      }
+    }
+    if (!(p.volume_fractions[i] > 0.0 && p.volume_fractions[i] <= 1.0)) {
+      bad(origin + ": [particles] volume_fractions" + at + " = " + fmt(p.volume_fractions[i]) +
+          " is outside (0, 1]");
+    }
+    sum += p.volume_fractions[i];
+    inverse += p.volume_fractions[i] / p.diameters_m[i];
+  }
+  if (std::fabs(sum - 1.0) > 1e-6) {
+    bad(origin + ": [particles] volume_fractions sum to " + fmt(sum) +
+        ", not 1 (each is a size class's share of the solids volume)");
+  }
+  p.diameter_m = 1.0 / inverse;
+}
+
+}  // namespace
+
 Scene parse_scene(const std::string& toml_text, const std::string& origin) {
   namespace ts = core::toml_schema;
   const toml::table root = ts::parse(toml_text, origin);
@@ -383,6 +440,7 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin) {
       bad(origin + ": the [" + required + "] table is missing (docs/scenes.md lists its keys)");
     }
   }
+  set_size_classes(s, origin);
   std::string error;
   if (!s.IsValid(&error)) bad(origin + ": " + error);
   return s;
@@ -427,6 +485,14 @@ bool materials_are_valid(const Scene& s, std::string* error) {
   // From fine powders (Geldart C, tens of microns) to coarse beads; below a micron the drag laws'
   // minimum fluidization has no root the solvers can find.
   if (!in_range(d, 1e-6, 0.1, false, false, "[particles] diameter_m", "m", error)) return false;
+  if (s.polydisperse() && !find_bed_model(s.solver).polydisperse()) {
+    return fail(error, "[particles] diameters_m: the " + s.solver +
+                           " model runs one particle size (give diameter_m, e.g. the Sauter mean " +
+                           fmt(d) + " m); size classes run with solver = \"dpm\"");
+  }
+  const double largest = s.polydisperse() ? *std::max_element(s.particles.diameters_m.begin(),
+                                                              s.particles.diameters_m.end())
+                                          : d;
   if (!in_range(s.particles.density_kg_m3, 0.0, 30000.0, true, false, "[particles] density_kg_m3",
                 "kg/m^3", error) ||
       !in_range(s.particles.restitution, 0.0, 1.0, true, false, "[particles] restitution", "",
@@ -434,8 +500,10 @@ bool materials_are_valid(const Scene& s, std::string* error) {
     return false;
   }
   const double min_box = std::min({s.geometry.width_m, s.geometry.height_m, s.geometry.depth_m});
-  if (d > min_box) {
-    return fail(error, "[particles] diameter_m = " + fmt(d) +
+  if (largest > min_box) {
+    return fail(error, std::string(s.polydisperse() ? "[particles] the largest of diameters_m, "
+                                                    : "[particles] diameter_m = ") +
+                           fmt(largest) +
                            " does not fit the box: it must be <= the smallest box size " +
                            fmt(min_box) + " m");
   }
@@ -623,11 +691,36 @@ void Scene::Validate() const {
 }
 
 double Scene::particle_volume_m3() const {
+  if (polydisperse()) {
+    double per_volume = 0.0;  // particles per unit solids volume, times pi/6
+    for (std::size_t i = 0; i < particles.diameters_m.size(); ++i) {
+      per_volume += particles.volume_fractions[i] / std::pow(particles.diameters_m[i], 3);
+    }
+    return kPi / 6.0 / per_volume;
+  }
   const double d = particles.diameter_m;
   return kPi * d * d * d / 6.0;
 }
 
 double Scene::particle_mass_kg() const { return particles.density_kg_m3 * particle_volume_m3(); }
+
+std::vector<double> Scene::number_fractions() const {
+  if (!polydisperse()) return {1.0};
+  std::vector<double> f;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < particles.diameters_m.size(); ++i) {
+    f.push_back(particles.volume_fractions[i] / std::pow(particles.diameters_m[i], 3));
+    sum += f.back();
+  }
+  for (double& v : f) v /= sum;
+  return f;
+}
+
+double Scene::smallest_particle_mass_kg() const {
+  if (!polydisperse()) return particle_mass_kg();
+  const double d = *std::min_element(particles.diameters_m.begin(), particles.diameters_m.end());
+  return particles.density_kg_m3 * (kPi * d * d * d / 6.0);
+}
 
 std::int64_t Scene::particle_count() const {
   if (particles.count > 0) return particles.count;

@@ -179,6 +179,9 @@ class BedModel {
   /// and turned into a bed height by the scene); false: the model's bed fills the column (the
   /// DBM's emulsion).
   virtual bool particle_bed() const { return true; }
+  /// Whether the model runs beds of several particle sizes ([particles] diameters_m); a scene
+  /// with size classes is refused for a model that does not.
+  virtual bool polydisperse() const { return false; }
 
   /// What a realization is ("packing"); empty: the model is deterministic and has none.
   virtual std::string realization_kind() const { return ""; }

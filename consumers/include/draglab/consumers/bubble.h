@@ -85,6 +85,10 @@ struct BedSample {
   double bubble_centroid_m = 0.0;  ///< Height of the bubble centroid [m].
   double bed_height_m = 0.0;       ///< From the width-averaged gas fraction.
   double pressure_drop_pa = 0.0;   ///< Width-averaged p(first cell centre) - p(outlet).
+  /// Beds of several sizes (the DPM): (mean height of the smallest size class - that of the
+  /// largest) / mean height of all particles, heights of the centres above the floor; 0 mixed,
+  /// > 0 the small particles above the large. 0 for a bed of one size.
+  double segregation_index = 0.0;
 };
 
 /// A bed model's state at one instant, for figures: the gas fraction on the scene's grid, the

@@ -195,8 +195,11 @@ class DemSystem {
 struct SettleOptions {
   int n = 1000;              ///< Number of spheres, >= 1.
   double diameter = 2.5e-3;  ///< [m], > 0.
-  double density = 2526.0;   ///< [kg/m^3], > 0.
-  std::uint64_t seed = 1;    ///< Random insertion seed (same seed, same packing).
+  /// Each particle's diameter [m] (n values, > 0), for beds of several sizes; empty: all
+  /// `diameter`. The order is the insertion order (shuffle it for a mixed bed).
+  std::vector<double> diameters;
+  double density = 2526.0;  ///< [kg/m^3], > 0.
+  std::uint64_t seed = 1;   ///< Random insertion seed (same seed, same packing).
   /// Solids fraction of the random insertion cloud above the floor, (0, 0.35].
   double insertion_solids_fraction = 0.25;
   /// Stop when the mean kinetic energy per particle is below this fraction of m g d, (0, 1e-2].

@@ -142,6 +142,9 @@ class DpmSimulation {
 
   const GasPhase& gas() const;
   const DemSystem& dem() const;
+  /// Each particle's drag coefficient c_p [kg/s] of the last step (drag = c_p (u_g - u_p)),
+  /// in the order of dem().particles().
+  const std::vector<double>& drag_coefficients() const;
   double time() const;  ///< Since the background flow started [s].
   double gas_dt() const { return gas_dt_; }
   double bed_weight_n() const;  ///< N m_p g (1 - rho_g/rho_p): buoyant weight [N].

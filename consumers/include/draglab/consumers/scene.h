@@ -42,10 +42,15 @@ struct SceneGeometry {
   double depth_m = 0.0;
 };
 
-/// Monodisperse spheres. Give exactly one of count and bed_height_mf_m. (The DPM's contact
-/// model is its own table, [dem].)
+/// Spheres of one size (diameter_m) or of 2 to 8 size classes (diameters_m with their
+/// volume_fractions, for the models that run them: the DPM). Give exactly one of count and
+/// bed_height_mf_m. (The DPM's contact model is its own table, [dem].)
 struct SceneParticles {
+  /// One size; with size classes, their Sauter mean 1/sum(x_i/d_i) (set by the parser), the
+  /// diameter of the bed's monodisperse quantities (U_mf, grid checks).
   double diameter_m = 0.0;
+  std::vector<double> diameters_m;       ///< Size classes [m]; empty: one size.
+  std::vector<double> volume_fractions;  ///< Their shares of the solids volume, summing to 1.
   double density_kg_m3 = 0.0;
   double restitution = 0.97;     ///< Normal restitution coefficient, (0, 1] (the TFM's default).
   std::int64_t count = 0;        ///< Number of particles, or 0: from bed_height_mf_m.
@@ -215,9 +220,16 @@ struct Scene {
   /// Throws Error(kInvalidArgument) with IsValid's message.
   void Validate() const;
 
-  /// Particle volume pi d^3/6 [m^3] and mass [kg].
+  /// Mean particle volume [m^3] (pi d^3/6 for one size; with size classes the number-weighted
+  /// mean, (pi/6)/sum(x_i/d_i^3)) and mean particle mass [kg].
   double particle_volume_m3() const;
   double particle_mass_kg() const;
+  /// Whether the bed has size classes ([particles] diameters_m).
+  bool polydisperse() const { return !particles.diameters_m.empty(); }
+  /// The number fraction of each size class (x_i/d_i^3 normalised); {1} for one size.
+  std::vector<double> number_fractions() const;
+  /// The lightest particle's mass [kg] (the DEM's contact time is shortest for it).
+  double smallest_particle_mass_kg() const;
   /// Particle count: `count`, or (1 - eps_mf) W D H_mf / V_p rounded.
   std::int64_t particle_count() const;
   /// Bed height at eps_mf: `bed_height_mf_m`, or N V_p / ((1 - eps_mf) W D); the DBM's bed
