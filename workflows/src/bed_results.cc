@@ -163,13 +163,23 @@ nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
     for (const auto& r : lr.runs) {
       // Column arrays: a few hundred samples per run stay readable and small.
       nlohmann::json t = nlohmann::json::array(), d = nlohmann::json::array(),
-                     centroid = nlohmann::json::array(), bed = nlohmann::json::array();
+                     centroid = nlohmann::json::array(), bed = nlohmann::json::array(),
+                     segregation = nlohmann::json::array();
+      bool sizes = false;
       for (const consumers::BedSample& smp : r.series) {
         t.push_back(smp.t_s);
         d.push_back(smp.bubble_diameter_m);
         centroid.push_back(smp.bubble_centroid_m);
         bed.push_back(smp.bed_height_m);
+        segregation.push_back(smp.segregation_index);
+        sizes = sizes || smp.segregation_index != 0.0;
       }
+      nlohmann::json series = {{"t_s", t},
+                               {"bubble_diameter_m", d},
+                               {"bubble_centroid_m", centroid},
+                               {"bed_height_m", bed}};
+      // Beds of several sizes only: the other studies' files stay as they were.
+      if (sizes) series["segregation_index"] = segregation;
       runs.push_back({{"seed", r.seed},
                       {"cells_x", r.cells_x},
                       {"cells_y", r.cells_y},
@@ -189,11 +199,7 @@ nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
                       {"void_fraction_clamps", r.void_fraction_clamps},
                       {"drag_out_of_range", r.drag_out_of_range},
                       {"headline", headline_json(r.headline)},
-                      {"series",
-                       {{"t_s", t},
-                        {"bubble_diameter_m", d},
-                        {"bubble_centroid_m", centroid},
-                        {"bed_height_m", bed}}}});
+                      {"series", series}});
     }
     nlohmann::json law = {{"law", lr.law},
                           {"umf_m_s", lr.umf_m_s},
