@@ -20,9 +20,7 @@ LawFormDescription Bvk2007Poly::describe() {
       "for model A) is not implemented.";
   d.parameters.push_back(
       {"g", 0.064, "1", "coefficient of the (1-phi) y^3 term of the size factor"});
-  d.validity.extra = {{"y",
-                       "d_i/<d>: particle diameter over the Sauter mean diameter of the mixture",
-                       {0.25, 4.0}}};
+  d.validity.extra = {size_ratio_input()};
   d.single_sphere_stokes_F = 1.064;  // at the representative y = 1: 1 * (1 + 0.064)
   d.has_inertia = true;
   return d;

@@ -22,9 +22,7 @@ LawFormDescription Bvk2007Polyfit::describe() {
   d.parameters.push_back({"b1", 1.0, "1", "slope of b(phi)"});
   d.parameters.push_back({"c0", 0.064, "1", "c(phi) = c0 + c1 phi, the coefficient of y^3"});
   d.parameters.push_back({"c1", -0.064, "1", "slope of c(phi)"});
-  d.validity.extra = {{"y",
-                       "d_i/<d>: particle diameter over the Sauter mean diameter of the mixture",
-                       {0.25, 4.0}}};
+  d.validity.extra = {size_ratio_input()};
   d.single_sphere_stokes_F = 1.064;  // at y = 1 with the default coefficients
   d.has_inertia = true;
   d.literature = false;

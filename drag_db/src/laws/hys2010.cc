@@ -25,9 +25,7 @@ LawFormDescription Hys2010::describe() {
   d.parameters.push_back({"k1", 2.66, "1", "a(phi) = 1 - k1 phi + k2 phi^2 - k3 phi^3"});
   d.parameters.push_back({"k2", 9.096, "1", "coefficient of phi^2 in a(phi)"});
   d.parameters.push_back({"k3", 11.338, "1", "coefficient of phi^3 in a(phi)"});
-  d.validity.extra = {{"y",
-                       "d_i/<d>: particle diameter over the Sauter mean diameter of the mixture",
-                       {0.25, 4.0}}};
+  d.validity.extra = {size_ratio_input()};
   d.single_sphere_stokes_F = 1.0;  // at y = 1 it is bvk2007
   d.has_inertia = true;
   return d;

@@ -15,13 +15,20 @@
 namespace draglab {
 namespace laws {
 
+using codegen::select;
 using std::atan;
 using std::exp;
 using std::log;
 using std::log10;
 using std::pow;
 using std::sqrt;
-using codegen::select;
+
+/// The extra input of the polydisperse forms: a particle's size ratio y = d_i/<d> to the Sauter
+/// mean of the mixture, for diameter ratios up to 1:4.
+inline ExtraInputSpec size_ratio_input() {
+  return {
+      "y", "d_i/<d>: particle diameter over the Sauter mean diameter of the mixture", {0.25, 4.0}};
+}
 
 /// Branch written so that it can be traced symbolically (see file comment).
 template <typename T>

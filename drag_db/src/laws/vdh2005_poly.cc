@@ -17,9 +17,7 @@ LawFormDescription Vdh2005Poly::describe() {
       "solids fraction; F_i normalised by 3 pi mu d_i eps u. The mixture's F (sum x_i F_i/y_i^2) "
       "is F_vdh2005(phi) for any size distribution. Re is ignored; the validity box allows "
       "Re <= 0.1.";
-  d.validity.extra = {{"y",
-                       "d_i/<d>: particle diameter over the Sauter mean diameter of the mixture",
-                       {0.25, 4.0}}};
+  d.validity.extra = {size_ratio_input()};
   return d;
 }
 
