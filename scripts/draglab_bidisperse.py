@@ -66,6 +66,12 @@ def column(rows, path, name, kind=float):
         fail("%s: column '%s' holds a value that is not a number" % (path, name))
 
 
+def sha256_of(path):
+    import hashlib
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
 def vdh2005(phi):
     eps = 1.0 - phi
     return 10.0 * phi / eps ** 2 + eps ** 2 * (1.0 + 1.5 * math.sqrt(phi))
@@ -128,8 +134,9 @@ def reduce_points(species_path, mono_path, out_path):
     with open(out_path, "w") as f:
         f.write("# per-species size factor S = F_i/F_mono of the bidisperse campaign, carried onto "
                 "the vdh2005 level: F = F_vdh2005(phi) S\n")
-        f.write("# from %s and %s by scripts/draglab_bidisperse.py reduce\n"
-                % (os.path.basename(species_path), os.path.basename(mono_path)))
+        f.write("# from %s and %s by scripts/draglab_bidisperse.py reduce (sha256 of the inputs: %s, "
+                "%s)\n" % (os.path.basename(species_path), os.path.basename(mono_path),
+                           sha256_of(species_path)[:16], sha256_of(mono_path)[:16]))
         f.write("phi,re_target,re,F,F_standard_error,F_discretisation_error,F_uncertainty,"
                 "realizations,y\n")
         for p in out:
