@@ -178,7 +178,7 @@ SparseLattice::SparseLattice(const arrays::VoxelGrid& grid, int threads, std::si
   for (std::int64_t n = 0; n < count; ++n) {
     const std::int64_t d = node_[static_cast<std::size_t>(n)];
     const std::int64_t i = d % nx, j = (d / nx) % ny, k = d / (nx * ny);
-    if (!owned_fluid(i, j, k)) continue;  // ghosts and halo nodes are never collided
+    if (!owned_fluid(i, j, k)) continue;  // the masked sweep runs over fluid segments only
     std::uint32_t m = 0;
     for (int q = 1; q < kQ; ++q) {
       if (solid[static_cast<std::size_t>(dense(i + kC[q][0], j + kC[q][1], k + kC[q][2]))]) {

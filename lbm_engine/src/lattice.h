@@ -7,9 +7,10 @@
 // structure-of-arrays rows of length `stride` in one buffer: population i of stored node n lives
 // at flat offset i * stride + n. The row stride is padded so that consecutive rows start 192
 // bytes apart modulo 4 KiB (unpadded rows at multiples of 4 KiB alias in the caches and the TLB:
-// a 10x loss on this kind of machine). Ghost nodes are never collided; they only keep the
-// neighbour offsets of a fluid x-run contiguous (every neighbour of a fluid node is stored, so
-// the neighbour row of a run is stored without gaps).
+// a 10x loss on this kind of machine). Ghost nodes keep the neighbour offsets of a fluid x-run
+// contiguous (every neighbour of a fluid node is stored, so the neighbour row of a run is stored
+// without gaps); the even sweep collides them along with the fluid nodes of their row (one loop
+// per row, solver.cc), and nothing reads what that leaves in them.
 //
 // Blocks. The x-rows are grouped into slabs of kSlabPlanes z-planes; a slab's stored nodes,
 // segments and links are contiguous and every neighbour of a slab lies in the slab or the two
@@ -19,10 +20,10 @@
 // Decomposition across ranks (PlaneRange): a rank owns the z-planes [begin, end) and stores two
 // halo planes besides, begin - 1 and end (periodic). Its lattice is built exactly as above with
 // "fluid" read as "owned fluid": halo nodes are stored when an owned fluid node neighbours them
-// and are never collided, like ghosts, so the kernels run unchanged; only the populations that
-// cross the two plane interfaces travel between ranks (HaloPlan, solver.cc). Rows, segments and
-// links are local (the halo planes are the first and last local planes); node() stays the
-// dense index in the whole box.
+// and are never collided (their rows are not swept), so the kernels run unchanged; only the
+// populations that cross the two plane interfaces travel between ranks (HaloPlan, solver.cc). Rows,
+// segments and links are local (the halo planes are the first and last local planes); node() stays
+// the dense index in the whole box.
 //
 // AA pattern (Bailey et al. 2009), one buffer, no write-allocate traffic:
 //  - even step: node n reads f_i from row i at n, collides, and writes the post-collision f*_i to

@@ -40,75 +40,78 @@ inline int team_size() {
 // them inside the loop and does not vectorize it. Written out, each loop over nodes is a plain
 // unit-stride SIMD loop over 19 streams (checked with -fopt-info-vec: 64-byte vectors).
 
-/// Even step over fluid segments [first, last): read row i, write row opp(i), same node.
+/// Even step over the stored nodes [first, first + length): read row i, write row opp(i), same
+/// node. The step touches no neighbour, so it runs over an x-row's whole stored range, ghosts
+/// included, as one unit-stride loop, instead of over the row's fluid segments (short in a dense
+/// packing, where each pays the loop's ends). A ghost's values are never read before they are
+/// written again: the link pass of this step writes the slots of a ghost that the next step
+/// reads (interpolated walls), and the masked odd sweep reads none (halfway bounce-back), so
+/// what the collision leaves there does not matter.
 template <typename T, CollisionKernel K, bool kStokes>
-void even_sweep(T* base, std::int64_t stride, const Segment* first, const Segment* last,
+void even_sweep(T* base, std::int64_t stride, std::int64_t first, std::int64_t length,
                 const KernelParams<T>& p) {
   const KernelParams<T> params = p;
-  for (const Segment* s = first; s != last; ++s) {
-    T* const r0 = base + 0 * stride + s->first;
-    T* const r1 = base + 1 * stride + s->first;
-    T* const r2 = base + 2 * stride + s->first;
-    T* const r3 = base + 3 * stride + s->first;
-    T* const r4 = base + 4 * stride + s->first;
-    T* const r5 = base + 5 * stride + s->first;
-    T* const r6 = base + 6 * stride + s->first;
-    T* const r7 = base + 7 * stride + s->first;
-    T* const r8 = base + 8 * stride + s->first;
-    T* const r9 = base + 9 * stride + s->first;
-    T* const r10 = base + 10 * stride + s->first;
-    T* const r11 = base + 11 * stride + s->first;
-    T* const r12 = base + 12 * stride + s->first;
-    T* const r13 = base + 13 * stride + s->first;
-    T* const r14 = base + 14 * stride + s->first;
-    T* const r15 = base + 15 * stride + s->first;
-    T* const r16 = base + 16 * stride + s->first;
-    T* const r17 = base + 17 * stride + s->first;
-    T* const r18 = base + 18 * stride + s->first;
-    const std::int64_t length = s->length;
+  T* const r0 = base + 0 * stride + first;
+  T* const r1 = base + 1 * stride + first;
+  T* const r2 = base + 2 * stride + first;
+  T* const r3 = base + 3 * stride + first;
+  T* const r4 = base + 4 * stride + first;
+  T* const r5 = base + 5 * stride + first;
+  T* const r6 = base + 6 * stride + first;
+  T* const r7 = base + 7 * stride + first;
+  T* const r8 = base + 8 * stride + first;
+  T* const r9 = base + 9 * stride + first;
+  T* const r10 = base + 10 * stride + first;
+  T* const r11 = base + 11 * stride + first;
+  T* const r12 = base + 12 * stride + first;
+  T* const r13 = base + 13 * stride + first;
+  T* const r14 = base + 14 * stride + first;
+  T* const r15 = base + 15 * stride + first;
+  T* const r16 = base + 16 * stride + first;
+  T* const r17 = base + 17 * stride + first;
+  T* const r18 = base + 18 * stride + first;
 #pragma GCC ivdep
-    for (std::int64_t k = 0; k < length; ++k) {
-      T g[kQ], o[kQ];
-      g[0] = r0[k];
-      g[1] = r1[k];
-      g[2] = r2[k];
-      g[3] = r3[k];
-      g[4] = r4[k];
-      g[5] = r5[k];
-      g[6] = r6[k];
-      g[7] = r7[k];
-      g[8] = r8[k];
-      g[9] = r9[k];
-      g[10] = r10[k];
-      g[11] = r11[k];
-      g[12] = r12[k];
-      g[13] = r13[k];
-      g[14] = r14[k];
-      g[15] = r15[k];
-      g[16] = r16[k];
-      g[17] = r17[k];
-      g[18] = r18[k];
-      collide_node<T, K, kStokes>(g, o, params);
-      r0[k] = o[0];
-      r2[k] = o[1];
-      r1[k] = o[2];
-      r4[k] = o[3];
-      r3[k] = o[4];
-      r6[k] = o[5];
-      r5[k] = o[6];
-      r8[k] = o[7];
-      r7[k] = o[8];
-      r10[k] = o[9];
-      r9[k] = o[10];
-      r12[k] = o[11];
-      r11[k] = o[12];
-      r14[k] = o[13];
-      r13[k] = o[14];
-      r16[k] = o[15];
-      r15[k] = o[16];
-      r18[k] = o[17];
-      r17[k] = o[18];
-    }
+  for (std::int64_t k = 0; k < length; ++k) {
+    T g[kQ], o[kQ];
+    g[0] = r0[k];
+    g[1] = r1[k];
+    g[2] = r2[k];
+    g[3] = r3[k];
+    g[4] = r4[k];
+    g[5] = r5[k];
+    g[6] = r6[k];
+    g[7] = r7[k];
+    g[8] = r8[k];
+    g[9] = r9[k];
+    g[10] = r10[k];
+    g[11] = r11[k];
+    g[12] = r12[k];
+    g[13] = r13[k];
+    g[14] = r14[k];
+    g[15] = r15[k];
+    g[16] = r16[k];
+    g[17] = r17[k];
+    g[18] = r18[k];
+    collide_node<T, K, kStokes>(g, o, params);
+    r0[k] = o[0];
+    r2[k] = o[1];
+    r1[k] = o[2];
+    r4[k] = o[3];
+    r3[k] = o[4];
+    r6[k] = o[5];
+    r5[k] = o[6];
+    r8[k] = o[7];
+    r7[k] = o[8];
+    r10[k] = o[9];
+    r9[k] = o[10];
+    r12[k] = o[11];
+    r11[k] = o[12];
+    r14[k] = o[13];
+    r13[k] = o[14];
+    r16[k] = o[15];
+    r15[k] = o[16];
+    r18[k] = o[17];
+    r17[k] = o[18];
   }
 }
 
@@ -563,7 +566,11 @@ class Solver final : public SolverBase {
           const Segment* first = segments + lattice_.row_segment_begin(r);
           const Segment* last = segments + lattice_.row_segment_begin(r + 1);
           if (parity == 0) {
-            even_sweep<T, K, kStokes>(base, stride, first, last, p);
+            if (first != last) {
+              const std::int64_t begin = lattice_.row_storage_begin(r);
+              even_sweep<T, K, kStokes>(base, stride, begin,
+                                        lattice_.row_storage_begin(r + 1) - begin, p);
+            }
           } else {
             odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p, masked);
           }
@@ -664,7 +671,11 @@ class Solver final : public SolverBase {
       const Segment* first = segments + lattice_.row_segment_begin(r);
       const Segment* last = segments + lattice_.row_segment_begin(r + 1);
       if (parity == 0) {
-        even_sweep<T, K, kStokes>(base, stride, first, last, p);
+        if (first != last) {
+          const std::int64_t begin = lattice_.row_storage_begin(r);
+          even_sweep<T, K, kStokes>(base, stride, begin, lattice_.row_storage_begin(r + 1) - begin,
+                                    p);
+        }
       } else {
         odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p, masked);
       }
@@ -769,13 +780,32 @@ class Solver final : public SolverBase {
   /// correction when `update`, momentum exchange per body into range t's partial sums when
   /// `forces`. The reflected value is computed from the same post-collision values either way,
   /// so the force is that of the populations the fluid receives.
+  /// (`update` is true exactly with interpolated walls; the pass is compiled for each
+  /// combination of the switches, so that the per-link loop carries no test of them.)
   void link_row(int t, std::int64_t row, int parity, bool update, bool forces, double correction) {
+    const bool correct = !wall_state_.empty();
+    if (update) {
+      if (correct) {
+        forces ? link_row_with<true, true, true>(t, row, parity, correction)
+               : link_row_with<true, true, false>(t, row, parity, correction);
+      } else {
+        forces ? link_row_with<true, false, true>(t, row, parity, correction)
+               : link_row_with<true, false, false>(t, row, parity, correction);
+      }
+    } else if (forces) {
+      link_row_with<false, false, true>(t, row, parity, correction);
+    }
+  }
+
+  template <bool kInterpolated, bool kCorrect, bool kForces>
+  void link_row_with(int t, std::int64_t row, int parity, double correction) {
     T* base = populations_.data();
     const LinkTable& L = links_;
     const std::int64_t begin = L.row_begin[static_cast<std::size_t>(row)];
     const std::int64_t end = L.row_begin[static_cast<std::size_t>(row) + 1];
     if (begin == end) return;
-    const bool interpolate = settings_.interpolated;
+    constexpr bool interpolate = kInterpolated;
+    constexpr bool update = kInterpolated;
     // Even parity: f*_i(r - c_i) at a, f*_ib(r) at b; odd parity: the other way round (the
     // weights follow the values, not the positions).
     const std::int64_t* first = parity == 0 ? L.a.data() : L.b.data();
@@ -784,14 +814,13 @@ class Solver final : public SolverBase {
     // back share the slot row opp(i) at r. Interpolated walls (plain sweeps): the odd sweep
     // writes the leaving value into the solid neighbour's slot, row i at r + c_i, and reads the
     // one coming back from there; the pass moves each value to where the next step reads it.
-    const bool plain = settings_.interpolated;
+    constexpr bool plain = kInterpolated;
     const std::int64_t* out = plain && parity == 1 ? L.ghost.data() : L.self.data();
     const std::int64_t* in = plain && parity == 0 ? L.ghost.data() : L.self.data();
     const std::int32_t* node = L.node.data();
     const double* weight_a = L.weight_a.data();
     const double* weight_b = L.weight_b.data();
-    double* force = forces ? partial_force_[static_cast<std::size_t>(t)].data() : nullptr;
-    const bool correct = !wall_state_.empty();
+    double* force = kForces ? partial_force_[static_cast<std::size_t>(t)].data() : nullptr;
     double defect = 0.0;
     for (std::int64_t l = begin; l < end; ++l) {
       if (l + kLinkPrefetch < end) {
@@ -804,20 +833,21 @@ class Solver final : public SolverBase {
       }
       const double f = base[out[l]];
       double back = f;
-      if (interpolate) {
+      if constexpr (interpolate) {
         const double fa = base[first[l]], fb = base[second[l]];
         double reflected = f + weight_a[l] * (fa - f) + weight_b[l] * (fb - f);
-        if (correct) reflected += wall_correction(l, reflected, f, fa, fb, base, out, update);
+        if constexpr (kCorrect)
+          reflected += wall_correction(l, reflected, f, fa, fb, base, out, update);
         back = static_cast<T>(reflected);  // in float, rounded as the fluid receives it
       }
-      if (update) {
+      if constexpr (update) {
         base[in[l]] = static_cast<T>(back);
         defect += back - f;
         if (l + 1 == end || node[l + 1] != node[l]) {
           base[node[l]] = static_cast<T>(base[node[l]] - correction);
         }
       }
-      if (force != nullptr) {
+      if constexpr (kForces) {
         // f = g + w. The rest part 2 w_i c_i (the reference pressure) sums to zero over the whole
         // fluid-solid interface (along every lattice line, as many fluid-to-solid links as
         // solid-to-fluid ones), but not over one body whose links in a sub-node gap were given to
