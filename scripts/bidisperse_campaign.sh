@@ -51,13 +51,16 @@ for s in "${specs[@]}"; do
   "$draglab" campaign run "$spec" --db "$db" --jobs "$jobs" --threads-per-unit 1 "${resume[@]}"
 done
 mkdir -p "$out_dir"
+# Stokes flow, or the target Re of the specs (the flow the exported data were measured in).
+flow="$(grep -h '^re = ' "$spec_dir"/*.toml | sort -u | sed 's/^re = //' | tr '\n' ' ')"
+[[ "$flow" == "[0] " || -z "$flow" ]] && flow="Stokes" || flow="Re ${flow% }"
 provenance() {
   echo "# $1 (issue 36): scripts/bidisperse_campaign.sh --db $(basename "$db")"
   echo "# specs: $(basename "$spec_dir")/*.toml (sha256 of their concatenation: $(cat "$spec_dir"/*.toml | sha256sum | cut -c1-16))"
   echo "# code: $("$draglab" --version); machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
 }
 {
-  provenance "bidisperse per-species Stokes drag"
+  provenance "bidisperse per-species drag ($flow)"
   echo "# columns: campaign, size_ratio, x_small (asked), then campaign export --species: y = d_i/<d> (Sauter), x = volume share, F_i = F_d,i/(3 pi mu d_i U) (drag-only, own diameter), F = mixture F (van der Hoef 2005)"
   header_done=0
   for s in "${specs[@]}"; do
@@ -80,7 +83,7 @@ for r in csv.DictReader(sys.stdin):
   done
 } > "$out_dir/units.csv"
 {
-  provenance "monodisperse Stokes F(phi) of the bidisperse campaign's reference"
+  provenance "monodisperse F(phi) ($flow) of the bidisperse campaign's reference"
   echo "# columns: those of campaign export $(name_of mono) --csv that the reduction reads"
   "$draglab" campaign export "$(name_of mono)" --db "$db" --csv 2>/dev/null |
     /usr/bin/python3 -c 'import csv, sys

@@ -501,6 +501,53 @@ TEST(Fit, CommittedBidisperseDatasetRefitsAndRanksTheLaws) {
   EXPECT_LT(rms("vdh2005_poly"), rms("bvk2007_poly"));
 }
 
+TEST(Fit, CommittedFiniteReBidisperseDataFollowTheStokesSizeFactor) {
+  // data/datasets/bidisperse_re/: the 36 size classes of the bidisperse campaign at Re 10 and 30
+  // (fit_points.csv, each carried onto bvk2007's level at its Re), and the same merged with the
+  // 108 Stokes classes (fit_points_all.csv; docs/fitting.md, "At finite Re").
+  const std::string dir = std::string(DRAGLAB_DATA_DIR) + "/datasets/";
+  auto read = [](const std::string& path) {
+    std::vector<FitPoint> points;
+    for (const DatasetPoint& p : read_dataset_csv(path).points) {
+      EXPECT_GT(p.y, 0.0);
+      points.push_back({p.phi, p.re, p.F, p.F_uncertainty, {p.y}});
+    }
+    return points;
+  };
+  const std::vector<FitPoint> stokes = read(dir + "bidisperse/fit_points.csv");
+  const std::vector<FitPoint> finite_re = read(dir + "bidisperse_re/fit_points.csv");
+  const std::vector<FitPoint> all = read(dir + "bidisperse_re/fit_points_all.csv");
+  ASSERT_EQ(finite_re.size(), 36u);
+  ASSERT_EQ(all.size(), stokes.size() + finite_re.size());
+  for (const FitPoint& p : finite_re) EXPECT_GE(p.re, 9.0);
+  FitOptions options;
+  options.form = "bvk2007_polyfit";
+  options.free = {"a0", "a1", "b0", "b1", "c0", "c1"};
+  options.cv_folds = 0;
+  // The size factor fitted in Stokes flow predicts the Re 10/30 points within their
+  // uncertainties (chi2 per point 0.30 when committed; above 1 the factor would depend on Re
+  // beyond what the data resolve).
+  const FitResult from_stokes = fit_law(stokes, options);
+  const LawForm& form = find_law_form("bvk2007_polyfit");
+  double chi2 = 0.0;
+  for (const FitPoint& p : finite_re) {
+    chi2 += std::pow(
+        (form.F(p.phi, p.re, p.extra.data(), from_stokes.values.data()) - p.F) / p.sigma, 2);
+  }
+  EXPECT_LT(chi2 / static_cast<double>(finite_re.size()), 1.0);
+  // The joint fit: the points' own scatter (chi2/dof 1.03 when committed), every parameter
+  // determined, and each within the Stokes fit's 95 % interval.
+  const FitResult joint = fit_law(all, options);
+  EXPECT_TRUE(joint.undetermined().empty()) << joint.FullReport();
+  EXPECT_TRUE(joint.constraints_satisfied) << joint.constraint_report;
+  EXPECT_LT(joint.chi2_per_dof, 2.0) << joint.FullReport();
+  for (std::size_t k = 0; k < joint.values.size(); ++k) {
+    if (!joint.is_free[k]) continue;
+    EXPECT_GE(joint.values[k], from_stokes.ci95_low[k]) << joint.names[k];
+    EXPECT_LE(joint.values[k], from_stokes.ci95_high[k]) << joint.names[k];
+  }
+}
+
 // A form with nothing free is bad input, not a crash.
 TEST(Fit, FormWithoutFreeParametersIsAClearError) {
   const auto points = synthetic("vdh2004", with("vdh2004", kVdhTruth), 0.02, 3);
