@@ -23,6 +23,10 @@
 //     uncertainty is > 0. "both" runs every seed on 4x10x4 and 6x15x6 (1.5 x, depth too).
 //     Work-precision on an "AxB" grid keeps the scene's depth cells and takes the finest
 //     configuration as the reference of the headline differences.
+//  g. A bed of several sizes: the report gives each run's segregation index at the sample nearest
+//     t_ref and its change over the run (last minus first sample), and per law the mean change
+//     with its standard error over the runs (s/sqrt(n)), worked by hand; a bed of one size (every
+//     index 0) gets no segregation text.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -214,6 +218,42 @@ TEST(SensitivityArithmetic, BothUsesTheFineMeanItsStandardErrorAndTheGridChangeO
     }
   }
   EXPECT_THROW(headline_uncertainty("holdup", {0.01}, 0.1, {0.01}, 0.1), Error);  // h_f = h_c
+}
+
+// (g) in the file comment.
+TEST(SensitivityReport, BedsOfSeveralSizesReportTheirSegregation) {
+  SensitivitySummary summary;
+  summary.scene = "binary";
+  summary.t_ref_s = 0.1;
+  SensitivityLawResult law;
+  law.law = "hys2010@1";
+  auto run_with = [](std::vector<std::pair<double, double>> samples) {
+    SensitivityRun run;
+    for (const auto& [t, index] : samples) {
+      BedSample s;
+      s.t_s = t;
+      s.segregation_index = index;
+      run.series.push_back(s);
+    }
+    return run;
+  };
+  // Changes +0.02 and +0.04: mean 0.03, SE |0.04 - 0.02| / 2 = 0.01.
+  law.runs.push_back(run_with({{0.0, -0.03}, {0.09, -0.02}, {0.12, -0.025}, {0.3, -0.01}}));
+  law.runs.push_back(run_with({{0.0, -0.02}, {0.1, 0.005}, {0.3, 0.02}}));
+  summary.laws.push_back(law);
+  const std::string brief = summary.BriefReport(), full = summary.FullReport();
+  EXPECT_NE(brief.find("segregation change over the run 0.03 +- 0.01"), std::string::npos) << brief;
+  EXPECT_NE(full.find("segregation index -0.02 at t_ref (change over the run 0.02)"),
+            std::string::npos)
+      << full;
+  EXPECT_NE(full.find("segregation index 0.005 at t_ref (change over the run 0.04)"),
+            std::string::npos)
+      << full;
+  SensitivitySummary mono = summary;
+  for (SensitivityRun& r : mono.laws[0].runs) {
+    for (BedSample& s : r.series) s.segregation_index = 0.0;
+  }
+  EXPECT_EQ(mono.FullReport().find("segregation"), std::string::npos) << mono.FullReport();
 }
 
 TEST(SensitivityRunner, RefusesBadLawsAndGridsBeforeAnySettling) {

@@ -666,6 +666,42 @@ std::string HeadlineText(const HeadlineNumbers& numbers) {
   return text;
 }
 
+/// A bed of several sizes: its segregation index at the sample nearest t_ref and its change over
+/// the run (last sample minus first; BedSample::segregation_index). False for a bed of one size,
+/// whose index is 0 throughout.
+bool SegregationOf(const SensitivityRun& run, double t_ref_s, double* at_t_ref, double* change) {
+  const std::vector<BedSample>& series = run.series;
+  if (std::none_of(series.begin(), series.end(),
+                   [](const BedSample& s) { return s.segregation_index != 0.0; })) {
+    return false;
+  }
+  const auto nearest = std::min_element(
+      series.begin(), series.end(), [t_ref_s](const BedSample& a, const BedSample& b) {
+        return std::abs(a.t_s - t_ref_s) < std::abs(b.t_s - t_ref_s);
+      });
+  *at_t_ref = nearest->segregation_index;
+  *change = series.back().segregation_index - series.front().segregation_index;
+  return true;
+}
+
+/// "; segregation change over the run M +- SE" over a law's runs (SE over the runs), or "" for
+/// beds of one size.
+std::string SegregationChangeText(const SensitivityLawResult& law, double t_ref_s) {
+  std::vector<double> changes;
+  for (const SensitivityRun& r : law.runs) {
+    double at_t_ref = 0.0, change = 0.0;
+    if (SegregationOf(r, t_ref_s, &at_t_ref, &change)) changes.push_back(change);
+  }
+  if (changes.empty()) return "";
+  const double n = static_cast<double>(changes.size());
+  double mean = 0.0;
+  for (double c : changes) mean += c / n;
+  double var = 0.0;
+  for (double c : changes) var += (c - mean) * (c - mean);
+  const double se = changes.size() > 1 ? std::sqrt(var / (n - 1.0) / n) : 0.0;
+  return "; segregation change over the run " + Num(mean, 3) + " +- " + Num(se, 2);
+}
+
 }  // namespace
 
 std::string SensitivitySummary::BriefReport() const {
@@ -688,7 +724,8 @@ std::string SensitivitySummary::BriefReport() const {
     if (lr.bubbles_found < static_cast<int>(lr.runs.size()))
       s << " (no bubble at t_ref in " << lr.runs.size() - lr.bubbles_found << " of "
         << lr.runs.size() << " runs: D = 0 there)";
-    s << "; U_mf " << Num(lr.umf_m_s) << " m/s, background " << Num(lr.background_m_s) << " m/s\n";
+    s << "; U_mf " << Num(lr.umf_m_s) << " m/s, background " << Num(lr.background_m_s) << " m/s"
+      << SegregationChangeText(lr, t_ref_s) << "\n";
   }
   return s.str();
 }
@@ -722,8 +759,13 @@ std::string SensitivitySummary::FullReport() const {
         s << HeadlineText(r.headline) << "; " << r.gas_steps << " steps, " << Num(r.wall_s, 3)
           << " s wall\n";
       } else {
-        s << "D " << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none"))
-          << ", " << r.gas_steps << " gas / " << r.dem_steps << " DEM steps, " << Num(r.wall_s, 3)
+        s << "D " << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none"));
+        double at_t_ref = 0.0, change = 0.0;
+        if (SegregationOf(r, t_ref_s, &at_t_ref, &change)) {
+          s << ", segregation index " << Num(at_t_ref, 3) << " at t_ref (change over the run "
+            << Num(change, 3) << ")";
+        }
+        s << ", " << r.gas_steps << " gas / " << r.dem_steps << " DEM steps, " << Num(r.wall_s, 3)
           << " s wall, momentum mismatch " << Num(r.momentum_mismatch, 2) << "\n";
       }
     }
