@@ -37,8 +37,8 @@ std::string duration(double seconds) {
 
 /// Seconds per fluid-node update on one core: a fixed number of steps of the full (non-linear)
 /// kernel with interpolated bounce-back on a 16-sphere phi = 0.2 packing at d = 16 (a box of the
-/// size of small campaign units, 56^3 nodes, beyond the private caches).
-double measure_node_update_seconds() {
+/// size of small campaign units, 56^3 nodes, beyond the private caches), in the spec's precision.
+double measure_node_update_seconds(lbm::Precision precision) {
   arrays::RandomPackingOptions po;
   po.phi = 0.2;
   po.n = 16;
@@ -48,6 +48,7 @@ double measure_node_update_seconds() {
   ro.re = 10.0;
   ro.max_steps = 400;
   ro.threads = 1;
+  ro.precision = precision;
   ro.throw_on_failure = false;  // the step limit is the point: it stops before convergence
   const lbm::RunResult r = lbm::run(packing, 16.0, ro);
   if (!(r.mflups > 0.0)) {
@@ -69,10 +70,11 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
     throw Error(ErrorCode::kInvalidArgument,
                 "campaign plan: node_update_seconds must be >= 0 (0 = measure)");
   }
+  const lbm::Precision precision = lbm::precision_from_string(spec.precision);
   CampaignPlan plan;
   plan.jobs = jobs;
   plan.node_update_seconds =
-      node_update_seconds > 0.0 ? node_update_seconds : measure_node_update_seconds();
+      node_update_seconds > 0.0 ? node_update_seconds : measure_node_update_seconds(precision);
   const lbm::Collision collision = lbm::collision_from_string(spec.collision);
   std::vector<double> unit_seconds;
   for (double phi : spec.phi) {
@@ -90,7 +92,7 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
         p.fluid_nodes = nodes * (1.0 - phi);
         p.steps = lbm::predicted_steps(phi, re, d, collision);
         p.unit_seconds = p.fluid_nodes * p.steps * plan.node_update_seconds;
-        p.memory_bytes = lbm::estimated_run_bytes(nodes, lbm::Precision::kDouble);
+        p.memory_bytes = lbm::estimated_run_bytes(nodes, precision);
         const lbm::ResolutionNeed need = lbm::resolution_needed(phi, re, collision);
         p.d_needed = need.d;
         p.resolution_detail = need.Summary();

@@ -192,6 +192,7 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
     ro.boundary = lbm::boundary_from_string(spec.boundary);
     ro.re = unit.re_target;
     ro.tolerance = spec.tolerance;
+    ro.precision = lbm::precision_from_string(spec.precision);
     ro.max_steps = spec.max_steps;
     ro.threads = threads;
     ro.ranks = group;
@@ -338,7 +339,8 @@ void check_memory(const CampaignSpec& spec, int workers) {
     const int n = internal::packing_options(spec, phi, 1).n;
     nodes = std::max(nodes, std::pow(std::cbrt(n * M_PI / (6.0 * phi)) * d, 3));
   }
-  const double bytes = lbm::estimated_run_bytes(nodes, lbm::Precision::kDouble) * workers;
+  const double bytes =
+      lbm::estimated_run_bytes(nodes, lbm::precision_from_string(spec.precision)) * workers;
   const double memory = lbm::physical_memory_bytes();
   if (memory > 0 && bytes > 0.8 * memory) {
     char buf[320];

@@ -42,7 +42,9 @@ const core::toml_schema::Schema& sections() {
       {"grid", {"phi", "re", "realizations", "seed"}},
       {"packing",
        {"spheres", "box_size", "distribution", "size_ratio", "large_fraction", "sigma", "min_gap"}},
-      {"lbm", {"resolutions", "collision", "boundary", "tolerance", "max_steps", "ranks_per_unit"}},
+      {"lbm",
+       {"resolutions", "collision", "boundary", "tolerance", "max_steps", "precision",
+        "ranks_per_unit"}},
       {"dataset", {"extrapolation"}},
   };
   return s;
@@ -131,6 +133,9 @@ bool CampaignSpec::IsValid(std::string* error) const {
   }
   if (collision != "auto" && collision != "trt" && collision != "bgk" && collision != "rr") {
     return fail(error, "[lbm] collision = '" + collision + "' is not one of auto, trt, bgk, rr");
+  }
+  if (precision != "double" && precision != "float") {
+    return fail(error, "[lbm] precision = '" + precision + "' is not one of double, float");
   }
   if (boundary != "ibb" && boundary != "bb") {
     return fail(error, "[lbm] boundary = '" + boundary + "' is not one of ibb, bb");
@@ -225,6 +230,8 @@ std::string CampaignSpec::to_json() const {
         {"max_steps", max_steps}}},
       {"dataset", {{"extrapolation", extrapolation}}},
   };
+  // Written only where it changes what a unit computes: older specs keep their text and hash.
+  if (precision != "double") j["lbm"]["precision"] = precision;
   return j.dump();
 }
 
@@ -251,6 +258,7 @@ CampaignSpec internal::spec_from_json(const std::string& text) {
   s.boundary = l.at("boundary").get<std::string>();
   s.tolerance = l.at("tolerance").get<double>();
   s.max_steps = l.at("max_steps").get<std::int64_t>();
+  s.precision = l.value("precision", std::string("double"));
   s.extrapolation = j.at("dataset").at("extrapolation").get<std::string>();
   return s;
 }
@@ -305,6 +313,7 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
     if (id == "lbm.collision") s.collision = text();
     if (id == "lbm.boundary") s.boundary = text();
     if (id == "lbm.tolerance") s.tolerance = number();
+    if (id == "lbm.precision") s.precision = text();
     if (id == "lbm.max_steps") {
       const std::int64_t v = integer();
       if (v < 1 || v > 100000000) {

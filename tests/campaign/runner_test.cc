@@ -380,6 +380,44 @@ TEST(CampaignRunner, BidisperseUnitsRecordEachSizeClassForTheSpeciesExport) {
   EXPECT_EQ(rows, 0u);
 }
 
+TEST(CampaignRunner, FloatUnitsRecordTheirPrecisionAndAgreeWithDouble) {
+  // The same two finite-Re units in double and in float storage ([lbm] precision): each record
+  // names its precision, and float moves F by far less than the 1e-3 the engine allows it
+  // (docs/scaling.md measured at most 4e-6; the runs stop at a tolerance of 1e-5 per
+  // characteristic time, so the two may stop a check apart: 1e-4 bounds that).
+  TempDir dir;
+  std::map<std::string, std::vector<double>> drag;
+  for (const std::string precision : {"double", "float"}) {
+    CampaignSpec spec;
+    spec.name = "precision_" + precision;
+    spec.phi = {0.3};
+    spec.re = {10};
+    spec.realizations = 2;
+    spec.spheres = 8;
+    spec.resolutions = {8};
+    spec.collision = "trt";
+    spec.precision = precision;
+    spec.extrapolation = "finest";
+    RunCampaignOptions options;
+    options.jobs = 1;
+    const std::string db_path = dir.file(precision + ".db");
+    const CampaignStatus st = run_campaign(db_path, spec, options);
+    ASSERT_EQ(st.units_done, 2);
+    RawDb raw(db_path);
+    for (int unit = 1; unit <= 2; ++unit) {
+      const std::vector<std::string> rows =
+          raw.rows("SELECT result_json FROM campaign_units WHERE id = " + std::to_string(unit));
+      ASSERT_EQ(rows.size(), 1u);
+      const nlohmann::json r = nlohmann::json::parse(rows[0]);
+      EXPECT_EQ(r.at("precision").get<std::string>(), precision);
+      drag[precision].push_back(r.at("F").get<double>());
+    }
+  }
+  for (std::size_t u = 0; u < 2; ++u) {
+    EXPECT_NEAR(drag["float"][u], drag["double"][u], 1e-4 * drag["double"][u]) << "unit " << u;
+  }
+}
+
 TEST(CampaignRunner, SecondProcessOnTheSameCampaignIsRefused) {
   TempDir dir;
   const std::string db = dir.file("lock.db"), spec = dir.file("tiny.toml");

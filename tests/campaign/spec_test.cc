@@ -195,6 +195,26 @@ TEST(CampaignSpec, RanksPerUnitIsCheckedAndNotPartOfTheIdentity) {
   EXPECT_NE(error.find("[lbm] ranks_per_unit = -2"), std::string::npos) << error;
 }
 
+TEST(CampaignSpec, FloatPrecisionIsPartOfTheIdentityAndDoubleKeepsOlderHashes) {
+  const CampaignSpec plain = parse_campaign_spec_text(kValid, "spec.toml");
+  EXPECT_EQ(plain.precision, "double");
+  const CampaignSpec named = parse_campaign_spec_text(
+      edit("max_steps = 50000", "max_steps = 50000\nprecision = \"double\""), "spec.toml");
+  // A spec written before the key and one naming the default are the same campaign.
+  EXPECT_EQ(named.to_json(), plain.to_json());
+  EXPECT_EQ(plain.to_json().find("precision"), std::string::npos);
+  const CampaignSpec single = parse_campaign_spec_text(
+      edit("max_steps = 50000", "max_steps = 50000\nprecision = \"float\""), "spec.toml");
+  EXPECT_EQ(single.precision, "float");
+  // Float changes what a unit computes (by round-off): another campaign.
+  EXPECT_NE(single.to_json(), plain.to_json());
+  EXPECT_EQ(internal::spec_from_json(single.to_json()).to_json(), single.to_json());
+  EXPECT_EQ(internal::spec_from_json(plain.to_json()).precision, "double");
+  EXPECT_NE(parse_error(edit("max_steps = 50000", "max_steps = 50000\nprecision = \"half\""))
+                .find("[lbm] precision = 'half' is not one of double, float"),
+            std::string::npos);
+}
+
 TEST(CampaignSpec, ForcedGapThatJamsIsRefusedWithTheLimit) {
   // phi = 0.5 with a forced gap of 0.12 d: padded solids fraction 0.5 * 1.12^3 = 0.70 > 0.62;
   // the gap may be at most (0.62/0.5)^(1/3) - 1 = 0.0743 d.

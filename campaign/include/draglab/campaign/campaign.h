@@ -51,6 +51,9 @@ struct CampaignSpec {
   std::string boundary = "ibb";     ///< [lbm] ibb or bb.
   double tolerance = 1e-5;          ///< [lbm] convergence tolerance (relative change per T).
   std::int64_t max_steps = 200000;  ///< [lbm] step limit of one unit.
+  /// [lbm] population storage, "double" or "float" (lbm::RunOptions::precision). Part of the
+  /// spec's identity only when "float", so specs written before the key keep their hash.
+  std::string precision = "double";
   /// [lbm] MPI ranks that share each unit's box (slabs of z-planes, lbm::RunOptions::ranks), [1,
   /// kMaxRanksPerUnit]; > 1 needs a job of at least 1 + ranks_per_unit ranks. How a unit is
   /// computed, not what: it is not part of the spec's identity (to_json), so a campaign may be
