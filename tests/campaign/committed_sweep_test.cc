@@ -1,0 +1,128 @@
+// The committed convergence in d of dense packings at Re 100 (data/datasets/dense_d_sweep_8/,
+// from the campaigns of data/campaigns/dense_d_sweep_8/: 8 spheres at phi 0.5 and 0.6, d 32, 48
+// and 64, one realization each): each file is the run of the committed spec it names (the spec
+// hash in its header is that spec's) and the drag converges in d (each refinement moves it less
+// than the one before). tests/lbm/committed_dense_sweep_test.cc checks the error model on it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/dataset.h"
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+const std::string kSpecs = std::string(DRAGLAB_DATA_DIR) + "/campaigns/dense_d_sweep_8/";
+const std::string kData = std::string(DRAGLAB_DATA_DIR) + "/datasets/dense_d_sweep_8/";
+
+struct Unit {
+  double phi = 0, re = 0, d = 0, F = NAN, estimate = NAN;
+  std::string status;
+};
+
+/// Splits one CSV line; quoted fields (result_json) may hold commas and doubled quotes.
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        out.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+/// The units of an exported campaign file and the spec hash its header names.
+std::vector<Unit> read_export(const std::string& path, std::string* spec_hash) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  std::vector<Unit> units;
+  std::vector<std::string> columns;
+  const std::string hash_key = "# Spec hash (SHA-256 of the canonical spec): ";
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(hash_key, 0) == 0) *spec_hash = line.substr(hash_key.size());
+    if (line.empty() || line[0] == '#') continue;
+    if (columns.empty()) {
+      columns = split_csv(line);
+      continue;
+    }
+    const std::vector<std::string> f = split_csv(line);
+    EXPECT_EQ(f.size(), columns.size()) << path;
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < columns.size() && i < f.size(); ++i) row[columns[i]] = f[i];
+    Unit u;
+    u.phi = std::stod(row["phi"]);
+    u.re = std::stod(row["re_target"]);
+    u.d = std::stod(row["resolution"]);
+    u.status = row["status"];
+    if (u.status == "done") {
+      u.F = std::stod(row["F"]);
+      u.estimate = std::stod(row["error_estimate"]);
+    }
+    units.push_back(u);
+  }
+  return units;
+}
+
+const std::vector<std::string> kParts = {"d32", "d48_re100", "d48_re300", "d64"};
+
+TEST(CommittedDenseSweep, EachFileIsTheRunOfItsCommittedSpec) {
+  for (const std::string& part : kParts) {
+    SCOPED_TRACE(part);
+    const CampaignSpec spec = parse_campaign_spec(kSpecs + part + ".toml");
+    std::string hash;
+    const std::vector<Unit> units = read_export(kData + part + ".csv", &hash);
+    EXPECT_EQ(hash, sha256_hex(spec.to_json()));
+    EXPECT_EQ(units.size(), spec.phi.size() * spec.re.size() * spec.resolutions.size());
+    for (const Unit& u : units) {
+      EXPECT_EQ(u.d, spec.resolutions.front());
+      if (u.status == "done") {
+        EXPECT_TRUE(std::isfinite(u.F) && u.F > 0.0);
+        EXPECT_TRUE(std::isfinite(u.estimate) && u.estimate > 0.0);
+      }
+    }
+  }
+}
+
+TEST(CommittedDenseSweep, EachRefinementMovesTheDragLessThanTheOneBefore) {
+  std::map<double, std::vector<Unit>> at_re100;  // phi -> runs
+  for (const std::string& part : kParts) {
+    std::string hash;
+    for (const Unit& u : read_export(kData + part + ".csv", &hash)) {
+      if (u.status == "done" && u.re == 100.0) at_re100[u.phi].push_back(u);
+    }
+  }
+  ASSERT_EQ(at_re100.size(), 2u);
+  for (auto& [phi, runs] : at_re100) {
+    SCOPED_TRACE("phi " + std::to_string(phi));
+    ASSERT_EQ(runs.size(), 3u) << "d 32, 48 and 64";
+    std::sort(runs.begin(), runs.end(), [](const Unit& a, const Unit& b) { return a.d < b.d; });
+    EXPECT_LT(std::fabs(runs[2].F - runs[1].F), std::fabs(runs[1].F - runs[0].F));
+  }
+}
+
+}  // namespace
+}  // namespace campaign
+}  // namespace draglab
