@@ -57,6 +57,43 @@ std::string resolve_spec_path(const std::string& spec) {
   return spec;
 }
 
+/// A finite number, or null (JSON has no nan).
+nlohmann::json finite_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nullptr; }
+
+nlohmann::json in_progress_json(const std::vector<campaign::UnitInProgress>& units) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& u : units) {
+    nlohmann::json j = {{"unit", u.unit_id},
+                        {"phi", u.phi},
+                        {"re_target", u.re_target},
+                        {"resolution", u.resolution},
+                        {"realization", u.realization},
+                        {"status", u.status},
+                        {"checkpoint_age_s", u.checkpoint_age_s}};
+    if (!u.unreadable.empty()) {
+      j["unreadable"] = u.unreadable;
+    } else {
+      const lbm::CheckpointProgress& p = u.progress;
+      j["code"] = p.code;
+      j["step"] = p.step;
+      j["checks"] = p.checks;
+      j["F"] = finite_or_null(p.F);
+      j["re"] = finite_or_null(p.re);
+      j["relative_change"] = finite_or_null(p.relative_change);
+      j["recent_F"] = {finite_or_null(p.recent_F_min), finite_or_null(p.recent_F_max)};
+      j["recent_re"] = {finite_or_null(p.recent_re_min), finite_or_null(p.recent_re_max)};
+      j["force_adjustments"] = p.force_adjustments;
+      j["averaging"] = p.averaging;
+      j["averaging_start"] = p.averaging_start;
+      j["averaged_samples"] = p.averaged_samples;
+      j["F_average"] = finite_or_null(p.F_average);
+      j["F_average_standard_error"] = finite_or_null(p.F_average_standard_error);
+    }
+    a.push_back(std::move(j));
+  }
+  return a;
+}
+
 nlohmann::json status_json(const campaign::CampaignStatus& s) {
   return {{"id", s.id},
           {"name", s.name},
@@ -67,7 +104,8 @@ nlohmann::json status_json(const campaign::CampaignStatus& s) {
           {"units_failed", s.units_failed},
           {"units_pending", s.units_pending},
           {"units_running", s.units_running},
-          {"wall_s", s.wall_s}};
+          {"wall_s", s.wall_s},
+          {"in_progress", in_progress_json(s.in_progress)}};
 }
 
 nlohmann::json point_json(const DatasetPoint& p) {

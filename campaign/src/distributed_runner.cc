@@ -167,7 +167,7 @@ CampaignStatus run_rank0(const std::string& db_path, const CampaignSpec& spec,
     const double fraction =
         opened.session_cost > 0 ? std::min(1.0, partial / opened.session_cost) : 1.0;
     options.progress(finished, opened.total,
-                     progress_line(spec.name, finished, opened.total, failed_session, fraction,
+                     progress_line(spec.name, finished, opened.total, failed_session, fraction, 0.0,
                                    seconds_since(start), event));
   };
 

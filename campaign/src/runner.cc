@@ -3,6 +3,7 @@
 // one database connection each, and commits every finished unit in its own transaction.
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -26,6 +27,7 @@
 #include "db/sqlite_util.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/drag_db/database.h"
 #include "draglab/error.h"
@@ -430,9 +432,10 @@ void release_unit(Database& db, std::int64_t unit_id, const std::string& token) 
 }
 
 std::string progress_line(const std::string& name, std::int64_t finished, std::int64_t total,
-                          std::int64_t failed, double fraction, double elapsed_s,
+                          std::int64_t failed, double fraction, double restored, double elapsed_s,
                           const std::string& event) {
-  const double eta = fraction > 0.005 ? elapsed_s * (1.0 - fraction) / fraction : NAN;
+  const double done_here = fraction - restored;
+  const double eta = done_here > 0.005 ? elapsed_s * (1.0 - fraction) / done_here : NAN;
   char buf[320];
   std::snprintf(buf, sizeof buf,
                 "campaign %s: %lld/%lld units (%lld failed this run), %.1f %% of the work, "
@@ -605,6 +608,10 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
   double cost_done = 0.0;
   std::vector<std::atomic<double>> fractions(workers);
   std::vector<double> in_flight_cost(workers, 0.0);
+  // A unit resumed from its checkpoint reports at once the progress it had: that part is not
+  // this session's work (restored_cost), or the ETA after a resume would be a few seconds.
+  std::vector<bool> resuming(workers, false);
+  double restored_cost = 0.0;
   std::vector<double> busy_s(workers, 0.0);
   std::vector<int> units_run(workers, 0);
   for (auto& f : fractions) f.store(0.0);
@@ -617,12 +624,20 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
     // Caller holds `mutex`.
     if (!options.progress) return;
     double partial = cost_done;
-    for (int w = 0; w < workers; ++w) partial += in_flight_cost[w] * fractions[w].load();
+    for (int w = 0; w < workers; ++w) {
+      const double f = fractions[w].load();
+      if (resuming[w] && f > 0.0) {
+        restored_cost += in_flight_cost[w] * f;
+        resuming[w] = false;
+      }
+      partial += in_flight_cost[w] * f;
+    }
     const double fraction = session_cost > 0 ? std::min(1.0, partial / session_cost) : 1.0;
+    const double restored = session_cost > 0 ? std::min(1.0, restored_cost / session_cost) : 0.0;
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    options.progress(
-        finished, total,
-        progress_line(spec.name, finished, total, failed_session, fraction, elapsed, event));
+    options.progress(finished, total,
+                     progress_line(spec.name, finished, total, failed_session, fraction, restored,
+                                   elapsed, event));
   };
 
   auto worker = [&](int w) {
@@ -631,17 +646,19 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
       const std::string token = host + ":" + std::to_string(::getpid()) + ":" + std::to_string(w);
       ClaimedUnit unit;
       while (!stop.load() && claim_next(wdb, id, token, &unit)) {
+        const std::string checkpoint = unit_checkpoint_path(db_path, id, unit.id);
         {
           std::lock_guard<std::mutex> g(mutex);
           fractions[w].store(0.0);
           in_flight_cost[w] =
               internal::unit_cost_estimate(spec, unit.phi, unit.re_target, unit.resolution);
+          resuming[w] = !checkpoint.empty() && core::file_exists(checkpoint);
         }
         std::atomic<double>& fraction = fractions[w];
         // Engine progress also refreshes the line (the callback throttles).
         const UnitOutcome o =
-            execute_unit(spec, unit, threads, &fraction, mpi::Communicator::self(),
-                         unit_checkpoint_path(db_path, id, unit.id), options.checkpoint_interval);
+            execute_unit(spec, unit, threads, &fraction, mpi::Communicator::self(), checkpoint,
+                         options.checkpoint_interval);
         const bool ours = commit_unit(wdb, unit, token, o);
         std::lock_guard<std::mutex> g(mutex);
         cost_done += in_flight_cost[w];
@@ -741,8 +758,62 @@ std::string CampaignStatus::FullReport() const {
   s << "  created at  " << created_at << "\n";
   s << "  pending     " << units_pending << ", running " << units_running << "\n";
   s << "  LBM time    " << format_duration(wall_s) << " (sum over finished units)\n";
+  for (const UnitInProgress& u : in_progress) {
+    char head[160];
+    std::snprintf(head, sizeof head, "  unit %lld (phi %g, Re %g, d %g, realization %d, %s): ",
+                  static_cast<long long>(u.unit_id), u.phi, u.re_target, u.resolution,
+                  u.realization, u.status.c_str());
+    s << head;
+    if (!u.unreadable.empty()) {
+      s << "checkpoint unreadable: " << u.unreadable << "\n";
+      continue;
+    }
+    s << "checkpoint " << format_duration(u.checkpoint_age_s) << " old, "
+      << u.progress.BriefReport() << "\n";
+  }
   return s.str();
 }
+
+namespace {
+
+/// Seconds since `path` was last written (0 if it cannot be read).
+double file_age_seconds(const std::string& path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) return 0.0;
+  return std::max(0.0, std::difftime(std::time(nullptr), st.st_mtime));
+}
+
+/// The unfinished units of a campaign whose checkpoint exists, with what it records.
+std::vector<UnitInProgress> units_in_progress(const Database& db, std::int64_t campaign_id) {
+  std::vector<UnitInProgress> out;
+  if (db.path().empty() || db.path() == ":memory:") return out;
+  Statement s(db.handle(),
+              "SELECT id, phi, re_target, resolution, realization, status FROM campaign_units "
+              "WHERE campaign_id = ? AND status IN ('running', 'pending') ORDER BY id");
+  s.bind(1, campaign_id);
+  while (s.step()) {
+    const std::string checkpoint =
+        runner::unit_checkpoint_path(db.path(), campaign_id, s.integer(0));
+    if (!core::file_exists(checkpoint)) continue;
+    UnitInProgress u;
+    u.unit_id = s.integer(0);
+    u.phi = s.real(1);
+    u.re_target = s.real(2);
+    u.resolution = s.real(3);
+    u.realization = static_cast<int>(s.integer(4));
+    u.status = s.text(5);
+    u.checkpoint_age_s = file_age_seconds(checkpoint);
+    try {
+      u.progress = lbm::read_checkpoint_progress(checkpoint);
+    } catch (const Error& e) {
+      u.unreadable = e.what();  // being replaced this instant, or damaged: say so, go on
+    }
+    out.push_back(std::move(u));
+  }
+  return out;
+}
+
+}  // namespace
 
 CampaignStatus campaign_status(const Database& db, const std::string& id_or_name) {
   require_campaign_tables(db);
@@ -780,6 +851,7 @@ CampaignStatus campaign_status(const Database& db, const std::string& id_or_name
     if (status == "running") st.units_running = n;
     if (status == "done" || status == "failed") st.wall_s += c.real(2);
   }
+  st.in_progress = units_in_progress(db, st.id);
   return st;
 }
 

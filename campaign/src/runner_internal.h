@@ -99,9 +99,11 @@ bool commit_unit(Database& db, const ClaimedUnit& unit, const std::string& token
 /// Returns a unit claimed by `token` to the queue (its worker is presumed dead).
 void release_unit(Database& db, std::int64_t unit_id, const std::string& token);
 
-/// The progress line and the event of a finished unit.
+/// The progress line and the event of a finished unit. `fraction` is the share of the session's
+/// work done, `restored` the part of it that resumed units brought from their checkpoints: the
+/// ETA extrapolates only the rate of the work this session did.
 std::string progress_line(const std::string& name, std::int64_t finished, std::int64_t total,
-                          std::int64_t failed, double fraction, double elapsed_s,
+                          std::int64_t failed, double fraction, double restored, double elapsed_s,
                           const std::string& event);
 std::string unit_event(const ClaimedUnit& unit, const UnitOutcome& o);
 

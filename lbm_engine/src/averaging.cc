@@ -90,6 +90,17 @@ bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, do
          sd_b > kUndampedFraction * sd_a;
 }
 
+double averaging_steps_left(double time_left_steps, double used, double relative_standard_error,
+                            double tolerance, double steps_per_sample) {
+  double samples_left = std::max(0.0, 2.0 * static_cast<double>(kMinBlocks) - used);
+  if (used >= 2.0 && relative_standard_error > tolerance) {
+    if (!std::isfinite(relative_standard_error) || !(tolerance > 0.0)) return HUGE_VAL;
+    const double ratio = relative_standard_error / tolerance;
+    samples_left = std::max(samples_left, used * (ratio * ratio - 1.0));
+  }
+  return std::max(time_left_steps, samples_left * steps_per_sample);
+}
+
 double finite_re_correction(double re_now, double re_filtered, double target_re,
                             double re_tolerance, ReControlState* state) {
   const auto deviation = [target_re](double re) { return std::abs(re / target_re - 1.0); };

@@ -56,6 +56,14 @@ TimeAverage time_average(const std::vector<double>& x, std::size_t truncated);
 /// kUndampedFraction of the first's).
 bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, double tolerance);
 
+/// Steps an averaging run still needs, estimated for its progress report: the more of the
+/// averaging time left (in steps) and the samples its relative standard error asks for to reach
+/// `tolerance` (the error falls as one over the square root of the samples), with at least the
+/// 2 kMinBlocks samples the blocking estimate needs; `used` samples so far, one per
+/// `steps_per_sample`. Infinite when the error is not known yet.
+double averaging_steps_left(double time_left_steps, double used, double relative_standard_error,
+                            double tolerance, double steps_per_sample);
+
 /// Corrections of the force inside Re's band (towards its middle third) once Re has reached
 /// it: a steady flow needs one or two.
 constexpr int kMaxFineCorrections = 3;

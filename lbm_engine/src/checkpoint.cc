@@ -1,6 +1,7 @@
 // checkpoint.cc: writing and reading the checkpoint file (checkpoint.h).
 #include "checkpoint.h"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -12,6 +13,7 @@
 
 #include "drag_db_version.h"
 #include "draglab/core/files.h"
+#include "draglab/core/text.h"
 #include "draglab/error.h"
 
 namespace draglab {
@@ -255,6 +257,76 @@ double checkpoint_pore_speed_ratio(const std::string& path) {
   } catch (const std::exception&) {
     return 0.0;
   }
+}
+
+CheckpointProgress read_checkpoint_progress(const std::string& path) {
+  if (!core::file_exists(path)) {
+    throw Error(ErrorCode::kNotFound, std::string(kField) + " '" + path + "' does not exist");
+  }
+  LoopState state;
+  CheckpointProgress p;
+  try {
+    const Json header = Json::parse(read_checkpoint_header(path, kField));
+    p.code = header.at("code").get<std::string>();
+    state = json_state(header.at("state"));
+  } catch (const std::runtime_error& e) {
+    if (dynamic_cast<const Error*>(&e) != nullptr) throw;
+    refuse(kField, path, "a damaged header");
+  }
+  const double nan = std::nan("");
+  p.step = state.step;
+  p.checks = state.history.size();
+  p.force_adjustments = state.adjustments;
+  p.F = p.re = p.relative_change = nan;
+  p.recent_F_min = p.recent_F_max = p.recent_re_min = p.recent_re_max = nan;
+  if (!state.history.empty()) {
+    const HistoryPoint& last = state.history.back();
+    p.F = last.F;
+    p.re = last.re;
+    p.relative_change = last.relative_change;
+    const std::size_t first =
+        state.history.size() - std::min(state.history.size(), CheckpointProgress::kRecentChecks);
+    p.recent_F_min = p.recent_F_max = last.F;
+    p.recent_re_min = p.recent_re_max = last.re;
+    for (std::size_t k = first; k < state.history.size(); ++k) {
+      const HistoryPoint& h = state.history[k];
+      p.recent_F_min = std::min(p.recent_F_min, h.F);
+      p.recent_F_max = std::max(p.recent_F_max, h.F);
+      p.recent_re_min = std::min(p.recent_re_min, h.re);
+      p.recent_re_max = std::max(p.recent_re_max, h.re);
+    }
+  }
+  p.averaging = state.averaging;
+  p.averaging_start = state.averaging_start;
+  p.averaged_samples = state.series_F.size();
+  p.F_average = p.F_average_standard_error = nan;
+  if (state.averaging && state.series_F.size() >= 2) {
+    const TimeAverage a = time_average(state.series_F);
+    p.F_average = a.mean;
+    p.F_average_standard_error = a.standard_error;
+  }
+  return p;
+}
+
+std::string CheckpointProgress::BriefReport() const {
+  using core::format_fixed;
+  std::string s = "step " + std::to_string(step);
+  if (checks == 0) return s + ", no check yet";
+  const std::string recent =
+      "last " + std::to_string(std::min(checks, kRecentChecks)) + " checks: ";
+  s += ", F " + format_fixed("%.6g", F) + " (" + recent + format_fixed("%.6g", recent_F_min) +
+       " - " + format_fixed("%.6g", recent_F_max) + "), Re " + format_fixed("%.5g", re) + " (" +
+       format_fixed("%.5g", recent_re_min) + " - " + format_fixed("%.5g", recent_re_max) +
+       "), change/T " + format_fixed("%.2g", relative_change) + ", " +
+       std::to_string(force_adjustments) + " force corrections";
+  if (!averaging) return s + "; not averaging";
+  s += "; averaging since step " + std::to_string(averaging_start) + ", " +
+       std::to_string(averaged_samples) + " samples";
+  if (std::isfinite(F_average)) {
+    s += ": F " + format_fixed("%.6g", F_average) + " +- " +
+         format_fixed("%.2g", F_average_standard_error);
+  }
+  return s;
 }
 
 void check_checkpoint_file(const std::string& path) {

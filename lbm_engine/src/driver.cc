@@ -1017,15 +1017,28 @@ class RunChecks {
       const double se = average_F_.mean != 0.0
                             ? average_F_.standard_error / std::abs(average_F_.mean)
                             : std::numeric_limits<double>::infinity();
-      progress_(
-          std::min(1.0, static_cast<double>(loop_.step) / static_cast<double>(options_.max_steps)),
-          "step " + std::to_string(loop_.step) +
-              ": averaging, F = " + format_fixed("%.6g", average_F_.mean) + " +- " +
-              format_fixed("%.2g", 100.0 * se) + " % over " + format_fixed("%.3g", averaged_time) +
-              " d/U, Re = " + format_fixed("%.4g", average_re_.mean) + ", " +
-              format_fixed("%.4g", result_.mflups) + " MFLUPS");
+      progress_(AveragingFraction(averaged_time, se),
+                "step " + std::to_string(loop_.step) +
+                    ": averaging, F = " + format_fixed("%.6g", average_F_.mean) + " +- " +
+                    format_fixed("%.2g", 100.0 * se) + " % over " +
+                    format_fixed("%.3g", averaged_time) +
+                    " d/U, Re = " + format_fixed("%.4g", average_re_.mean) + ", " +
+                    format_fixed("%.4g", result_.mflups) + " MFLUPS");
     }
     return Next::kNextCheck;
+  }
+
+  /// The share of the run done while averaging: its steps over those plus the steps still
+  /// needed (averaging_steps_left); never below steps over max_steps.
+  double AveragingFraction(double averaged_time, double relative_standard_error) const {
+    const double steps_per_time = sc_.d / (sc_.target_re * sc_.nu / sc_.d);
+    const double left =
+        averaging_steps_left(std::max(0.0, options_.average_time - averaged_time) * steps_per_time,
+                             static_cast<double>(average_F_.used), relative_standard_error,
+                             options_.average_tolerance, static_cast<double>(sc_.interval));
+    const double step = static_cast<double>(loop_.step);
+    const double fraction = std::isfinite(left) ? step / (step + left) : 0.0;
+    return std::clamp(std::max(fraction, step / static_cast<double>(options_.max_steps)), 0.0, 1.0);
   }
 
   /// The target Re: the force rescaled towards it (exactly in Stokes mode, where the scheme is

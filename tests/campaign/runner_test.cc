@@ -21,6 +21,7 @@
 #include "draglab/drag_db/database.h"
 #include "draglab/drag_db/dataset.h"
 #include "draglab/error.h"
+#include "runner_internal.h"
 
 namespace draglab {
 namespace campaign {
@@ -237,6 +238,24 @@ TEST(CampaignRunner, UnitKilledMidRunGoesOnFromItsCheckpoint) {
   ASSERT_TRUE(WIFSIGNALED(status)) << "the unit finished before it could be killed";
   ASSERT_TRUE(campaign_test::exists(checkpoint));
 
+  // `campaign status` reads where the killed unit stood from its checkpoint: the step the resumed
+  // run then goes on from.
+  std::string status_out, status_err;
+  ASSERT_EQ(run_cli({"--db", db, "--json", "campaign", "status", "resumable"}, dir.path(),
+                    &status_out, &status_err),
+            0)
+      << status_err;
+  const auto in_progress = nlohmann::json::parse(status_out).at("in_progress");
+  ASSERT_EQ(in_progress.size(), 1u) << status_out;
+  EXPECT_EQ(in_progress[0].at("status"), "running") << "the killed process left it so";
+  const long long step_at_kill = in_progress[0].at("step").get<long long>();
+  EXPECT_GT(step_at_kill, 0);
+  ASSERT_EQ(run_cli({"--db", db, "campaign", "status", "resumable"}, dir.path(), &status_out,
+                    &status_err),
+            0);
+  EXPECT_NE(status_out.find("step " + std::to_string(step_at_kill)), std::string::npos)
+      << status_out;
+
   std::string out, err;
   std::vector<std::string> resume = {"--db", db};
   resume.insert(resume.end(), run_args.begin(), run_args.end());
@@ -254,10 +273,23 @@ TEST(CampaignRunner, UnitKilledMidRunGoesOnFromItsCheckpoint) {
       resumed_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
   const auto fresh = nlohmann::json::parse(
       reference_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
-  EXPECT_GT(resumed["resumed_from_step"].get<long long>(), 0) << resumed.dump();
+  EXPECT_EQ(resumed["resumed_from_step"].get<long long>(), step_at_kill) << resumed.dump();
   EXPECT_EQ(fresh["resumed_from_step"].get<long long>(), 0);
   EXPECT_EQ(resumed["F"].get<double>(), fresh["F"].get<double>());  // the same bits
   EXPECT_EQ(resumed["steps"], fresh["steps"]);
+}
+
+// A resumed unit reports at once the progress its checkpoint holds; the ETA extrapolates the
+// rate of what this session did, not of what it brought back (which would read seconds).
+TEST(CampaignProgress, EtaAfterAResumeExtrapolatesOnlyThisSessionsWork) {
+  // Half the work done, 40 % of it restored: 10 % in 60 s, so 50 % more takes 300 s.
+  const std::string resumed = runner::progress_line("c", 0, 2, 0, 0.5, 0.4, 60.0, "");
+  EXPECT_NE(resumed.find("eta 5m00s"), std::string::npos) << resumed;
+  const std::string fresh = runner::progress_line("c", 0, 2, 0, 0.5, 0.0, 60.0, "");
+  EXPECT_NE(fresh.find("eta 1m00s"), std::string::npos) << fresh;
+  // Nothing done this session yet: no rate, no ETA.
+  const std::string none = runner::progress_line("c", 0, 2, 0, 0.4, 0.4, 5.0, "");
+  EXPECT_NE(none.find("eta ?"), std::string::npos) << none;
 }
 
 TEST(CampaignRunner, DivergingUnitIsRecordedFailedAndTheOthersComplete) {

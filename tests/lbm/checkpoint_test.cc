@@ -17,10 +17,14 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
 
+#include "averaging.h"
+#include "checkpoint.h"
 #include "draglab/error.h"
 #include "validation_support.h"
 
@@ -44,6 +48,31 @@ RunOptions options_for(double re, Collision collision) {
   return o;
 }
 
+/// What read_checkpoint_progress reports of a stopped run is that run's own record.
+void expect_progress_is_the_runs(const CheckpointProgress& p, const RunResult& run) {
+  EXPECT_EQ(p.step, run.steps);
+  // The checkpoint holds the checks made before it was written (a Stokes run's record may add
+  // the check its stop makes).
+  ASSERT_GT(p.checks, 0u);
+  ASSERT_LE(p.checks, run.history.size());
+  ASSERT_GE(p.checks + 1, run.history.size());
+  const HistoryPoint& last = run.history[p.checks - 1];
+  EXPECT_EQ(p.F, last.F);
+  EXPECT_EQ(p.re, last.re);
+  const std::size_t first = p.checks - std::min<std::size_t>(p.checks, 40);
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (std::size_t k = first; k < p.checks; ++k) {
+    lo = std::min(lo, run.history[k].F);
+    hi = std::max(hi, run.history[k].F);
+  }
+  EXPECT_EQ(p.recent_F_min, lo);
+  EXPECT_EQ(p.recent_F_max, hi);
+  EXPECT_EQ(p.force_adjustments, run.force_adjustments);
+  EXPECT_FALSE(p.averaging);
+  EXPECT_NE(p.BriefReport().find("step " + std::to_string(run.steps)), std::string::npos)
+      << p.BriefReport();
+}
+
 void expect_resumed_run_is_bit_identical(double phi, double d, double re, Collision collision,
                                          const std::string& name) {
   SCOPED_TRACE(name);
@@ -62,6 +91,7 @@ void expect_resumed_run_is_bit_identical(double phi, double d, double re, Collis
   EXPECT_FALSE(first.converged);
   EXPECT_NE(first.diagnosis.find("holds step"), std::string::npos) << first.diagnosis;
   EXPECT_TRUE(exists(o.checkpoint));
+  expect_progress_is_the_runs(read_checkpoint_progress(o.checkpoint), first);
   o.max_steps = 2 * reference.steps / 3 + 1;
   const RunResult second = run(sc.grid, sc.packing.phi(), o);
   EXPECT_FALSE(second.converged);
@@ -95,6 +125,42 @@ TEST(Checkpoint, ResumedRrRunKeepsItsWallCorrectionState) {
 
 TEST(Checkpoint, ResumedStokesRunIsBitIdentical) {
   expect_resumed_run_is_bit_identical(0.2, 10.0, 0.0, Collision::kTrt, "stokes");
+}
+
+// An averaging run's progress: the time mean so far is the engine's own (MSER start-up, blocking
+// standard error) of the samples the checkpoint carries. A synthetic state: a start-up transient
+// then a stationary, correlated signal.
+TEST(Checkpoint, ProgressOfAnAveragingRunIsTheTimeMeanOfItsSamples) {
+  LoopState state;
+  state.step = 5000;
+  state.averaging = true;
+  state.averaging_start = 3000;
+  state.adjustments = 4;
+  for (int k = 0; k < 200; ++k) {
+    const double F = 70.0 + 5.0 * std::exp(-k / 10.0) + std::sin(0.7 * k) + 0.3 * std::cos(2.3 * k);
+    state.series_F.push_back(F);
+    state.history.push_back({3000 + 10 * k, F, 300.0 + std::sin(0.5 * k), 1e-3});
+  }
+  std::vector<double> populations(64, 0.25);
+  const std::string path = temporary_path("averaging");
+  save_run_checkpoint(path, {{"case", "synthetic"}}, state,
+                      {{"populations", populations.data(), populations.size() * sizeof(double)}});
+  const CheckpointProgress p = read_checkpoint_progress(path);
+  std::remove(path.c_str());
+  const TimeAverage expected = time_average(state.series_F);
+  EXPECT_TRUE(p.averaging);
+  EXPECT_EQ(p.averaging_start, 3000);
+  EXPECT_EQ(p.averaged_samples, 200u);
+  EXPECT_EQ(p.force_adjustments, 4);
+  EXPECT_GT(expected.truncated, 0u) << "the transient is discarded";
+  EXPECT_EQ(p.F_average, expected.mean);
+  EXPECT_EQ(p.F_average_standard_error, expected.standard_error);
+  EXPECT_NEAR(p.F_average, 70.0, 0.1);
+  EXPECT_NEAR(p.recent_re_min, 299.0, 0.05);
+  EXPECT_NEAR(p.recent_re_max, 301.0, 0.05);
+  EXPECT_NE(p.BriefReport().find("averaging since step 3000, 200 samples"), std::string::npos)
+      << p.BriefReport();
+  EXPECT_THROW(read_checkpoint_progress(path), Error);  // gone: kNotFound
 }
 
 TEST(Checkpoint, AnotherRunsDamagedOrForeignFileIsRefused) {

@@ -265,6 +265,24 @@ TEST(TimeAveraging, MserCutsTheStartUpAndKeepsAStationarySeries) {
   EXPECT_NEAR(avg.mean, 20.0, 4.0 * avg.standard_error + 0.01);
 }
 
+// The progress of an averaging run: the standard error falls as one over the square root of
+// the samples, so halving it takes three times the samples already taken; the averaging time
+// and blocking's smallest series are floors.
+TEST(TimeAveraging, StepsLeftFollowTheSquareRootLawAndTheFloors) {
+  // 100 samples of 10 steps at twice the tolerance: 300 more samples, 3000 steps.
+  EXPECT_DOUBLE_EQ(averaging_steps_left(0.0, 100.0, 0.01, 0.005, 10.0), 3000.0);
+  // Averaging time left dominates.
+  EXPECT_DOUBLE_EQ(averaging_steps_left(5000.0, 100.0, 0.01, 0.005, 10.0), 5000.0);
+  // Already below the tolerance: only the time left.
+  EXPECT_DOUBLE_EQ(averaging_steps_left(700.0, 100.0, 0.001, 0.005, 10.0), 700.0);
+  EXPECT_DOUBLE_EQ(averaging_steps_left(0.0, 100.0, 0.001, 0.005, 10.0), 0.0);
+  // Too few samples for blocking: at least 2 kMinBlocks in all.
+  EXPECT_DOUBLE_EQ(averaging_steps_left(0.0, 10.0, 0.001, 0.005, 10.0),
+                   (2.0 * kMinBlocks - 10.0) * 10.0);
+  // The error not known yet (a mean of zero): no estimate.
+  EXPECT_EQ(averaging_steps_left(0.0, 100.0, HUGE_VAL, 0.005, 10.0), HUGE_VAL);
+}
+
 TEST(TimeAveraging, UnsteadinessIsFluctuationWithoutTrend) {
   std::vector<double> oscillating(60), decaying(60), ringing(60);
   for (std::size_t k = 0; k < 60; ++k) {

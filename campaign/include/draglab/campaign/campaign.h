@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "draglab/drag_db/dataset.h"
+#include "draglab/lbm/lbm.h"
 
 namespace draglab {
 class Database;
@@ -113,6 +114,18 @@ struct SessionReport {
   std::string ToJson() const;  ///< The same as a JSON object.
 };
 
+/// A unit not yet finished whose checkpoint lies beside the database: where its run stood when
+/// the checkpoint was last written.
+struct UnitInProgress {
+  std::int64_t unit_id = 0;
+  double phi = 0.0, re_target = 0.0, resolution = 0.0;
+  int realization = 0;
+  std::string status;  ///< "running", or "pending" (a stopped campaign that will resume it).
+  double checkpoint_age_s = 0.0;  ///< Since the checkpoint was written.
+  lbm::CheckpointProgress progress;
+  std::string unreadable;  ///< Why the checkpoint could not be read ("" if it could).
+};
+
 struct CampaignStatus {
   std::int64_t id = 0;
   std::string name;
@@ -120,8 +133,9 @@ struct CampaignStatus {
   std::string created_at;
   std::int64_t units_total = 0, units_done = 0, units_failed = 0, units_pending = 0,
                units_running = 0;
-  double wall_s = 0.0;    ///< Sum of the finished units' run times.
-  SessionReport session;  ///< Filled by run_campaign for the run it made.
+  double wall_s = 0.0;                      ///< Sum of the finished units' run times.
+  std::vector<UnitInProgress> in_progress;  ///< Units with a checkpoint, in unit order.
+  SessionReport session;                    ///< Filled by run_campaign for the run it made.
   std::string BriefReport() const;
   std::string FullReport() const;
 };

@@ -97,9 +97,10 @@
 // viscosity-dependent wall of BGK (Lambda = (tau - 1/2)^2), regularized ((tau - 1/2)/2) or TRT
 // with another Lambda, and a growth with Re from the thinning boundary layer: sqrt(1 + Re/7) for
 // bounce-back (first order), 1 + Re/7 for the interpolated wall (second order; the 7 bounds the
-// measured d sweeps, dense packings at Re 100 included: src/error_model.cc). rr with TRT's wall adds what is left of its wall shift, 0.8/d lattice
-// units (the largest measured against TRT at the same d, rounded up). It is an a-priori scale for
-// one run; campaigns should still extrapolate in d.
+// measured d sweeps, dense packings at Re 100 included: src/error_model.cc). rr with TRT's wall
+// adds what is left of its wall shift, 0.8/d lattice units (the largest measured against TRT at the
+// same d, rounded up). It is an a-priori scale for one run; campaigns should still extrapolate in
+// d.
 #pragma once
 
 #include <array>
@@ -308,6 +309,31 @@ struct RunResult {
 /// Error(kInvalidArgument) naming it); whether it was written by the same run is checked when
 /// the run starts.
 void check_checkpoint_file(const std::string& path);
+
+/// Where a run stood when its checkpoint was last written, read from the file's header alone
+/// (not its populations): what the owner of an hours-long run reads while it goes on (`draglab
+/// campaign status`). "Recent" spans the last kRecentChecks checks of its history.
+struct CheckpointProgress {
+  static constexpr std::size_t kRecentChecks = 40;
+  std::string code;  ///< Version of the binary that wrote it.
+  std::int64_t step = 0;
+  std::size_t checks = 0;                           ///< Checks in its history.
+  double F = 0.0, re = 0.0, relative_change = 0.0;  ///< At the last check (nan before one).
+  double recent_F_min = 0.0, recent_F_max = 0.0, recent_re_min = 0.0, recent_re_max = 0.0;
+  int force_adjustments = 0;
+  bool averaging = false;            ///< Unsteady flow: the time average has begun ...
+  std::int64_t averaging_start = 0;  ///< ... at this step,
+  std::size_t averaged_samples = 0;  ///< with this many samples so far,
+  /// whose mean after the start-up (MSER) and blocking standard error stand here (nan with
+  /// fewer than two samples).
+  double F_average = 0.0, F_average_standard_error = 0.0;
+  std::string BriefReport() const;
+};
+
+/// The progress a checkpoint (RunOptions::checkpoint) records. Throws Error(kInvalidArgument)
+/// naming the file if it is not a draglab checkpoint or its header is damaged, kNotFound if it
+/// does not exist.
+CheckpointProgress read_checkpoint_progress(const std::string& path);
 
 /// A-priori number of time steps a run with the automatic relaxation time (RunOptions::tau == 0)
 /// needs to converge at tolerance ~1e-5, for planning (draglab campaign plan): the larger of
