@@ -201,6 +201,7 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                         {"memory_bytes", p.memory_bytes},
                         {"d_needed", p.d_needed},
                         {"resolution_verdict", p.resolution_verdict},
+                        {"unsteady", p.unsteady},
                         {"resolution_detail", p.resolution_detail}});
     }
     ctx.print_json({{"campaign", spec.name},

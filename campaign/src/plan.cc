@@ -91,6 +91,7 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
         const double nodes = std::pow(edge * d, 3);
         p.fluid_nodes = nodes * (1.0 - phi);
         p.steps = lbm::predicted_steps(phi, re, d, collision);
+        p.unsteady = lbm::expects_unsteady_flow(phi, re);
         p.unit_seconds = p.fluid_nodes * p.steps * plan.node_update_seconds;
         p.memory_bytes = lbm::estimated_run_bytes(nodes, precision);
         const lbm::ResolutionNeed need = lbm::resolution_needed(phi, re, collision);
@@ -153,21 +154,25 @@ std::string CampaignPlan::BriefReport() const {
 
 std::string CampaignPlan::FullReport() const {
   std::ostringstream out;
-  out << "phi     Re      d      units  collision  fluid nodes  steps     unit time   memory/unit  "
-         "d needed  resolution\n";
+  out << "phi     Re      d      units  collision  flow      fluid nodes  steps     unit time   "
+         "memory/unit  d needed  resolution\n";
   for (const PlannedPoint& p : points) {
-    char line[220];
+    char line[240];
     std::snprintf(line, sizeof line,
-                  "%-7.3g %-7.4g %-6.4g %-6d %-10s %-12.3g %-9.3g %-11s %-12s %-9.3g %s\n", p.phi,
-                  p.re, p.resolution, p.units, p.collision.c_str(), p.fluid_nodes, p.steps,
-                  duration(p.unit_seconds).c_str(),
+                  "%-7.3g %-7.4g %-6.4g %-6d %-10s %-9s %-12.3g %-9.3g %-11s %-12s %-9.3g %s\n",
+                  p.phi, p.re, p.resolution, p.units, p.collision.c_str(),
+                  p.re == 0.0 ? "Stokes" : (p.unsteady ? "unsteady" : "steady"), p.fluid_nodes,
+                  p.steps, duration(p.unit_seconds).c_str(),
                   format_fixed("%.2g GiB", p.memory_bytes / 1073741824.0).c_str(), p.d_needed,
                   p.resolution_verdict.c_str());
     out << line;
   }
   out << "d needed: the largest of the bounds from the pores' hydraulic diameter, the boundary "
          "layer and the cell Reynolds number the collision holds (lbm/resolution.h); collision "
-         "auto runs trt where kappa Re/d is within what trt holds, rr with TRT's wall beyond\n";
+         "auto runs trt where kappa Re/d is within what trt holds, rr with TRT's wall beyond; flow "
+         "unsteady: expected to be time-averaged over "
+      << format_fixed("%g", lbm::RunOptions().average_time)
+      << " d/U after its start-up (counted in steps)\n";
   out << "time per fluid-node update (one core, measured): "
       << format_fixed("%.3g", node_update_seconds * 1e9) << " ns\n";
   out << BriefReport() << "\n";

@@ -316,9 +316,10 @@ std::string CheckpointProgress::BriefReport() const {
       "last " + std::to_string(std::min(checks, kRecentChecks)) + " checks: ";
   s += ", F " + format_fixed("%.6g", F) + " (" + recent + format_fixed("%.6g", recent_F_min) +
        " - " + format_fixed("%.6g", recent_F_max) + "), Re " + format_fixed("%.5g", re) + " (" +
-       format_fixed("%.5g", recent_re_min) + " - " + format_fixed("%.5g", recent_re_max) +
-       "), change/T " + format_fixed("%.2g", relative_change) + ", " +
-       std::to_string(force_adjustments) + " force corrections";
+       format_fixed("%.5g", recent_re_min) + " - " + format_fixed("%.5g", recent_re_max) + ")";
+  // (no change per characteristic time yet after a correction of the force restarts its window)
+  if (std::isfinite(relative_change)) s += ", change/T " + format_fixed("%.2g", relative_change);
+  s += ", " + std::to_string(force_adjustments) + " force corrections";
   if (!averaging) return s + "; not averaging";
   s += "; averaging since step " + std::to_string(averaging_start) + ", " +
        std::to_string(averaged_samples) + " samples";

@@ -1446,9 +1446,14 @@ double predicted_steps(double phi, double re, double d, Collision collision) {
     return std::max(2.5 * characteristic, 0.9 * darcy);
   };
   if (re == 0.0) return steps_at(stokes_tau, 0.0);
-  // The Stokes run that measures kappa (TRT, tau 1.5, a loose tolerance), then the run itself.
+  // The Stokes run that measures kappa (TRT, tau 1.5, a loose tolerance), then the run itself:
+  // its approach to the target Re, and where the flow is expected to turn unsteady the time
+  // average over average_time d/U after it.
   const VelocityPlan plan = plan_velocity(phi, re, d, collision, kDefaultMachTarget, 0.0, false);
-  return kPoreSpeedRunShare * steps_at(1.5, 0.0) + steps_at(plan.tau, re);
+  const double averaging = expects_unsteady_flow(phi, re)
+                               ? RunOptions().average_time * d * d / (re * ((plan.tau - 0.5) / 3.0))
+                               : 0.0;
+  return kPoreSpeedRunShare * steps_at(1.5, 0.0) + steps_at(plan.tau, re) + averaging;
 }
 
 RunResult run(const arrays::VoxelGrid& grid, double phi_exact, const RunOptions& options,

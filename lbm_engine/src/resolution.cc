@@ -139,5 +139,9 @@ ResolutionNeed resolution_needed(double phi, double re, Collision collision, dou
   return need;
 }
 
+bool expects_unsteady_flow(double phi, double re) {
+  return re / (1.0 - phi) >= kUnsteadySphereRe && re * (2.0 / 3.0) / phi >= kUnsteadyPoreRe;
+}
+
 }  // namespace lbm
 }  // namespace draglab

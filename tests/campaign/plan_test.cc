@@ -16,6 +16,7 @@
 #include "draglab/campaign/campaign.h"
 #include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/lbm/resolution.h"
 
 namespace draglab {
 namespace campaign {
@@ -73,6 +74,26 @@ TEST(CampaignPlan, StepModelFollowsItsFormula) {
   // More steps at higher resolution and, at fixed d, at higher Re in dilute arrays (smaller nu).
   EXPECT_GT(lbm::predicted_steps(0.1, 25.0, 20.0), lbm::predicted_steps(0.1, 25.0, 10.0));
   EXPECT_GT(lbm::predicted_steps(0.1, 25.0, 10.0), lbm::predicted_steps(0.1, 5.0, 10.0));
+}
+
+// The planning rule for unsteady flow at the measured runs it was set between
+// (docs/campaigns.md), and the average it adds: average_time d/U in steps, d^2 / (Re nu).
+TEST(CampaignPlan, UnsteadyPointsAddTheirTimeAverage) {
+  EXPECT_TRUE(lbm::expects_unsteady_flow(0.3, 100.0));  // random phi 0.3, Re 100: unsteady
+  EXPECT_TRUE(lbm::expects_unsteady_flow(0.5, 300.0));  // dense sweeps at Re 300
+  EXPECT_TRUE(lbm::expects_unsteady_flow(0.6, 300.0));
+  EXPECT_FALSE(lbm::expects_unsteady_flow(0.5, 100.0));  // dense sweeps at Re 100: steady
+  EXPECT_FALSE(lbm::expects_unsteady_flow(0.6, 100.0));
+  for (double phi = 0.05; phi < 0.61; phi += 0.05) {
+    EXPECT_FALSE(lbm::expects_unsteady_flow(phi, 30.0)) << phi;  // every run at Re <= 30
+  }
+  // The average alone: at phi 0.5, Re 300, d 48 the steady part is far smaller.
+  const lbm::VelocityPlan v = lbm::plan_velocity(0.5, 300.0, 48.0, lbm::Collision::kAuto,
+                                                 lbm::kDefaultMachTarget, 0.0, false);
+  const double average = lbm::RunOptions().average_time * 48.0 * 48.0 / (300.0 * v.nu);
+  const double steps = lbm::predicted_steps(0.5, 300.0, 48.0);
+  EXPECT_GT(steps, average);
+  EXPECT_LT(steps, 1.5 * average);
 }
 
 TEST(CampaignPlan, BadInputIsRefused) {

@@ -194,13 +194,17 @@ struct PlannedPoint {
   std::string resolution_verdict;
   std::string resolution_detail;  ///< lbm::ResolutionNeed::Summary().
   std::string collision;          ///< The operator the units run ("auto" resolved per point).
+  /// The flow is expected to turn unsteady (lbm::expects_unsteady_flow): `steps` then include
+  /// the time average.
+  bool unsteady = false;
 };
 
 /// What `draglab campaign plan` predicts before any work: units, memory and run time, from the
 /// engine's step model (lbm::predicted_steps) and this machine's measured time per fluid-node
 /// update (a short timed run, or the given value). Limits: the step model is within a factor
-/// ~2.6 per unit (median 1.2) where it was calibrated (phi <= 0.4, Re <= 25, d = 10); beyond that
-/// it is an extrapolation, and units that fail (Mach limit, tau near 1/2) are not predicted.
+/// ~2.6 per unit (median 1.2) where it was calibrated (phi <= 0.4, Re <= 25, d = 10) and within 3
+/// on the dense sweeps at Re 100 and 300 (docs/campaigns.md); elsewhere it is an extrapolation,
+/// and units that fail (Mach limit, tau near 1/2) are not predicted.
 struct CampaignPlan {
   std::vector<PlannedPoint> points;
   std::int64_t units = 0;

@@ -339,9 +339,10 @@ CheckpointProgress read_checkpoint_progress(const std::string& path);
 /// needs to converge at tolerance ~1e-5, for planning (draglab campaign plan): the larger of
 /// 2.5 characteristic times d^2/(nu (1 + Re)) and 0.9 times d^2/(nu phi F), the viscous time of
 /// the Darcy relaxation of the mean flow (permeability ~ d^2/(18 phi F)), with F the BVK 2007
-/// estimate. Calibrated on the measured step counts of 60 units (phi 0.1 - 0.4, Re 0 - 25,
-/// d = 10): every unit within a factor 2.6, median 1.2 (docs/campaigns.md). phi in (0, 1),
-/// re >= 0, d > 0.
+/// estimate, plus average_time d/U where the flow is expected to turn unsteady
+/// (expects_unsteady_flow, resolution.h). Calibrated on the measured step counts of 60 units
+/// (phi 0.1 - 0.4, Re 0 - 25, d = 10): every unit within a factor 2.6, median 1.2; checked on the
+/// dense sweeps at Re 100 and 300, d 32 - 64 (docs/campaigns.md). phi in (0, 1), re >= 0, d > 0.
 double predicted_steps(double phi, double re, double d, Collision collision = Collision::kAuto);
 
 /// The resolutions a run accepts, lattice units per sphere diameter: below 4 a sphere is a few

@@ -105,5 +105,16 @@ struct ResolutionNeed {
 /// TRT's ends).
 ResolutionNeed resolution_needed(double phi, double re, Collision collision, double kappa = 0.0);
 
+/// Whether a run at (phi, Re) is expected to end in unsteady flow, time-averaged over
+/// RunOptions::average_time d/U after its start-up: where both the sphere-scale Reynolds number
+/// Re_p = Re/(1 - phi) reaches kUnsteadySphereRe and the pores' Re_h = Re (2/3)/phi reaches
+/// kUnsteadyPoreRe. A planning rule, not a stability criterion: it sets the predicted cost
+/// (predicted_steps), while each run judges its own flow. The thresholds lie between the
+/// measured steady and unsteady runs of random packings (docs/campaigns.md): unsteady at
+/// phi 0.3 / Re 100 (Re_p 143, Re_h 222) and phi 0.5 - 0.6 / Re 300 (Re_h 333 - 400), steady at
+/// phi 0.5 - 0.6 / Re 100 (Re_h 111 - 133) and everywhere at Re <= 30.
+constexpr double kUnsteadySphereRe = 100.0, kUnsteadyPoreRe = 150.0;
+bool expects_unsteady_flow(double phi, double re);
+
 }  // namespace lbm
 }  // namespace draglab
