@@ -12,13 +12,22 @@ group with at least two finished resolutions:
     is monotone, else the finest run, its spread then the last refinement's move) beside its
     recorded error_estimate, and whether it is within.
 
-Usage: scripts/dense_d_sweep.py CSV... [--out FILE]   (writes a CSV table; prints a summary)
+With --plot FILE.png, a figure: per (phi, Re) the drag against 1/d^2 (an order-2 wall is a
+straight line there) with each run's error estimate as its bar (clipped at 25 %, the bar of an
+under-resolved run runs off the panel), the reference at 1/d^2 = 0, the diverged runs marked at
+the panel's foot, and, with --draglab BIN, the published laws of the comparison
+(`draglab law eval`) as horizontal lines.
+
+Usage: scripts/dense_d_sweep.py CSV... [--out FILE] [--plot FILE.png [--draglab BIN]]
 """
 import argparse
 import csv
 import io
 import math
+import subprocess
 import sys
+
+LAWS = ("bvk2007", "tang2015", "tenneti2011")
 
 
 def read_units(path):
@@ -116,10 +125,68 @@ def reduce(units):
     return table
 
 
+def law_value(draglab, law, phi, re):
+    """F of a stored law at (phi, Re), or None where it does not apply."""
+    run = subprocess.run([draglab, "--json", "law", "eval", law, "--phi", repr(phi), "--re",
+                          repr(re)], capture_output=True, text=True, check=False)
+    if run.returncode != 0:
+        return None
+    import json
+    return json.JSONDecoder().raw_decode(run.stdout.lstrip())[0].get("F")
+
+
+def plot(table, path, draglab):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    keys = sorted({(r["phi"], r["re"]) for r in table}, key=lambda k: (k[1], k[0]))
+    fig, axes = plt.subplots(1, len(keys), figsize=(3.6 * len(keys), 3.6), squeeze=False)
+    for ax, (phi, re) in zip(axes[0], keys):
+        rows = [r for r in table if r["phi"] == phi and r["re"] == re]
+        done = [r for r in rows if r["status"] == "done"]
+        x = [1.0 / r["d"] ** 2 for r in done]
+        y = [r["F"] for r in done]
+        err = [min(r["error_estimate"], 0.25) * r["F"] for r in done]
+        ax.errorbar(x, y, yerr=err, fmt="o", color="C0", capsize=3, label="LBM, estimate as bar")
+        for r in done:
+            ax.annotate("d %g" % r["d"], (1.0 / r["d"] ** 2, r["F"]), textcoords="offset points",
+                        xytext=(5, -10), fontsize=7)
+        ref = rows[0]["reference"]
+        if not math.isnan(rows[0]["richardson_order2"]):
+            ax.plot([0.0], [ref], "*", color="C3", markersize=10, label="order-2 Richardson")
+        elif not math.isnan(ref):
+            ax.plot([0.0], [ref], "_", color="C3", markersize=12, label="finest run (reference)")
+        lo = min(y) if y else 0.0
+        hi = max(y) if y else 1.0
+        if draglab:
+            for i, law in enumerate(LAWS):
+                v = law_value(draglab, law, phi, re)
+                if v is not None:
+                    ax.axhline(v, color="C%d" % (i + 4), ls="--", lw=1, label=law)
+                    lo, hi = min(lo, v), max(hi, v)
+        for r in rows:
+            if r["status"] != "done":
+                ax.plot([1.0 / r["d"] ** 2], [lo - 0.04 * (hi - lo)], "x", color="k")
+                ax.annotate("d %g diverged" % r["d"], (1.0 / r["d"] ** 2, lo - 0.04 * (hi - lo)),
+                            textcoords="offset points", xytext=(-20, 6), fontsize=7)
+        pad = 0.12 * (hi - lo) + 0.02 * hi
+        ax.set_ylim(lo - pad, hi + pad)
+        ax.set_xlim(left=-0.00005)
+        ax.set_title("phi %g, Re %g" % (phi, re), fontsize=10)
+        ax.set_xlabel("1/d^2")
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("F (drag-only, canonical)")
+    axes[0][0].legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("csv", nargs="+")
     ap.add_argument("--out")
+    ap.add_argument("--plot")
+    ap.add_argument("--draglab", help="draglab binary for the laws' values in the plot")
     args = ap.parse_args()
     units = []
     for path in args.csv:
@@ -138,6 +205,8 @@ def main():
         w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in row.items()})
     if args.out:
         out.close()
+    if args.plot:
+        plot(table, args.plot, args.draglab)
     checked = [r for r in table if r["within"] != ""]
     beyond = [r for r in checked if r["within"] == 0]
     print("%d runs checked against their reference, %d beyond their estimate" %
