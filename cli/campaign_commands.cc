@@ -9,12 +9,15 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
 #include "cli/progress.h"
+#include "cli/stop_signal.h"
 #include "drag_db_version.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/core/files.h"
@@ -278,8 +281,20 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
                          mpi::size(), mpi::host_name(), mpi::size() - 1));
   }
   const auto start = std::chrono::steady_clock::now();
+  // One process keeps each unit's checkpoint: a SIGTERM or SIGINT then stops the units at their
+  // next check with their checkpoints saved (an MPI campaign keeps none: the default stands).
+  std::optional<StopOnSignal> stop_on_signal;
+  if (!distributed) stop_on_signal.emplace();
   const campaign::CampaignStatus st = campaign::run_campaign(db_path, spec, options);
   printer->finish();
+  if (lbm::stop_requested()) {
+    // Not a failure of the campaign, but not its end either: exit 1, the queue as it stands.
+    throw std::runtime_error(fmt::format(
+        "stopped on request (SIGTERM or SIGINT): {} of {} units done, {} back in the queue, each "
+        "unit that had started with its checkpoint; go on with: draglab campaign run {} --resume",
+        st.units_done + st.units_failed, st.units_total, st.units_pending + st.units_running,
+        c.spec));
+  }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

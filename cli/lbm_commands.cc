@@ -10,12 +10,14 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <fmt/core.h>
 
 #include "cli/cli_context.h"
 #include "cli/progress.h"
+#include "cli/stop_signal.h"
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/packing_io.h"
 #include "draglab/arrays/voxelization.h"
@@ -315,6 +317,10 @@ void run_lbm(const CliContext& ctx, const RunCommand& c) {
   co.fields = c.fields;
   co.description = the_case.description;
   ProgressLine progress(!ctx.quiet && root);
+  // With a checkpoint, SIGTERM and SIGINT stop the run at its next check with the checkpoint
+  // saved (the same command goes on from it); without one they end it at once, as before.
+  std::optional<StopOnSignal> stop_on_signal;
+  if (!co.run.checkpoint.empty()) stop_on_signal.emplace();
   lbm::CaseResult result;
   try {
     result = lbm::run_case(the_case.packing, co, [&progress](double f, const std::string& stage) {

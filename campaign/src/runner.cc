@@ -645,7 +645,7 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
       Database wdb(db_path, worker_db_options());
       const std::string token = host + ":" + std::to_string(::getpid()) + ":" + std::to_string(w);
       ClaimedUnit unit;
-      while (!stop.load() && claim_next(wdb, id, token, &unit)) {
+      while (!stop.load() && !lbm::stop_requested() && claim_next(wdb, id, token, &unit)) {
         const std::string checkpoint = unit_checkpoint_path(db_path, id, unit.id);
         {
           std::lock_guard<std::mutex> g(mutex);
@@ -659,6 +659,15 @@ CampaignStatus run_campaign(const std::string& db_path, const CampaignSpec& spec
         const UnitOutcome o =
             execute_unit(spec, unit, threads, &fraction, mpi::Communicator::self(), checkpoint,
                          options.checkpoint_interval);
+        if (o.run.stopped_on_request) {
+          // A stop was asked (lbm::request_stop: SIGTERM, SIGINT): not a result. The unit goes
+          // back to the queue, its checkpoint kept for the run that resumes it.
+          release_unit(wdb, unit.id, token);
+          std::lock_guard<std::mutex> g(mutex);
+          in_flight_cost[w] = 0.0;
+          busy_s[w] += o.wall_s;
+          break;
+        }
         const bool ours = commit_unit(wdb, unit, token, o);
         std::lock_guard<std::mutex> g(mutex);
         cost_done += in_flight_cost[w];

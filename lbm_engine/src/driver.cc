@@ -39,6 +39,7 @@
 //    stops (a stop by max_steps saves the state before its off-schedule check), so a resumed run
 //    makes the uninterrupted run's decisions and reaches its bits.
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -1145,6 +1146,19 @@ class RunChecks {
   std::string failure_;
 };
 
+/// Set by request_stop(), possibly from a signal handler.
+std::atomic<bool> g_stop_requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "request_stop must be async-signal-safe");
+
+/// Why a run that request_stop() ended has no result, and how it goes on.
+std::string stopped_diagnosis(const RunOptions& options, const LoopState& loop,
+                              bool no_checkpoint) {
+  return "stopped on request at step " + std::to_string(loop.step) +
+         (no_checkpoint ? std::string(" (no checkpoint: the run starts afresh when run again)")
+                        : "; the checkpoint '" + options.checkpoint + "' holds it: the same run " +
+                              "goes on from there");
+}
+
 /// Why a run that reached max_steps has no result: how far it got, and how to go on.
 std::string not_converged_diagnosis(const RunOptions& options, const RunResult& result,
                                     const LoopState& loop, bool no_checkpoint) {
@@ -1285,6 +1299,15 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
 
   while (true) {
     checkpoint->SaveIfDue();
+    bool stopping = g_stop_requested.load();
+    if (group.size() > 1) stopping = group.sum(std::int64_t{stopping ? 1 : 0}) > 0;
+    if (stopping) {
+      checkpoint->KeepForMoreSteps();
+      result.steps = step;
+      result.mflups = stepping_s > 0.0 ? static_cast<double>(fluid) * step / stepping_s / 1e6 : 0.0;
+      result.stopped_on_request = true;
+      return stop(stopped_diagnosis(options, loop, !checkpoint->enabled()));
+    }
     if (step >= options.max_steps) {
       checkpoint->KeepForMoreSteps();
       result.steps = step;
@@ -1435,6 +1458,10 @@ RunResult run_planned(const arrays::VoxelGrid& grid, double phi_exact, const Run
 }
 
 }  // namespace
+
+void request_stop() { g_stop_requested.store(true); }
+bool stop_requested() { return g_stop_requested.load(); }
+void clear_stop_request() { g_stop_requested.store(false); }
 
 double predicted_steps(double phi, double re, double d, Collision collision) {
   collision = choose_collision(phi, re, d, collision).collision;

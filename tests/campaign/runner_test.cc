@@ -292,6 +292,76 @@ TEST(CampaignProgress, EtaAfterAResumeExtrapolatesOnlyThisSessionsWork) {
   EXPECT_NE(none.find("eta ?"), std::string::npos) << none;
 }
 
+const char* kStopSpec = R"(# 1 unit at Re 10 of about 4 s (tests/campaign/runner_test.cc)
+[campaign]
+name = "stoppable"
+[grid]
+phi = [0.3]
+re = [10]
+realizations = 1
+seed = 5
+[packing]
+spheres = 8
+[lbm]
+resolutions = [16]
+[dataset]
+extrapolation = "finest"
+)";
+
+// SIGTERM (a batch system's stop, the end of a session) stops `campaign run` at the unit's next
+// check with its checkpoint saved (no periodic save here): exit 1 naming the resume command, the
+// unit back in the queue (not failed), and the resumed campaign gives the bits of one that never
+// stopped. tests/lbm/checkpoint_test.cc checks the engine's side (the save at the stop).
+TEST(CampaignRunner, SigtermPutsTheUnitBackInTheQueueAndResumeGivesItsBits) {
+  TempDir dir;
+  const std::string db = dir.file("stop.db"), spec = dir.file("stoppable.toml");
+  write_file(spec, kStopSpec);
+  const std::vector<std::string> run_args = {
+      "campaign", "run", spec, "--jobs", "1", "--threads-per-unit", "1", "--checkpoint-interval",
+      "1000000"};
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, 1);
+    dup2(null, 2);
+    std::vector<const char*> argv = {DRAGLAB_CLI, "--db", db.c_str()};
+    for (const std::string& a : run_args) argv.push_back(a.c_str());
+    argv.push_back(nullptr);
+    execv(DRAGLAB_CLI, const_cast<char* const*>(argv.data()));
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (count_status(db, "running") < 1 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // into the unit's stepping
+  ASSERT_EQ(kill(child, SIGTERM), 0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "SIGTERM ended the process instead of stopping the run";
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_EQ(count_status(db, "pending"), 1);
+  EXPECT_EQ(count_status(db, "failed"), 0);
+
+  std::string out, err;
+  std::vector<std::string> resume = {"--db", db};
+  resume.insert(resume.end(), run_args.begin(), run_args.end());
+  resume.push_back("--resume");
+  ASSERT_EQ(run_cli(resume, dir.path(), &out, &err), 0) << err;
+  const std::string reference_db = dir.file("reference.db");
+  std::vector<std::string> reference = {"--db", reference_db};
+  reference.insert(reference.end(), run_args.begin(), run_args.end());
+  ASSERT_EQ(run_cli(reference, dir.path(), &out, &err), 0) << err;
+  RawDb resumed_raw(db), reference_raw(reference_db);
+  const auto resumed = nlohmann::json::parse(
+      resumed_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
+  const auto fresh = nlohmann::json::parse(
+      reference_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
+  EXPECT_EQ(resumed["F"].get<double>(), fresh["F"].get<double>());  // the same bits
+  EXPECT_EQ(resumed["steps"], fresh["steps"]);
+}
+
 TEST(CampaignRunner, DivergingUnitIsRecordedFailedAndTheOthersComplete) {
   TempDir dir;
   const std::string db_path = dir.file("fail.db");

@@ -127,6 +127,42 @@ TEST(Checkpoint, ResumedStokesRunIsBitIdentical) {
   expect_resumed_run_is_bit_identical(0.2, 10.0, 0.0, Collision::kTrt, "stokes");
 }
 
+// request_stop (what SIGTERM and SIGINT call in `campaign run` and `lbm run --checkpoint`) ends a
+// run at its next check with its checkpoint saved there, between the periodic saves; the same
+// run then goes on to the bits of one that never stopped. The stop is asked from inside the run
+// (its progress callback, once the main run steps), as a signal handler would.
+TEST(Checkpoint, RunStoppedOnRequestSavesItsStateAndGoesOnToTheSameBits) {
+  const ScArray sc = make_sc_array(0.3, 16.0);
+  const RunOptions plain = options_for(20.0, Collision::kTrt);
+  const RunResult reference = run(sc.grid, sc.packing.phi(), plain);
+  ASSERT_TRUE(reference.converged) << format_run(reference);
+
+  RunOptions o = plain;
+  o.checkpoint = temporary_path("stop");
+  o.checkpoint_interval = 1e6;  // no periodic save: only the stop writes the file
+  std::remove(o.checkpoint.c_str());
+  const ProgressCallback stop_once_stepping = [](double, const std::string& status) {
+    if (status.rfind("step ", 0) == 0) request_stop();
+  };
+  const RunResult stopped = lbm::run(sc.grid, sc.packing.phi(), o, stop_once_stepping);
+  clear_stop_request();
+  ASSERT_TRUE(stopped.stopped_on_request) << format_run(stopped);
+  EXPECT_FALSE(stopped.converged);
+  EXPECT_NE(stopped.diagnosis.find("stopped on request at step"), std::string::npos)
+      << stopped.diagnosis;
+  ASSERT_GT(stopped.steps, 0);
+  ASSERT_LT(stopped.steps, reference.steps) << "the run ended before the stop was asked";
+  ASSERT_TRUE(exists(o.checkpoint));
+  EXPECT_EQ(read_checkpoint_progress(o.checkpoint).step, stopped.steps);
+
+  const RunResult resumed = run(sc.grid, sc.packing.phi(), o);
+  ASSERT_TRUE(resumed.converged) << format_run(resumed);
+  EXPECT_EQ(resumed.resumed_from_step, stopped.steps);
+  EXPECT_EQ(resumed.F, reference.F);  // the same bits
+  EXPECT_EQ(resumed.steps, reference.steps);
+  EXPECT_FALSE(exists(o.checkpoint));
+}
+
 // An averaging run's progress: the time mean so far is the engine's own (MSER start-up, blocking
 // standard error) of the samples the checkpoint carries. A synthetic state: a start-up transient
 // then a stationary, correlated signal.

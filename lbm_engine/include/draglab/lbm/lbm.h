@@ -296,6 +296,8 @@ struct RunResult {
   std::size_t memory_bytes = 0;           ///< Populations plus lattice tables.
   std::int64_t resumed_from_step = 0;     ///< The checkpoint's step it went on from (0: none).
   int checkpoints_written = 0;
+  /// request_stop() ended the run at a check (its checkpoint, if it keeps one, holds the step).
+  bool stopped_on_request = false;
   std::string BriefReport() const;
   std::string FullReport() const;
   /// Every scalar of the run as a JSON object (text) with the options that shaped it
@@ -309,6 +311,16 @@ struct RunResult {
 /// Error(kInvalidArgument) naming it); whether it was written by the same run is checked when
 /// the run starts.
 void check_checkpoint_file(const std::string& path);
+
+/// Asks every run of this process to end at its next check: a run that keeps a checkpoint saves
+/// it there (the same run goes on from it), and each returns unconverged with
+/// RunResult::stopped_on_request. Async-signal-safe: what a SIGTERM handler calls, so that a
+/// batch system's stop (or the end of a working session) loses no stepping. The ranks of a
+/// decomposed run stop together.
+void request_stop();
+bool stop_requested();
+/// The request stays until cleared: a program that goes on running after a stop clears it.
+void clear_stop_request();
 
 /// Where a run stood when its checkpoint was last written, read from the file's header alone
 /// (not its populations): what the owner of an hours-long run reads while it goes on (`draglab
