@@ -208,6 +208,43 @@ resolutions = [12]
 extrapolation = "finest"
 )";
 
+/// Starts `draglab --db DB ARGS...` as a child process (its output discarded); -1 if fork fails.
+pid_t spawn_draglab(const std::string& db, const std::vector<std::string>& args) {
+  const pid_t child = fork();
+  if (child == 0) {
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, 1);
+    dup2(null, 2);
+    std::vector<const char*> argv = {DRAGLAB_CLI, "--db", db.c_str()};
+    for (const std::string& a : args) argv.push_back(a.c_str());
+    argv.push_back(nullptr);
+    execv(DRAGLAB_CLI, const_cast<char* const*>(argv.data()));
+    _exit(127);
+  }
+  return child;
+}
+
+/// Resumes the one-unit campaign `run_args` in `db`, runs it afresh in another database, and
+/// gives both units' records.
+void resume_and_run_afresh(const TempDir& dir, const std::string& db,
+                           const std::vector<std::string>& run_args, nlohmann::json* resumed,
+                           nlohmann::json* fresh) {
+  std::string out, err;
+  std::vector<std::string> resume = {"--db", db};
+  resume.insert(resume.end(), run_args.begin(), run_args.end());
+  resume.push_back("--resume");
+  ASSERT_EQ(run_cli(resume, dir.path(), &out, &err), 0) << err;
+  const std::string reference_db = dir.file("reference.db");
+  std::vector<std::string> reference = {"--db", reference_db};
+  reference.insert(reference.end(), run_args.begin(), run_args.end());
+  ASSERT_EQ(run_cli(reference, dir.path(), &out, &err), 0) << err;
+  RawDb resumed_raw(db), reference_raw(reference_db);
+  *resumed = nlohmann::json::parse(
+      resumed_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
+  *fresh = nlohmann::json::parse(
+      reference_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
+}
+
 TEST(CampaignRunner, UnitKilledMidRunGoesOnFromItsCheckpoint) {
   TempDir dir;
   const std::string db = dir.file("ck.db"), spec = dir.file("resumable.toml");
@@ -215,18 +252,8 @@ TEST(CampaignRunner, UnitKilledMidRunGoesOnFromItsCheckpoint) {
   const std::vector<std::string> run_args = {
       "campaign", "run", spec, "--jobs", "1", "--threads-per-unit", "1", "--checkpoint-interval",
       "0"};
-  const pid_t child = fork();
+  const pid_t child = spawn_draglab(db, run_args);
   ASSERT_GE(child, 0);
-  if (child == 0) {
-    const int null = open("/dev/null", O_WRONLY);
-    dup2(null, 1);
-    dup2(null, 2);
-    std::vector<const char*> argv = {DRAGLAB_CLI, "--db", db.c_str()};
-    for (const std::string& a : run_args) argv.push_back(a.c_str());
-    argv.push_back(nullptr);
-    execv(DRAGLAB_CLI, const_cast<char* const*>(argv.data()));
-    _exit(127);
-  }
   const std::string checkpoint = db + ".campaign-1-unit-1.checkpoint";
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (!campaign_test::exists(checkpoint) && std::chrono::steady_clock::now() < deadline) {
@@ -256,23 +283,9 @@ TEST(CampaignRunner, UnitKilledMidRunGoesOnFromItsCheckpoint) {
   EXPECT_NE(status_out.find("step " + std::to_string(step_at_kill)), std::string::npos)
       << status_out;
 
-  std::string out, err;
-  std::vector<std::string> resume = {"--db", db};
-  resume.insert(resume.end(), run_args.begin(), run_args.end());
-  resume.push_back("--resume");
-  ASSERT_EQ(run_cli(resume, dir.path(), &out, &err), 0) << err;
+  nlohmann::json resumed, fresh;
+  resume_and_run_afresh(dir, db, run_args, &resumed, &fresh);
   EXPECT_FALSE(campaign_test::exists(checkpoint)) << "a finished unit removes its checkpoint";
-
-  const std::string reference_db = dir.file("reference.db");
-  std::vector<std::string> reference = {"--db", reference_db};
-  reference.insert(reference.end(), run_args.begin(), run_args.end());
-  ASSERT_EQ(run_cli(reference, dir.path(), &out, &err), 0) << err;
-
-  RawDb resumed_raw(db), reference_raw(reference_db);
-  const auto resumed = nlohmann::json::parse(
-      resumed_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
-  const auto fresh = nlohmann::json::parse(
-      reference_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
   EXPECT_EQ(resumed["resumed_from_step"].get<long long>(), step_at_kill) << resumed.dump();
   EXPECT_EQ(fresh["resumed_from_step"].get<long long>(), 0);
   EXPECT_EQ(resumed["F"].get<double>(), fresh["F"].get<double>());  // the same bits
@@ -319,18 +332,8 @@ TEST(CampaignRunner, SigtermPutsTheUnitBackInTheQueueAndResumeGivesItsBits) {
   const std::vector<std::string> run_args = {
       "campaign", "run", spec, "--jobs", "1", "--threads-per-unit", "1", "--checkpoint-interval",
       "1000000"};
-  const pid_t child = fork();
+  const pid_t child = spawn_draglab(db, run_args);
   ASSERT_GE(child, 0);
-  if (child == 0) {
-    const int null = open("/dev/null", O_WRONLY);
-    dup2(null, 1);
-    dup2(null, 2);
-    std::vector<const char*> argv = {DRAGLAB_CLI, "--db", db.c_str()};
-    for (const std::string& a : run_args) argv.push_back(a.c_str());
-    argv.push_back(nullptr);
-    execv(DRAGLAB_CLI, const_cast<char* const*>(argv.data()));
-    _exit(127);
-  }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (count_status(db, "running") < 1 && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -344,20 +347,8 @@ TEST(CampaignRunner, SigtermPutsTheUnitBackInTheQueueAndResumeGivesItsBits) {
   EXPECT_EQ(count_status(db, "pending"), 1);
   EXPECT_EQ(count_status(db, "failed"), 0);
 
-  std::string out, err;
-  std::vector<std::string> resume = {"--db", db};
-  resume.insert(resume.end(), run_args.begin(), run_args.end());
-  resume.push_back("--resume");
-  ASSERT_EQ(run_cli(resume, dir.path(), &out, &err), 0) << err;
-  const std::string reference_db = dir.file("reference.db");
-  std::vector<std::string> reference = {"--db", reference_db};
-  reference.insert(reference.end(), run_args.begin(), run_args.end());
-  ASSERT_EQ(run_cli(reference, dir.path(), &out, &err), 0) << err;
-  RawDb resumed_raw(db), reference_raw(reference_db);
-  const auto resumed = nlohmann::json::parse(
-      resumed_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
-  const auto fresh = nlohmann::json::parse(
-      reference_raw.rows("SELECT result_json FROM campaign_units WHERE status = 'done'").at(0));
+  nlohmann::json resumed, fresh;
+  resume_and_run_afresh(dir, db, run_args, &resumed, &fresh);
   EXPECT_EQ(resumed["F"].get<double>(), fresh["F"].get<double>());  // the same bits
   EXPECT_EQ(resumed["steps"], fresh["steps"]);
 }
