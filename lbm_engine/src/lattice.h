@@ -15,7 +15,8 @@
 // Blocks. The x-rows are grouped into slabs of kSlabPlanes z-planes; a slab's stored nodes,
 // segments and links are contiguous and every neighbour of a slab lies in the slab or the two
 // adjacent ones. OpenMP threads get contiguous, fluid-node-balanced ranges of x-rows (static
-// schedule), and the same ranges first-touch the memory.
+// schedule), and the same ranges first-touch the memory. Within its range a thread sweeps the
+// rows in tiles of a few y-rows (solver.cc, SweepPlan).
 //
 // Decomposition across ranks (PlaneRange): a rank owns the z-planes [begin, end) and stores two
 // halo planes besides, begin - 1 and end (periodic). Its lattice is built exactly as above with

@@ -290,6 +290,68 @@ constexpr double kWallCorrectionGain = 5.0;
 /// Links ahead that the link pass prefetches.
 constexpr std::int64_t kLinkPrefetch = 16;
 
+/// y-rows of a sweep tile (see SweepPlan).
+constexpr std::int64_t kTileRows = 8;
+
+/// The order in which one work range sweeps its x-rows and, after each row, the rows whose link
+/// pass may then run. A link of row (j, p) reads and writes nodes of the rows (j + c_y, p + c_z)
+/// only (|c_y|, |c_z| <= 1, periodic), so its pass may run once those are swept; run then, it finds
+/// them cached. Rows are swept in tiles of kTileRows y-rows, plane by plane through the range
+/// (tile by tile), so that a row's neighbours are swept a few rows after it, and not a plane or
+/// two (the x-row order) after it, while the sweeps still walk a few whole rows of storage at a
+/// time. Rows whose neighbours another range sweeps run after the step's barrier.
+struct SweepPlan {
+  std::vector<std::int64_t> order;        ///< Rows in sweep order.
+  std::vector<std::int64_t> ready_begin;  ///< Link rows after order[s]: ready[ready_begin[s] ..).
+  std::vector<std::int64_t> ready;
+  std::vector<std::int64_t> after_barrier;
+};
+
+/// The last position in a range's sweep order (`position`: by row - r0) of the rows that the
+/// links of row r touch, or -1 if another range sweeps one of them.
+std::int64_t ready_position(std::int64_t r, std::int64_t ny, std::int64_t planes, std::int64_t r0,
+                            std::int64_t r1, const std::vector<std::int64_t>& position) {
+  const std::int64_t j = r % ny, p = r / ny;
+  std::int64_t last = -1;
+  for (std::int64_t cz = -1; cz <= 1; ++cz) {
+    for (std::int64_t cy = -1; cy <= 1; ++cy) {
+      const std::int64_t n = (j + cy + ny) % ny + ny * ((p + cz + planes) % planes);
+      if (n < r0 || n >= r1) return -1;
+      last = std::max(last, position[static_cast<std::size_t>(n - r0)]);
+    }
+  }
+  return last;
+}
+
+SweepPlan plan_sweep(const SparseLattice& lattice, const LinkTable& links, int range) {
+  const std::int64_t ny = lattice.dims()[1];
+  const std::int64_t planes = lattice.num_rows() / ny;
+  const std::int64_t r0 = lattice.range_row_begin(range);
+  const std::int64_t r1 = lattice.range_row_begin(range + 1);
+  SweepPlan plan;
+  for (std::int64_t r = r0; r < r1; ++r) plan.order.push_back(r);
+  std::stable_sort(plan.order.begin(), plan.order.end(), [ny](std::int64_t a, std::int64_t b) {
+    return (a % ny) / kTileRows < (b % ny) / kTileRows;
+  });
+  std::vector<std::int64_t> position(static_cast<std::size_t>(r1 - r0));
+  for (std::size_t s = 0; s < plan.order.size(); ++s) {
+    position[static_cast<std::size_t>(plan.order[s] - r0)] = static_cast<std::int64_t>(s);
+  }
+  std::vector<std::vector<std::int64_t>> after(plan.order.size());
+  for (std::int64_t r = r0; r < r1; ++r) {
+    const std::size_t row = static_cast<std::size_t>(r);
+    if (links.row_begin[row] == links.row_begin[row + 1]) continue;
+    const std::int64_t last = ready_position(r, ny, planes, r0, r1, position);
+    (last < 0 ? plan.after_barrier : after[static_cast<std::size_t>(last)]).push_back(r);
+  }
+  plan.ready_begin.push_back(0);
+  for (const auto& rows : after) {
+    plan.ready.insert(plan.ready.end(), rows.begin(), rows.end());
+    plan.ready_begin.push_back(static_cast<std::int64_t>(plan.ready.size()));
+  }
+  return plan;
+}
+
 template <typename T>
 class Solver final : public SolverBase {
  public:
@@ -321,6 +383,9 @@ class Solver final : public SolverBase {
     receive_down_.resize(send_down_.size());
     receive_up_.resize(send_up_.size());
     set_force(settings.force_x);
+    if (!lattice.decomposed()) {
+      for (int t = 0; t < ranges; ++t) sweep_plans_.push_back(plan_sweep(lattice, links, t));
+    }
     if (settings.interpolated && settings.wall_correction > 0.0) {
       wall_state_.assign(links.size(), 0.0);
       wall_rate_ = std::min(kWallCorrectionRate, kWallCorrectionGain / settings.wall_correction);
@@ -520,8 +585,9 @@ class Solver final : public SolverBase {
  private:
   /// One time step in one parallel region: the collision sweep of the given parity and, when
   /// interpolating or when body_force != nullptr, the link pass, each thread over the links of
-  /// its own x-rows, two planes behind its sweep (the rows at the ends of its range after a
-  /// barrier). With interpolated walls the sweeps run without the solid-neighbour masks.
+  /// its own x-rows, each row's as soon as the rows it touches are swept (SweepPlan; the rows at
+  /// the ends of its range after a barrier). With interpolated walls the sweeps run without the
+  /// solid-neighbour masks.
   /// (docs/scaling.md has what each part costs.)
   void step(int parity, std::vector<double>* body_force) {
     switch (settings_.kernel) {
@@ -553,16 +619,14 @@ class Solver final : public SolverBase {
     const bool links = update || body_force != nullptr;
     const double correction = begin_step(body_force);
     const bool forces = body_force != nullptr;
-    // A link of row R reads and writes only nodes of rows R - lag .. R + lag (row j + ny k; a
-    // neighbour across the periodic y boundary in the next plane is 2 ny - 1 rows on): its pass
-    // runs right behind the sweep, while those rows are still cached, except for the rows within
-    // lag of either end of a work range, whose neighbours another range sweeps (after the barrier).
-    const std::int64_t lag = 2 * lattice_.dims()[1];
+    // Each range sweeps its rows in its plan's order and runs the link pass of a row as soon as
+    // the rows it touches are swept (SweepPlan), those next to another range after the barrier.
 #pragma omp parallel num_threads(threads_)
     {
       for (int t = thread_id(); t < ranges; t += team_size()) {
-        const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
-        for (std::int64_t r = r0; r < r1; ++r) {
+        const SweepPlan& plan = sweep_plans_[static_cast<std::size_t>(t)];
+        for (std::size_t s = 0; s < plan.order.size(); ++s) {
+          const std::int64_t r = plan.order[s];
           const Segment* first = segments + lattice_.row_segment_begin(r);
           const Segment* last = segments + lattice_.row_segment_begin(r + 1);
           if (parity == 0) {
@@ -574,9 +638,10 @@ class Solver final : public SolverBase {
           } else {
             odd_sweep<T, K, kStokes>(base, stride, masks, first, last, p, masked);
           }
-          const std::int64_t behind = r - lag;
-          if (links && behind >= r0 + lag && behind < r1 - lag) {
-            link_row(t, behind, parity, update, forces, correction);
+          if (!links) continue;
+          for (std::int64_t k = plan.ready_begin[s]; k < plan.ready_begin[s + 1]; ++k) {
+            link_row(t, plan.ready[static_cast<std::size_t>(k)], parity, update, forces,
+                     correction);
           }
         }
       }
@@ -585,12 +650,9 @@ class Solver final : public SolverBase {
         // read it.
 #pragma omp barrier
         for (int t = thread_id(); t < ranges; t += team_size()) {
-          const std::int64_t r0 = lattice_.range_row_begin(t), r1 = lattice_.range_row_begin(t + 1);
-          const std::int64_t head = std::min(r1, r0 + lag), tail = std::max(head, r1 - lag);
-          for (std::int64_t r = r0; r < head; ++r)
+          for (std::int64_t r : sweep_plans_[static_cast<std::size_t>(t)].after_barrier) {
             link_row(t, r, parity, update, forces, correction);
-          for (std::int64_t r = tail; r < r1; ++r)
-            link_row(t, r, parity, update, forces, correction);
+          }
         }
       }
     }
@@ -907,9 +969,10 @@ class Solver final : public SolverBase {
   std::vector<double> partial_defect_;              ///< Per work range.
   std::vector<double> wall_state_;  ///< Per link: rr's wall correction (empty: off).
   double wall_rate_ = kWallCorrectionRate;
-  double pending_defect_ = 0.0;      ///< Net mass added by the last interpolation pass.
-  double force_magnitude_ = 0.0;     ///< See force_magnitude().
-  std::int64_t boundary_nodes_ = 0;  ///< This rank's.
+  std::vector<SweepPlan> sweep_plans_;  ///< Per work range (one rank's whole box only).
+  double pending_defect_ = 0.0;         ///< Net mass added by the last interpolation pass.
+  double force_magnitude_ = 0.0;        ///< See force_magnitude().
+  std::int64_t boundary_nodes_ = 0;     ///< This rank's.
   std::int64_t global_boundary_nodes_ = -1;
 };
 
