@@ -218,6 +218,7 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                     {"fits_in_memory", plan.fits_in_memory},
                     {"refused_units", plan.refused_units},
                     {"under_resolved_units", plan.under_resolved_units},
+                    {"unstable_units", plan.unstable_units},
                     {"points", points}});
   } else {
     std::cout << fmt::format("campaign {}\n", spec.name) << plan.FullReport();

@@ -104,6 +104,9 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
         if (re > 0.0 && !velocity.within_limit()) {
           p.resolution_verdict = "refused";
           plan.refused_units += p.units;
+        } else if (re > 0.0 && d < need.stability) {
+          p.resolution_verdict = "may diverge";
+          plan.unstable_units += p.units;
         } else if (d < std::max(need.gaps, need.boundary_layer)) {
           p.resolution_verdict = "under-resolved";
           plan.under_resolved_units += p.units;
@@ -147,6 +150,10 @@ std::string CampaignPlan::BriefReport() const {
          (refused_units > 0 ? "; " + std::to_string(refused_units) +
                                   " units WILL BE REFUSED (cell Reynolds number: raise d)"
                             : std::string()) +
+         (unstable_units > 0 ? "; " + std::to_string(unstable_units) +
+                                   " units may diverge (beyond the cell Reynolds number their "
+                                   "operator has held: raise d)"
+                             : std::string()) +
          (under_resolved_units > 0
               ? "; " + std::to_string(under_resolved_units) + " units under-resolved"
               : std::string());

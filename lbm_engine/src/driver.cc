@@ -212,10 +212,11 @@ std::string diverged_diagnosis(const SparseLattice& lattice, const RunOptions& o
     text += "; at step " + std::to_string(last_check_step) + " the fastest node was " +
             node_text(lattice, last_max_node) + " (|u| = " + format_fixed("%.3g", last_max_speed) +
             "), a cell Reynolds number |u| dx / nu = " + format_fixed("%.3g", cell_re);
-    if (std::isfinite(limit)) {
+    if (std::isfinite(stable)) {
       text += " (" + std::string(to_string(options.collision)) + " has held up to " +
-              format_fixed("%g", stable) +
-              " in every measured packing and diverged in all beyond " + format_fixed("%g", limit) +
+              format_fixed("%g", stable) + " in every measured packing" +
+              (std::isfinite(limit) ? " and diverged in all beyond " + format_fixed("%g", limit)
+                                    : std::string()) +
               ")";
       if (target_re > 0.0) {
         const double d_hold =
@@ -815,6 +816,26 @@ class RunChecks {
   const TimeAverage& average_re() const { return average_re_; }
   const std::string& failure() const { return failure_; }
 
+  /// The remedy of a Mach stop: beyond the cell Reynolds number where the operator has held, a
+  /// local speed that grows steadily is the start of an instability (the d that holds); within
+  /// it, the velocity plan's Mach target.
+  std::string MachStopRemedy() const {
+    if (sc_.target_re <= 0.0 || options_.tau != 0.0) {
+      return "); remedy: lower tau (the velocity is U = Re nu / d at the target Re), or leave tau "
+             "to the engine";
+    }
+    const double stable = stable_cell_reynolds(options_.collision);
+    const double kappa = estimated_pore_speed_ratio(sc_.phi);
+    if (std::isfinite(stable) && kappa * sc_.target_re / sc_.d > stable) {
+      return "); kappa Re / d = " + format_fixed("%.3g", kappa * sc_.target_re / sc_.d) +
+             " is beyond " + format_fixed("%g", stable) + ", where " +
+             to_string(options_.collision) + " has held in every measured packing: remedy: --d " +
+             format_fixed("%g", std::ceil(kappa * sc_.target_re / stable)) +
+             " or more, or a lower Mach target (--mach)";
+    }
+    return "); remedy: lower the Mach target (--mach)";
+  }
+
   /// The flow's health from the moment sweep: finite populations, positive density, the Mach
   /// limit (a blow-up is told from a steady rise), the Mach warning.
   Next Health() {
@@ -839,12 +860,9 @@ class RunChecks {
       }
       return Fail("Mach number " + format_fixed("%.3g", mach) + " above the limit " +
                   format_fixed("%g", options_.mach_limit) + " at step " + std::to_string(step) +
-                  ", " + node_text(lattice_, m_.max_speed_node) + " (max |u| = " +
-                  format_fixed("%.3g", std::sqrt(m_.max_speed2)) + ", grown steadily" +
-                  (sc_.target_re > 0.0 && options_.tau == 0.0
-                       ? std::string("); remedy: lower the Mach target (--mach)")
-                       : std::string("); remedy: lower tau (the velocity is U = Re nu / d at the "
-                                     "target Re), or leave tau to the engine")));
+                  ", " + node_text(lattice_, m_.max_speed_node) +
+                  " (max |u| = " + format_fixed("%.3g", std::sqrt(m_.max_speed2)) +
+                  ", grown steadily" + MachStopRemedy());
     }
     const double mach_warning = sc_.target_re > 0.0 && options_.tau == 0.0
                                     ? std::max(kMachWarning, 1.5 * options_.mach_target)

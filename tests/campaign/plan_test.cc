@@ -96,6 +96,32 @@ TEST(CampaignPlan, UnsteadyPointsAddTheirTimeAverage) {
   EXPECT_LT(steps, 1.5 * average);
 }
 
+TEST(CampaignPlan, UnitsBeyondTheCellReynoldsNumberTheOperatorHoldsMayDiverge) {
+  // The dense sweeps at Re 300 (auto: rr with TRT's wall): phi 0.6 diverged at d 32 and converged
+  // at d 48; the plan says so before anything runs.
+  CampaignSpec spec = parse_campaign_spec_text(R"(
+[campaign]
+name = "dense-re300"
+[grid]
+phi = [0.6]
+re = [300]
+realizations = 1
+seed = 32
+[packing]
+spheres = 8
+[lbm]
+resolutions = [32, 48]
+)",
+                                               "dense.toml");
+  const CampaignPlan plan = plan_campaign(spec, 1, 1e-8);
+  ASSERT_EQ(plan.points.size(), 2u);
+  EXPECT_EQ(plan.points[0].resolution_verdict, "may diverge");
+  EXPECT_NE(plan.points[1].resolution_verdict, "may diverge");
+  EXPECT_EQ(plan.unstable_units, 1);
+  EXPECT_GE(plan.points[0].d_needed, 48.0 * 0.99);
+  EXPECT_NE(plan.BriefReport().find("1 units may diverge"), std::string::npos);
+}
+
 TEST(CampaignPlan, BadInputIsRefused) {
   const CampaignSpec spec = small_spec();
   EXPECT_THROW(plan_campaign(spec, 0, 1e-8), Error);

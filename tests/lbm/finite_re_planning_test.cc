@@ -167,7 +167,14 @@ TEST(CollisionChoice, AutoTakesTrtWithinItsStableCellReynoldsAndRrBeyond) {
   EXPECT_EQ(plan_velocity(0.1, 0.5, 64.0, Collision::kAuto, 0.3, 0.0, false).tau, 1.5);
   EXPECT_EQ(plan_velocity(0.6, 30.0, 10.0, Collision::kAuto, 0.3, 0.0, false, 0.0).tau,
             plan_velocity(0.6, 30.0, 10.0, Collision::kRegularized, 0.3, 0.0, false).tau);
-  EXPECT_EQ(resolution_needed(0.6, 300.0, Collision::kAuto).stability, 0.0);
+  // Beyond TRT's bound auto runs rr with TRT's wall, so rr's measured bound is auto's rule (c):
+  // phi 0.6 at Re 300 asks d 48, where the dense sweep's unit converged (d 32 diverged).
+  const ResolutionNeed dense = resolution_needed(0.6, 300.0, Collision::kAuto);
+  EXPECT_NEAR(dense.stability, estimated_pore_speed_ratio(0.6) * 300.0 / 82.0, 1e-12);
+  EXPECT_GT(dense.stability, 32.0);
+  EXPECT_LT(dense.stability, 48.0);
+  EXPECT_EQ(resolution_needed(0.6, 300.0, Collision::kRegularized).stability, dense.stability);
+  EXPECT_FALSE(std::isfinite(max_cell_reynolds(Collision::kRegularized)));
 }
 
 TEST(ResolutionRule, BoundsFollowTheirFormulas) {

@@ -188,8 +188,9 @@ struct PlannedPoint {
   double memory_bytes = 0.0;  ///< Per unit (populations, flags, links: generous).
   /// The resolution rule at (phi, Re) for the spec's collision (lbm/resolution.h) and what it
   /// says of this d: "ok", "under-resolved" (below the gap or boundary-layer bound: the error
-  /// grows; extrapolate in d) or "refused" (the engine will refuse the unit: beyond the
-  /// operator's cell Reynolds number).
+  /// grows; extrapolate in d), "may diverge" (below the stability bound: beyond the cell
+  /// Reynolds number where the operator has held in every measured packing) or "refused" (the
+  /// engine will refuse the unit: beyond the operator's cell Reynolds number).
   double d_needed = 0.0;
   std::string resolution_verdict;
   std::string resolution_detail;  ///< lbm::ResolutionNeed::Summary().
@@ -218,6 +219,7 @@ struct CampaignPlan {
   bool fits_in_memory = true;         ///< largest_unit_memory_bytes x jobs <= 80 % of the machine.
   std::int64_t refused_units = 0;     ///< Units the engine will refuse (cell Reynolds number).
   std::int64_t under_resolved_units = 0;  ///< Units below the accuracy rules.
+  std::int64_t unstable_units = 0;        ///< Units below the stability bound ("may diverge").
   std::string BriefReport() const;
   std::string FullReport() const;
 };

@@ -19,7 +19,7 @@
 //      0.2 % of d 24; phi 0.6 at d 16, D_h = 7, within 0.05 %);
 //  (b) boundary layer: the thinner of the sphere's, d / sqrt(Re_p) with Re_p = Re / (1 - phi),
 //      and the pores', D_h / sqrt(Re_h) with Re_h = Re (2/3)/phi, spans kLayerNodes nodes;
-//  (c) stability: kappa Re / d below the operator's max_cell_reynolds.
+//  (c) stability: kappa Re / d below the operator's stable_cell_reynolds.
 // (a) and (b) are accuracy rules (docs/validation.md checks them against d sweeps); (c) is the
 // one a run refuses on.
 #pragma once
@@ -51,7 +51,9 @@ double estimated_pore_speed_ratio(double phi);
 /// for kAuto.
 double max_cell_reynolds(Collision collision);
 /// The cell Reynolds number at which every measured run of `collision` was stable, whatever
-/// phi: the resolution suggested to a refused or diverged run. Infinite for regularized.
+/// phi: the resolution suggested to a refused or diverged run, and rule (c) of the resolution
+/// rule. For regularized (and auto, which takes it beyond TRT's) the value measured with TRT's
+/// wall: a run beyond it is warned and planned for, not refused.
 double stable_cell_reynolds(Collision collision);
 
 /// The operator of a run: `requested` itself, or for Collision::kAuto TRT in Stokes flow and
