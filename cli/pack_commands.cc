@@ -226,12 +226,14 @@ void run_stats(const CliContext& ctx, const std::string& file) {
   print_statistics(p, s);
 }
 
-void run_voxelize(const CliContext& ctx, const std::string& file, double resolution) {
+void run_voxelize(const CliContext& ctx, const std::string& file, double resolution,
+                  const std::string& raw) {
   const arrays::Packing p = arrays::read_packing_hdf5(file);
   arrays::VoxelizationOptions vo;
   vo.resolution = resolution;
   std::string error;
   if (!vo.IsValid(&error)) throw UsageError(error);
+  if (!raw.empty()) core::check_output_file(raw, "--raw");
   ProgressLine progress(!ctx.quiet);
   const auto start = std::chrono::steady_clock::now();
   const arrays::VoxelGrid g = arrays::voxelize(
@@ -240,6 +242,8 @@ void run_voxelize(const CliContext& ctx, const std::string& file, double resolut
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double gap = arrays::min_gap_lattice_units(p, g.resolution());
+  // The solid flags as they are stored (1 solid, 0 fluid, x fastest): another code's input.
+  if (!raw.empty()) core::write_file_atomically(raw, g.solid.data(), g.solid.size(), "--raw");
   if (ctx.json) {
     ctx.print_json({{"file", file},
                     {"dims", g.dims},
@@ -249,6 +253,7 @@ void run_voxelize(const CliContext& ctx, const std::string& file, double resolut
                     {"links", g.num_links()},
                     {"memory_bytes", g.memory_bytes()},
                     {"min_gap_lattice", gap},
+                    {"raw", raw.empty() ? nlohmann::json() : nlohmann::json(raw)},
                     {"wall_s", wall}});
     return;
   }
@@ -259,6 +264,10 @@ void run_voxelize(const CliContext& ctx, const std::string& file, double resolut
   std::cout << fmt::format("boundary links   {} ({:.1f} MiB with the flags)\n", g.num_links(),
                            g.memory_bytes() / 1048576.0);
   std::cout << fmt::format("smallest gap     {} lattice units\n", format_number(gap, 3));
+  if (!raw.empty()) {
+    std::cout << fmt::format("solid flags      {} ({} bytes: 1 solid, 0 fluid, x fastest)\n", raw,
+                             g.solid.size());
+  }
   std::cout << fmt::format("time             {:.2f} s\n", wall);
 }
 
@@ -346,9 +355,18 @@ void add_pack_commands(CLI::App& app, CliContext& ctx) {
   vox->add_option("file", *vox_file, "Packing HDF5 file")->required();
   vox->add_option("--resolution", *resolution, "Lattice units per reference diameter")
       ->capture_default_str();
-  vox->footer("Example:\n  draglab pack voxelize p.h5 --resolution 24 --json");
-  vox->callback([&ctx, vox_file, resolution] {
-    ctx.action = [&ctx, vox_file, resolution] { run_voxelize(ctx, *vox_file, *resolution); };
+  auto raw = std::make_shared<std::string>();
+  vox->add_option("--raw", *raw,
+                  "Also write the solid flags to this file: one byte per node (1 solid, 0 fluid), "
+                  "x fastest, then y, then z (the lattice `lbm run` uses at this d_ref/dx, for "
+                  "another code)");
+  vox->footer(
+      "Examples:\n  draglab pack voxelize p.h5 --resolution 24 --json\n"
+      "  draglab pack voxelize p.h5 --resolution 16 --raw p_d16.raw   # e.g. for a peer LBM code");
+  vox->callback([&ctx, vox_file, resolution, raw] {
+    ctx.action = [&ctx, vox_file, resolution, raw] {
+      run_voxelize(ctx, *vox_file, *resolution, *raw);
+    };
   });
 
   pack->callback([&ctx, o, pack] {

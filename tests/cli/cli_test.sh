@@ -108,6 +108,9 @@ check "pack ordered fcc" 0 "$draglab" pack --ordered fcc --phi 0.5 --cells 2 --o
 json_check "fcc q6 (Steinhardt FCC 0.5745)" "abs(j['q6'] - 0.57452) < 1e-4 and j['n'] == 32"
 check "pack voxelize" 0 "$draglab" pack voxelize "$work/p.h5" --resolution 8 --json
 json_check "voxelize json" "abs(j['phi_lattice'] - 0.3) < 0.05 and j['links'] > 0"
+# --raw: one byte per node, x fastest, 1 = solid; its solid fraction is the lattice's phi.
+check "pack voxelize --raw" 0 "$draglab" pack voxelize "$work/p.h5" --resolution 8 --raw "$work/p.raw" --json
+json_check "voxelize --raw flags" "(lambda b: len(b) == j['dims'][0] * j['dims'][1] * j['dims'][2] and set(b) <= {0, 1} and abs(sum(b) / len(b) - j['phi_lattice']) < 1e-12)(open('$work/p.raw', 'rb').read())"
 check "pack ensemble" 0 "$draglab" pack ensemble --phi 0.2 --n 40 --sweeps 20 -R 2 --out-dir "$work/ens" --json
 json_check "ensemble json" "len(j) == 2 and j[0]['seed'] != j[1]['seed']"
 check "pack phi too high" 2 "$draglab" pack --phi 0.7 --n 100 --out "$work/bad1.h5"
