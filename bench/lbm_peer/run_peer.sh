@@ -97,7 +97,7 @@ echo "$table"
 if [ -n "$out" ]; then
   {
     echo "# bench/lbm_peer/run_peer.sh --threads $threads --repeat $repeat --iterations $iterations$([ "$same_packing" = 1 ] && echo ' --same-packing')"
-    echo "# code: $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet || echo '+modified'); peer: RRZE lbm-benchmark-kernels $(git -C "$(dirname "$peer")/.." rev-parse --short HEAD 2>/dev/null || echo '?'), list-aa-pv-soa, double"
+    echo "# code: $(git -C "$root" rev-parse --short HEAD)$(git -C "$root" diff --quiet || echo '+modified'); peer: RRZE lbm-benchmark-kernels $(git -C "$(dirname "$peer")/.." rev-parse --short HEAD 2>/dev/null || echo '?'), list-aa-pv-soa, double$([ "$same_packing" = 1 ] && echo ', its src/Geometry.c given the file geometry type')"
     echo "# machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(date -u +%Y-%m-%d)"
     echo "$table"
   } >"$out"
