@@ -14,9 +14,9 @@ group with at least two finished resolutions:
 
 With --plot FILE.png, a figure: per (phi, Re) the drag against 1/d^2 (an order-2 wall is a
 straight line there) with each run's error estimate as its bar (clipped at 25 %, the bar of an
-under-resolved run runs off the panel), the reference at 1/d^2 = 0, the diverged runs marked at
-the panel's foot, and, with --draglab BIN, the published laws of the comparison
-(`draglab law eval`) as horizontal lines.
+under-resolved run runs off the panel), the reference at 1/d^2 = 0, at the panel's foot a cross
+for each diverged (failed) run and a circle for each run still going on, and, with --draglab BIN,
+the published laws of the comparison (`draglab law eval`) as horizontal lines.
 
 Usage: scripts/dense_d_sweep.py CSV... [--out FILE] [--plot FILE.png [--draglab BIN]]
 """
@@ -166,8 +166,11 @@ def plot(table, path, draglab):
                     lo, hi = min(lo, v), max(hi, v)
         for r in rows:
             if r["status"] != "done":
-                ax.plot([1.0 / r["d"] ** 2], [lo - 0.04 * (hi - lo)], "x", color="k")
-                ax.annotate("d %g diverged" % r["d"], (1.0 / r["d"] ** 2, lo - 0.04 * (hi - lo)),
+                # failed: the run diverged or stopped; otherwise it is still running (in parts)
+                what, mark = ("diverged", "x") if r["status"] == "failed" else ("running", "o")
+                ax.plot([1.0 / r["d"] ** 2], [lo - 0.04 * (hi - lo)], mark, color="k",
+                        fillstyle="none")
+                ax.annotate("d %g %s" % (r["d"], what), (1.0 / r["d"] ** 2, lo - 0.04 * (hi - lo)),
                             textcoords="offset points", xytext=(-20, 6), fontsize=7)
         pad = 0.12 * (hi - lo) + 0.02 * hi
         ax.set_ylim(lo - pad, hi + pad)

@@ -89,7 +89,7 @@ std::vector<Unit> read_export(const std::string& path, std::string* spec_hash) {
   return units;
 }
 
-const std::vector<std::string> kParts = {"d32", "d48_re100", "d48_re300", "d64"};
+const std::vector<std::string> kParts = {"d32", "d48_re100", "d48_re300", "d64", "d64_re300"};
 
 TEST(CommittedDenseSweep, EachFileIsTheRunOfItsCommittedSpec) {
   for (const std::string& part : kParts) {

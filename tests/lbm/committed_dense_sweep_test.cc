@@ -1,4 +1,4 @@
-// The error model against the committed convergence in d of dense packings at Re 100
+// The error model against the committed convergence in d of dense packings at Re 100 and 300
 // (data/datasets/dense_d_sweep_8/: random phi 0.5 and 0.6, 8 spheres, d 32, 48 and 64, the
 // engine's automatic operator; measured by the campaigns of data/campaigns/dense_d_sweep_8/).
 // Reference per packing: the Richardson value of the two finest d at order 2 (the interpolated
@@ -80,42 +80,56 @@ double model_estimate(const nlohmann::json& r) {
   return discretisation_error_estimate(em);
 }
 
-TEST(CommittedDenseSweep, TheErrorModelBoundsEveryResolvedRunAtRe100) {
+/// Checks every resolved run at `re` of the exported `parts` against the references of its
+/// packing (the file comment); `runs_per_phi` is how many finished runs each packing has.
+/// Returns how many (run, reference) pairs were checked.
+int check_error_model(const std::vector<std::string>& parts, double re,
+                      const std::map<double, std::size_t>& runs_per_phi) {
   std::map<double, std::vector<nlohmann::json>> by_phi;
-  for (const char* part : {"d32", "d48_re100", "d64"}) {
+  for (const std::string& part : parts) {
     for (const auto& r : finished_runs(kData + part + ".csv")) {
-      if (std::abs(r.at("re").get<double>() - 100.0) < 2.0)
+      if (std::abs(r.at("re").get<double>() / re - 1.0) < 0.02)
         by_phi[r.at("phi").get<double>()].push_back(r);
     }
   }
-  ASSERT_EQ(by_phi.size(), 2u);
+  EXPECT_EQ(by_phi.size(), runs_per_phi.size());
   int checked = 0;
   for (auto& [phi, runs] : by_phi) {
-    SCOPED_TRACE("phi " + std::to_string(phi));
-    ASSERT_EQ(runs.size(), 3u);
+    SCOPED_TRACE("phi " + std::to_string(phi) + ", Re " + std::to_string(re));
+    const auto expected = runs_per_phi.lower_bound(phi - 1e-9);
+    EXPECT_TRUE(expected != runs_per_phi.end() && std::abs(expected->first - phi) < 1e-9);
+    if (expected == runs_per_phi.end()) continue;
+    EXPECT_EQ(runs.size(), expected->second);
+    if (runs.size() != expected->second || runs.size() < 2) continue;  // no reference
     std::sort(runs.begin(), runs.end(),
               [](const auto& a, const auto& b) { return a.at("d") < b.at("d"); });
-    const double d[3] = {runs[0].at("d"), runs[1].at("d"), runs[2].at("d")};
-    const double F[3] = {runs[0].at("F"), runs[1].at("F"), runs[2].at("F")};
+    // The finest three resolutions (or two).
+    std::vector<double> d, F;
+    for (std::size_t k = runs.size() >= 3 ? runs.size() - 3 : 0; k < runs.size(); ++k) {
+      d.push_back(runs[k].at("d"));
+      F.push_back(runs[k].at("F"));
+    }
     std::vector<double> references;
-    if ((F[0] - F[1]) * (F[1] - F[2]) > 0.0) {
+    if (d.size() == 2) {
+      references.push_back(richardson(d[0], F[0], d[1], F[1], 2.0));
+    } else if ((F[0] - F[1]) * (F[1] - F[2]) > 0.0) {
       references.push_back(richardson(d[1], F[1], d[2], F[2], 2.0));
-      references.push_back(richardson(d[1], F[1], d[2], F[2], observed_order(d, F)));
+      references.push_back(richardson(d[1], F[1], d[2], F[2], observed_order(d.data(), F.data())));
     } else {
       references.push_back(F[2]);
     }
     for (const auto& r : runs) {
       const double estimate = model_estimate(r);
-      // The record's own estimate came from the model of its day (growth 1 + Re/10); recomputed
-      // from the record, a resolved TRT run's differs only by that growth: a check of the inputs
-      // read here.
+      // The record's own estimate came from the model of its day (growth 1 + Re/10 before the
+      // Re 100 sweep); recomputed from the record, a resolved TRT run's differs only by that
+      // growth: a check of the inputs read here.
       const bool resolved = r.at("d").get<double>() >= r.at("resolution_needed").get<double>();
       if (r.at("collision") == "trt" && resolved) {
-        const double re = r.at("re").get<double>();
+        const double run_re = r.at("re").get<double>();
         const double floor = r.at("precision") == "float" ? 1e-5 : 0.0;
         EXPECT_NEAR(estimate - floor,
-                    (r.at("discretisation_error").get<double>() - floor) * (1.0 + re / 7.0) /
-                        (1.0 + re / 10.0),
+                    (r.at("discretisation_error").get<double>() - floor) * (1.0 + run_re / 7.0) /
+                        (1.0 + run_re / 10.0),
                     1e-9);
       }
       if (!resolved) continue;
@@ -127,7 +141,18 @@ TEST(CommittedDenseSweep, TheErrorModelBoundsEveryResolvedRunAtRe100) {
       }
     }
   }
-  EXPECT_GE(checked, 6);
+  return checked;
+}
+
+TEST(CommittedDenseSweep, TheErrorModelBoundsEveryResolvedRunAtRe100) {
+  EXPECT_GE(check_error_model({"d32", "d48_re100", "d64"}, 100.0, {{0.5, 3}, {0.6, 3}}), 6);
+}
+
+// Re 300: unsteady flow, each F a time mean (its standard error, about 0.1 %, is small beside
+// the estimates). phi 0.5 has d 32 (below the boundary-layer bound: not checked), 48 and 64;
+// phi 0.6 diverged at d 32 and its d 64 run has not finished: d 48 alone, no reference yet.
+TEST(CommittedDenseSweep, TheErrorModelBoundsEveryResolvedRunAtRe300) {
+  EXPECT_GE(check_error_model({"d32", "d48_re300", "d64_re300"}, 300.0, {{0.5, 3}, {0.6, 1}}), 4);
 }
 
 }  // namespace
