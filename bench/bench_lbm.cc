@@ -30,7 +30,10 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  const draglab::lbm::BenchResult r = draglab::lbm::benchmark(threads, repeat);
+  draglab::lbm::BenchOptions options;
+  options.threads = threads;
+  options.repeat = repeat;
+  const draglab::lbm::BenchResult r = draglab::lbm::benchmark(options);
   const double roofline = r.bandwidth_gbs * 1e9 / 304.0 / 1e6;
   std::printf(
       "{\"threads\": %d, \"repeat\": %d, \"mflups\": %.2f, \"mflups_fluid_packing\": %.2f, "

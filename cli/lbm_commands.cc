@@ -112,6 +112,7 @@ struct CalibrateCommand {
 struct BenchCommand {
   int threads = 0;
   int repeat = 5;
+  double phi = 0.4;
 };
 
 /// The geometry of a run, and how to describe it.
@@ -441,10 +442,19 @@ void run_bench(const CliContext& ctx, const BenchCommand& b) {
         fmt::format("--threads = {} is outside [0, {}] (0 = all)", b.threads, kMaxThreads));
   }
   if (b.repeat < 1 || b.repeat > 100) throw UsageError("--repeat must lie in [1, 100]");
-  ctx.info(
-      "lbm bench: all-fluid box, phi = 0.4 packing, the blocks-8 geometry and in-place bandwidth "
-      "kernel, the first two at least 4x the last-level cache (about a minute)");
-  const lbm::BenchResult r = lbm::benchmark(b.threads, b.repeat);
+  if (!(b.phi >= 0.1 && b.phi <= 0.6)) {
+    throw UsageError(
+        fmt::format("--phi = {} is outside [0.1, 0.6] (the packing's solid fraction)", b.phi));
+  }
+  ctx.info(fmt::format(
+      "lbm bench: all-fluid box, phi = {} packing, the blocks-8 geometry and in-place bandwidth "
+      "kernel, the first two at least 4x the last-level cache (about a minute)",
+      b.phi));
+  lbm::BenchOptions options;
+  options.threads = b.threads;
+  options.repeat = b.repeat;
+  options.packing_phi = b.phi;
+  const lbm::BenchResult r = lbm::benchmark(options);
   if (ctx.json) {
     ctx.print_json(
         {{"mflups", r.mflups},
@@ -463,7 +473,8 @@ void run_bench(const CliContext& ctx, const BenchCommand& b) {
          {"threads", r.threads},
          {"last_level_cache_bytes", r.last_level_cache_bytes},
          {"box_edge", r.box_edge},
-         {"packing_spheres", r.packing_spheres}});
+         {"packing_spheres", r.packing_spheres},
+         {"packing_phi", r.packing_phi}});
     return;
   }
   std::cout << fmt::format(
@@ -471,9 +482,10 @@ void run_bench(const CliContext& ctx, const BenchCommand& b) {
       "{:.0f} MiB last-level cache)\n",
       r.box_edge, r.mflups, r.threads, r.last_level_cache_bytes / 1048576.0);
   std::cout << fmt::format(
-      "phi = 0.4 packing {:.1f} MFLUPS (fluid nodes), {:.2f} x all-fluid "
+      "phi = {} packing {:.1f} MFLUPS (fluid nodes), {:.2f} x all-fluid "
       "(goal >= 0.8)\n",
-      r.mflups_fluid_packing, r.mflups > 0 ? r.mflups_fluid_packing / r.mflups : 0.0);
+      r.packing_phi, r.mflups_fluid_packing,
+      r.mflups > 0 ? r.mflups_fluid_packing / r.mflups : 0.0);
   std::cout << fmt::format("  same, halfway bounce-back {:.1f} MFLUPS, {:.2f} x all-fluid\n",
                            r.mflups_fluid_packing_bb,
                            r.mflups > 0 ? r.mflups_fluid_packing_bb / r.mflups : 0.0);
@@ -786,8 +798,12 @@ void add_lbm_commands(CLI::App& app, CliContext& ctx) {
 
   auto bc = std::make_shared<BenchCommand>();
   auto* bench = lbm->add_subcommand(
-      "bench", "MLUPS (100^3 fluid box), MFLUPS (phi = 0.4 packing), bandwidth, roofline fraction");
+      "bench",
+      "MLUPS (100^3 fluid box), MFLUPS (random packing, phi 0.4 unless --phi), bandwidth, "
+      "roofline fraction");
   bench->add_option("--threads", bc->threads, "OpenMP threads (0 = all)")->capture_default_str();
+  bench->add_option("--phi", bc->phi, "Solid fraction of the random packing (d 16), [0.1, 0.6]")
+      ->capture_default_str();
   bench->add_option("--repeat", bc->repeat, "Repetitions (median)")->capture_default_str();
   bench->footer(
       "roofline_fraction = MLUPS / (bandwidth / 304 bytes): 1 is the in-place D3Q19 double\n"

@@ -9,8 +9,9 @@
 // box, 152 MB of populations, runs from a 480 MiB L3 and reads above the DRAM roofline):
 //  - mflups: all-fluid periodic box of edge max(100, (4 LLC / 152 B)^(1/3)) nodes, double, TRT
 //    (full equilibrium), 100 steps per run.
-//  - mflups_fluid_packing: fluid-node updates per second on a phi = 0.4 random packing at d = 16
-//    (max(200, 4 LLC / (5362 nodes x 152 B)) spheres: about 5362 nodes per sphere, 60 % fluid),
+//  - mflups_fluid_packing: fluid-node updates per second on a random packing at d = 16 of solid
+//    fraction packing_phi (0.4 unless asked; max(200, 4 LLC / (n_s x 152 B)) spheres, n_s =
+//    (pi/6) 16^3 / phi box nodes per sphere: 5362 at phi 0.4, 60 % fluid),
 //    double, TRT with the default interpolated bounce-back (its link pass included), 100 steps
 //    per run; mflups_fluid_packing_bb: the same with halfway bounce-back (no link pass).
 //  - mflups_blocks, mflups_blocks_bb: the same two on RRZE lbm-benchmark-kernels' `blocks-8`
@@ -35,6 +36,7 @@
 
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/voxelization.h"
+#include "draglab/error.h"
 #include "draglab/lbm/lbm.h"
 #include "lattice.h"
 #include "solver.h"
@@ -150,6 +152,8 @@ double last_level_cache_bytes() {
 }
 
 constexpr double kCacheMultiple = 4.0;
+constexpr double kMinBenchPhi = 0.1;
+constexpr double kMaxBenchPhi = 0.6;
 // The peer's porous benchmark geometry: 100^3, blocks of 8 (849 808 fluid nodes).
 constexpr std::int64_t kBlocksEdge = 100;
 constexpr std::int64_t kBlocksSize = 8;
@@ -180,7 +184,24 @@ double update_bandwidth_gbs(int threads, std::int64_t n) {
 
 }  // namespace
 
-BenchResult benchmark(int threads, int repeat) {
+bool BenchOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& what) {
+    if (error) *error = what;
+    return false;
+  };
+  if (threads < 0) return fail("threads must be >= 0 (0 = all)");
+  if (repeat < 1 || repeat > 100) return fail("repeat must lie in [1, 100]");
+  if (!(packing_phi >= kMinBenchPhi && packing_phi <= kMaxBenchPhi)) {
+    return fail("the packing's solid fraction must lie in [0.1, 0.6]");
+  }
+  return true;
+}
+
+BenchResult benchmark(const BenchOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw Error(ErrorCode::kInvalidArgument, "lbm bench: " + error);
+  int threads = options.threads;
+  int repeat = options.repeat;
 #if defined(_OPENMP)
   if (threads <= 0) threads = std::max(1, omp_get_max_threads());
 #else
@@ -203,9 +224,12 @@ BenchResult benchmark(int threads, int repeat) {
   box.solid.assign(static_cast<std::size_t>(box.num_nodes()), 0);
 
   arrays::RandomPackingOptions packing_options;
-  packing_options.phi = 0.4;
+  packing_options.phi = options.packing_phi;
+  // Box nodes per sphere at d 16: (pi/6) 16^3 / phi, 5362 at phi 0.4.
+  const double box_nodes_per_sphere = 5362.0 * 0.4 / options.packing_phi;
   packing_options.n = static_cast<int>(
-      std::max(200.0, std::ceil(kCacheMultiple * cache / (5362.0 * kBytesPerNode))));
+      std::max(200.0, std::ceil(kCacheMultiple * cache / (box_nodes_per_sphere * kBytesPerNode))));
+  result.packing_phi = options.packing_phi;
   result.packing_spheres = packing_options.n;
   packing_options.seed = 1;
   const arrays::Packing packing = arrays::generate_random_packing(packing_options);

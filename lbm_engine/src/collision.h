@@ -73,29 +73,6 @@ DRAGLAB_LBM_INLINE void trt_pair(T gi, T gib, T& oi, T& oib, T w, T drho, T jx, 
   oib = gib - rp + rm + fp - fm;
 }
 
-/// One opposite pair for the regularized kernel: cpc = c.Pi_neq.c - tr(Pi_neq)/3.
-template <typename T, bool kStokes, int CX, int CY, int CZ>
-DRAGLAB_LBM_INLINE void rr_pair(T& oi, T& oib, T w, T drho, T jx, T jy, T jz, T ux, T uy, T uz,
-                                T ju, T cpc, const KernelParams<T>& p) {
-  const T cj = T(CX) * jx + T(CY) * jy + T(CZ) * jz;
-  T eqp, fp;
-  if (kStokes) {
-    eqp = w * drho;
-    fp = T(0);
-  } else {
-    const T cu = T(CX) * ux + T(CY) * uy + T(CZ) * uz;
-    eqp = w * (drho + T(4.5) * cj * cu - T(1.5) * ju);
-    fp = w * p.force_even * (T(9) * cu * T(CX) - T(3) * ux);
-  }
-  const T eqm = T(3) * w * cj;
-  const T one_minus_omega = T(1) - p.omega_plus;
-  const T neq_even = one_minus_omega * w * T(4.5) * cpc;
-  const T neq_odd = one_minus_omega * w * T(-1.5) * p.force_x * T(CX);
-  const T fm = T(3) * w * p.force_odd * T(CX);
-  oi = eqp + eqm + neq_even + neq_odd + fp + fm;
-  oib = eqp - eqm + neq_even - neq_odd + fp - fm;
-}
-
 }  // namespace detail
 
 /// Collides one node: g[0..18] in (shifted, pre-collision), o[0..18] out (shifted,
@@ -182,68 +159,75 @@ DRAGLAB_LBM_INLINE void collide_node(const T (&g)[19], T (&o)[19], const KernelP
     (void)s56;
     return;
   }
-  // Regularized: moments.
-  const T drho = ((g[0] + g[1]) + (g[2] + g[3])) + ((g[4] + g[5]) + (g[6] + g[7])) +
-                 ((g[8] + g[9]) + (g[10] + g[11])) + ((g[12] + g[13]) + (g[14] + g[15])) +
-                 ((g[16] + g[17]) + g[18]);
+  // Regularized, in the same pair form: with the node scalar A = drho - 1.5 j.u - 3 F+ u_x
+  // (F+ = (1 - omega+/2) G_x) and, per weight class, n_w = 4.5 w (1 - omega+),
+  //   o_i = P + M,  o_ib = P - M,
+  //   P = w A + cu (4.5 w c.j + 9 w F+ c_x) + n_w Q_i : Pi_neq,
+  //   M = 3 w c.j + c_x w (3 F- - 1.5 (1 - omega+) G_x)      (F- = (1 - omega-/2) G_x).
+  const T s12 = g[1] + g[2], s34 = g[3] + g[4], s56 = g[5] + g[6], s78 = g[7] + g[8];
+  const T s910 = g[9] + g[10], s1112 = g[11] + g[12], s1314 = g[13] + g[14];
+  const T s1516 = g[15] + g[16], s1718 = g[17] + g[18];
   const T d12 = g[1] - g[2], d34 = g[3] - g[4], d56 = g[5] - g[6];
   const T d78 = g[7] - g[8], d910 = g[9] - g[10], d1112 = g[11] - g[12], d1314 = g[13] - g[14];
   const T d1516 = g[15] - g[16], d1718 = g[17] - g[18];
-  const T jx = d12 + d78 + d910 + d1112 + d1314 + T(0.5) * p.force_x;
-  const T jy = d34 + d78 - d910 + d1516 + d1718;
-  const T jz = d56 + d1112 - d1314 + d1516 - d1718;
-  T ux, uy, uz;
-  if (kStokes) {
-    ux = jx;
-    uy = jy;
-    uz = jz;
-  } else {
+  const T drho = ((g[0] + s12) + (s34 + s56)) + ((s78 + s910) + (s1112 + s1314)) + (s1516 + s1718);
+  const T jx = (d12 + d78) + (d910 + d1112) + d1314 + T(0.5) * p.force_x;
+  const T jy = (d34 + d78) - d910 + (d1516 + d1718);
+  const T jz = (d56 + d1112) - d1314 + (d1516 - d1718);
+  T ux = 0, uy = 0, uz = 0, a = drho;
+  if (!kStokes) {
     const T inv_rho = T(1) / (T(1) + drho);
     ux = jx * inv_rho;
     uy = jy * inv_rho;
     uz = jz * inv_rho;
+    a = drho - T(1.5) * (jx * ux + jy * uy + jz * uz) - T(3) * p.force_even * ux;
   }
-  const T ju = kStokes ? T(0) : jx * ux + jy * uy + jz * uz;
-  {
-    // Second moment of the shifted populations minus the equilibrium one (Pi_eq - I/3 =
-    // drho I/3 + j u): Pi_neq.
-    const T s78 = g[7] + g[8], s910 = g[9] + g[10], s1112 = g[11] + g[12], s1314 = g[13] + g[14];
-    const T s1516 = g[15] + g[16], s1718 = g[17] + g[18];
-    const T third_drho = drho * T(1.0 / 3.0);
-    const T pxx =
-        (g[1] + g[2]) + s78 + s910 + s1112 + s1314 - third_drho - (kStokes ? T(0) : jx * ux);
-    const T pyy =
-        (g[3] + g[4]) + s78 + s910 + s1516 + s1718 - third_drho - (kStokes ? T(0) : jy * uy);
-    const T pzz =
-        (g[5] + g[6]) + s1112 + s1314 + s1516 + s1718 - third_drho - (kStokes ? T(0) : jz * uz);
-    const T pxy = s78 - s910 - (kStokes ? T(0) : jx * uy);
-    const T pxz = s1112 - s1314 - (kStokes ? T(0) : jx * uz);
-    const T pyz = s1516 - s1718 - (kStokes ? T(0) : jy * uz);
-    const T third_trace = (pxx + pyy + pzz) * T(1.0 / 3.0);
-    const T eq0 = kStokes ? w0 * drho : w0 * (drho - T(1.5) * ju);
-    const T f0 = kStokes ? T(0) : w0 * p.force_even * (T(-3) * ux);
-    // Q_0 : Pi = -tr(Pi)/3.
-    o[0] = eq0 + (T(1) - p.omega_plus) * w0 * T(4.5) * (-third_trace) + f0;
-    using detail::rr_pair;
-    const T ax = pxx - third_trace, ay = pyy - third_trace, az = pzz - third_trace;
-    const T dxy = pxx + pyy - third_trace, dxz = pxx + pzz - third_trace,
-            dyz = pyy + pzz - third_trace;
-    rr_pair<T, kStokes, 1, 0, 0>(o[1], o[2], wa, drho, jx, jy, jz, ux, uy, uz, ju, ax, p);
-    rr_pair<T, kStokes, 0, 1, 0>(o[3], o[4], wa, drho, jx, jy, jz, ux, uy, uz, ju, ay, p);
-    rr_pair<T, kStokes, 0, 0, 1>(o[5], o[6], wa, drho, jx, jy, jz, ux, uy, uz, ju, az, p);
-    rr_pair<T, kStokes, 1, 1, 0>(o[7], o[8], wd, drho, jx, jy, jz, ux, uy, uz, ju, dxy + T(2) * pxy,
-                                 p);
-    rr_pair<T, kStokes, 1, -1, 0>(o[9], o[10], wd, drho, jx, jy, jz, ux, uy, uz, ju,
-                                  dxy - T(2) * pxy, p);
-    rr_pair<T, kStokes, 1, 0, 1>(o[11], o[12], wd, drho, jx, jy, jz, ux, uy, uz, ju,
-                                 dxz + T(2) * pxz, p);
-    rr_pair<T, kStokes, 1, 0, -1>(o[13], o[14], wd, drho, jx, jy, jz, ux, uy, uz, ju,
-                                  dxz - T(2) * pxz, p);
-    rr_pair<T, kStokes, 0, 1, 1>(o[15], o[16], wd, drho, jx, jy, jz, ux, uy, uz, ju,
-                                 dyz + T(2) * pyz, p);
-    rr_pair<T, kStokes, 0, 1, -1>(o[17], o[18], wd, drho, jx, jy, jz, ux, uy, uz, ju,
-                                  dyz - T(2) * pyz, p);
-  }
+  // Pi_neq = sum g c c - drho I/3 - j u (Pi_eq - I/3 = drho I/3 + j u), and Q_i : Pi_neq =
+  // c.Pi_neq.c - tr(Pi_neq)/3, scaled by n_w: axis x is n_a (pxx - t), diagonal xy is
+  // n_d (pxx + pyy - t) +- 2 n_d pxy (t = tr/3).
+  const T third_drho = drho * T(1.0 / 3.0);
+  const T pxx = (s12 + s78) + (s910 + s1112) + s1314 - third_drho - (kStokes ? T(0) : jx * ux);
+  const T pyy = (s34 + s78) + (s910 + s1516) + s1718 - third_drho - (kStokes ? T(0) : jy * uy);
+  const T pzz = (s56 + s1112) + (s1314 + s1516) + s1718 - third_drho - (kStokes ? T(0) : jz * uz);
+  const T pxy = s78 - s910 - (kStokes ? T(0) : jx * uy);
+  const T pxz = s1112 - s1314 - (kStokes ? T(0) : jx * uz);
+  const T pyz = s1516 - s1718 - (kStokes ? T(0) : jy * uz);
+  const T t = (pxx + pyy + pzz) * T(1.0 / 3.0);
+  const T one_minus_omega = T(1) - p.omega_plus;
+  const T n_a = T(4.5) * wa * one_minus_omega, n_d = T(4.5) * wd * one_minus_omega;
+  const T two_n_d = T(2) * n_d;
+  o[0] = w0 * a - T(4.5) * w0 * one_minus_omega * t;
+  const T m_a = T(3) * wa, m_d = T(3) * wd;
+  const T r_x = p.force_odd * T(3) - T(1.5) * one_minus_omega * p.force_x;
+  const T r_a = wa * r_x, r_d = wd * r_x;
+  const T c_a = wa * a, c_d = wd * a;
+  const T k_a = T(4.5) * wa, k_d = T(4.5) * wd;
+  const T f_a = T(9) * wa * p.force_even, f_d = T(9) * wd * p.force_even;
+  // One pair: cj = c.j, cu = c.u, cx = c_x (compile-time), nq = n_w Q_i : Pi_neq.
+  auto pair = [&](T & oi, T & oib, T cj, T cu, T nq, int cx, bool axis)
+      __attribute__((always_inline)) {
+    T P = (axis ? c_a : c_d) + nq;
+    if (!kStokes) {
+      T slope = (axis ? k_a : k_d) * cj;
+      if (cx != 0) slope += (axis ? f_a : f_d) * T(cx);
+      P += cu * slope;
+    }
+    T M = (axis ? m_a : m_d) * cj;
+    if (cx != 0) M += (axis ? r_a : r_d) * T(cx);
+    oi = P + M;
+    oib = P - M;
+  };
+  const T dxy = n_d * (pxx + pyy - t), dxz = n_d * (pxx + pzz - t), dyz = n_d * (pyy + pzz - t);
+  const T exy = two_n_d * pxy, exz = two_n_d * pxz, eyz = two_n_d * pyz;
+  pair(o[1], o[2], jx, ux, n_a * (pxx - t), 1, true);
+  pair(o[3], o[4], jy, uy, n_a * (pyy - t), 0, true);
+  pair(o[5], o[6], jz, uz, n_a * (pzz - t), 0, true);
+  pair(o[7], o[8], jx + jy, ux + uy, dxy + exy, 1, false);
+  pair(o[9], o[10], jx - jy, ux - uy, dxy - exy, 1, false);
+  pair(o[11], o[12], jx + jz, ux + uz, dxz + exz, 1, false);
+  pair(o[13], o[14], jx - jz, ux - uz, dxz - exz, 1, false);
+  pair(o[15], o[16], jy + jz, uy + uz, dyz + eyz, 0, false);
+  pair(o[17], o[18], jy - jz, uy - uz, dyz - eyz, 0, false);
 }
 
 }  // namespace lbm

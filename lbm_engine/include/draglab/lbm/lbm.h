@@ -397,11 +397,17 @@ RunResult run_with_fields(const arrays::VoxelGrid& grid, double phi_exact,
                           const ProgressCallback& progress = nullptr);
 
 /// Performance measurement (`draglab lbm bench`): medians of `repeat` interleaved runs (see
-/// src/bench.cc); working sets >= 4x the last-level cache. threads = 0: all.
+/// src/bench.cc); working sets >= 4x the last-level cache.
+struct BenchOptions {
+  int threads = 0;           ///< OpenMP threads (0: all).
+  int repeat = 5;            ///< Interleaved repetitions (median), [1, 100].
+  double packing_phi = 0.4;  ///< Solid fraction of the random packing, [0.1, 0.6].
+  bool IsValid(std::string* error) const;
+};
 struct BenchResult {
   double mflups = 0.0;                   ///< All-fluid periodic box (box_edge^3), double, TRT.
-  double mflups_fluid_packing = 0.0;     ///< Fluid-node updates/s on a phi = 0.4 random packing
-                                         ///< (TRT, interpolated bounce-back: the default scheme).
+  double mflups_fluid_packing = 0.0;     ///< Fluid-node updates/s on the random packing (d 16;
+                                         ///< TRT, interpolated bounce-back: the default scheme).
   double mflups_fluid_packing_bb = 0.0;  ///< Same packing, halfway bounce-back (no link pass).
   /// Fluid-node updates/s on RRZE lbm-benchmark-kernels' `blocks-8` geometry (100^3), with the
   /// interpolated path (q = 1/2 links) and with halfway bounce-back.
@@ -420,8 +426,9 @@ struct BenchResult {
   double last_level_cache_bytes = 0.0;
   std::int64_t box_edge = 0;
   int packing_spheres = 0;
+  double packing_phi = 0.0;
 };
-BenchResult benchmark(int threads = 0, int repeat = 5);
+BenchResult benchmark(const BenchOptions& options = BenchOptions());
 
 }  // namespace lbm
 }  // namespace draglab
