@@ -389,7 +389,19 @@ class Solver final : public SolverBase {
     if (settings.interpolated && settings.wall_correction > 0.0) {
       wall_state_.assign(links.size(), 0.0);
       wall_rate_ = std::min(kWallCorrectionRate, kWallCorrectionGain / settings.wall_correction);
+      wall_gain_ = wall_gains(links, settings.wall_correction);
     }
+  }
+
+  /// Per link, the factor of wall_correction()'s steady value (its division done once):
+  /// c0 / (1 + c0) on a link of a one-node gap, c / (1 + c/2) with c = (1 - b) c0 elsewhere.
+  static std::vector<double> wall_gains(const LinkTable& links, double c0) {
+    std::vector<double> gain(links.size());
+    for (std::size_t l = 0; l < gain.size(); ++l) {
+      const double c = (1.0 - links.weight_b[l]) * c0;
+      gain[l] = links.partner[l] >= 0 ? c0 / (1.0 + c0) : c / (1.0 + 0.5 * c);
+    }
+    return gain;
   }
 
   void set_force(double force_x) override {
@@ -562,7 +574,7 @@ class Solver final : public SolverBase {
   }
 
   std::size_t bytes() const override {
-    return populations_.bytes() + wall_state_.size() * sizeof(double);
+    return populations_.bytes() + (wall_state_.size() + wall_gain_.size()) * sizeof(double);
   }
   std::vector<StateSection> state() override {
     std::vector<StateSection> sections = {
@@ -932,24 +944,20 @@ class Solver final : public SolverBase {
   /// closure's value k = f + a (f_a - f) + b (f_b - f): relaxed by wall_rate_ per step
   /// towards its implicit steady value, which damps its feedback through the wall node's moments
   /// and leaves the steady state as it is. `update` false (a force-only pass) keeps the state.
+  /// The steady value, with c = (1 - b) c0: (k + c (h + g)) / (1 + c/2) - k = c (h + g - k/2) /
+  /// (1 + c/2), h = (f_a - f + f_b)/2; on a link of a one-node gap (both links of the line
+  /// halfway bounce-back, b = 0, solved together) c0 (f*_ib - f*_i + g) / (1 + c0).
   double wall_correction(std::int64_t l, double k, double f, double fa, double fb, const T* base,
                          const std::int64_t* out, bool update) {
     const LinkTable& L = links_;
-    const int q = L.direction[l];
+    const auto link = static_cast<std::size_t>(l);
+    const int q = L.direction[link];
     const double g = 3.0 * d3q19::weight(q) * kC[q][0] * settings_.force_x;
-    const double c0 = settings_.wall_correction;
-    const std::int64_t partner = L.partner[static_cast<std::size_t>(l)];
-    double target;
-    if (partner >= 0) {
-      // One-node gap: both links of the line are halfway bounce-back (b = 0); solved together,
-      // n- + g/2 = (f*_ib - f*_i + g) / (1 + c).
-      const double f_opposite = base[out[partner]];
-      target = c0 * (f_opposite - f + g) / (1.0 + c0);
-    } else {
-      const double c = (1.0 - L.weight_b[static_cast<std::size_t>(l)]) * c0;
-      target = (k + c * (0.5 * (fa - f + fb) + g)) / (1.0 + 0.5 * c) - k;
-    }
-    double& state = wall_state_[static_cast<std::size_t>(l)];
+    const std::int64_t partner = L.partner[link];
+    const double source =
+        partner >= 0 ? base[out[partner]] - f + g : 0.5 * (fa - f + fb) + g - 0.5 * k;
+    const double target = wall_gain_[link] * source;
+    double& state = wall_state_[link];
     const double next = state + wall_rate_ * (target - state);
     if (update) state = next;
     return next;
@@ -968,6 +976,7 @@ class Solver final : public SolverBase {
   std::vector<std::vector<double>> partial_force_;  ///< Per work range.
   std::vector<double> partial_defect_;              ///< Per work range.
   std::vector<double> wall_state_;  ///< Per link: rr's wall correction (empty: off).
+  std::vector<double> wall_gain_;   ///< Per link: see wall_gains().
   double wall_rate_ = kWallCorrectionRate;
   std::vector<SweepPlan> sweep_plans_;  ///< Per work range (one rank's whole box only).
   double pending_defect_ = 0.0;         ///< Net mass added by the last interpolation pass.
