@@ -1,7 +1,8 @@
 // Fast unit checks of the LBM engine core (lbm_engine/src): streaming and bounce-back against an
 // independent dense reference, the exact steady momentum balance, Stokes mode against the full
 // equilibrium at vanishing Re, mass conservation, the stability diagnoses (tau near 1/2, Mach
-// limit, step limit), target-Re control, float storage, and bad input.
+// limit, step limit), target-Re control, float storage, bad input, and the regularized collision
+// kernel against its textbook form (Latt & Chopard 2006 with Guo forcing, written out below).
 //
 // Set-ups: (a) small periodic boxes with random solid flags and the collision switched off
 // (omega = 0, no force), where the AA-pattern sweeps must reproduce plain streaming with
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "collision.h"
 #include "d3q19.h"
 #include "draglab/arrays/packing.h"
 #include "draglab/arrays/voxelization.h"
@@ -405,6 +407,67 @@ TEST(LbmEngineSmoke, GapTooSmallForResolutionIsBadInput) {
   }
 }
 
+/// The regularized kernel (written in pair form for speed) against the textbook form it must
+/// equal: f*_i = feq_i + (1 - omega) w_i (4.5 Q_i : Pi_neq - 1.5 c_i.G) + F_i, with the
+/// second-order equilibrium, Pi_neq = sum g c c - drho I/3 - j u, Q_i = c_i c_i - I/3 and Guo's
+/// F_i = (1 - omega/2) w_i (3 c_i.G + 9 (c_i.u)(c_i.G) - 3 u.G) (Stokes mode: the equilibrium and
+/// Pi_eq linear in j, F_i without its u terms). Random shifted populations; round-off tolerance.
+TEST(LbmEngineSmoke, RegularizedKernelIsItsTextbookForm) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> deviation(-0.02, 0.02);
+  for (double tau : {0.501, 0.6, 1.0, 1.7}) {
+    for (bool stokes : {false, true}) {
+      const double omega = 1.0 / tau, G = 3e-4;
+      KernelParams<double> p;
+      p.omega_plus = p.omega_minus = omega;
+      p.force_x = G;
+      p.force_even = p.force_odd = (1.0 - 0.5 * omega) * G;
+      double g[19], o[19];
+      for (double& v : g) v = deviation(rng);
+      if (stokes) {
+        collide_node<double, CollisionKernel::kRegularized, true>(g, o, p);
+      } else {
+        collide_node<double, CollisionKernel::kRegularized, false>(g, o, p);
+      }
+      double drho = 0.0, j[3] = {0.5 * G, 0.0, 0.0}, second[3][3] = {};
+      for (int i = 0; i < 19; ++i) {
+        drho += g[i];
+        for (int a = 0; a < 3; ++a) {
+          j[a] += g[i] * d3q19::kC[i][a];
+          for (int b = 0; b < 3; ++b) second[a][b] += g[i] * d3q19::kC[i][a] * d3q19::kC[i][b];
+        }
+      }
+      double u[3];
+      for (int a = 0; a < 3; ++a) u[a] = stokes ? j[a] : j[a] / (1.0 + drho);
+      double pi[3][3];
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) {
+          pi[a][b] = second[a][b] - (a == b ? drho / 3.0 : 0.0) - (stokes ? 0.0 : j[a] * u[b]);
+        }
+      }
+      const double ju = j[0] * u[0] + j[1] * u[1] + j[2] * u[2];
+      for (int i = 0; i < 19; ++i) {
+        SCOPED_TRACE("tau " + std::to_string(tau) + (stokes ? ", Stokes" : "") + ", i " +
+                     std::to_string(i));
+        const auto& c = d3q19::kC[i];
+        const double w = d3q19::weight(i);
+        const double cj = c[0] * j[0] + c[1] * j[1] + c[2] * j[2];
+        const double cu = c[0] * u[0] + c[1] * u[1] + c[2] * u[2];
+        const double feq = w * (drho + 3.0 * cj + (stokes ? 0.0 : 4.5 * cj * cu - 1.5 * ju));
+        double q_pi = 0.0;
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) q_pi += (c[a] * c[b] - (a == b ? 1.0 / 3.0 : 0.0)) * pi[a][b];
+        }
+        const double cG = c[0] * G;
+        const double guo =
+            (1.0 - 0.5 * omega) * w * (3.0 * cG + (stokes ? 0.0 : 9.0 * cu * cG - 3.0 * u[0] * G));
+        const double expected = feq + (1.0 - omega) * w * (4.5 * q_pi - 1.5 * cG) + guo;
+        EXPECT_NEAR(o[i], expected, 1e-15);
+      }
+    }
+  }
+}
+
 TEST(LbmEngineSmoke, OptionValidationAndNames) {
   RunOptions options;
   std::string error;
@@ -424,6 +487,14 @@ TEST(LbmEngineSmoke, OptionValidationAndNames) {
   }
   for (Precision p : {Precision::kDouble, Precision::kFloat}) {
     EXPECT_EQ(precision_from_string(to_string(p)), p);
+  }
+  BenchOptions bench;
+  EXPECT_TRUE(bench.IsValid(&error)) << error;
+  for (double phi : {0.05, 0.7, std::nan("")}) {
+    bench.packing_phi = phi;
+    EXPECT_FALSE(bench.IsValid(&error));
+    EXPECT_NE(error.find("solid fraction"), std::string::npos);
+    EXPECT_THROW(benchmark(bench), Error);
   }
   try {
     collision_from_string("mrt");
