@@ -1,8 +1,9 @@
 // The committed convergence in d of dense packings at Re 100 (data/datasets/dense_d_sweep_8/,
 // from the campaigns of data/campaigns/dense_d_sweep_8/: 8 spheres at phi 0.5 and 0.6, d 32, 48
-// and 64, one realization each): each file is the run of the committed spec it names (the spec
-// hash in its header is that spec's) and the drag converges in d (each refinement moves it less
-// than the one before). tests/lbm/committed_dense_sweep_test.cc checks the error model on it.
+// and 64, one realization each; and data/datasets/dense_d_sweep/, the 27-sphere packings of the
+// same phi): each file is the run of the committed spec it names (the spec hash in its header is
+// that spec's), and on 8 spheres the drag converges in d (each refinement moves it less than the
+// one before). tests/lbm/committed_dense_sweep_test.cc checks the error model on both.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,8 +23,8 @@ namespace draglab {
 namespace campaign {
 namespace {
 
-const std::string kSpecs = std::string(DRAGLAB_DATA_DIR) + "/campaigns/dense_d_sweep_8/";
-const std::string kData = std::string(DRAGLAB_DATA_DIR) + "/datasets/dense_d_sweep_8/";
+const std::string kCampaigns = std::string(DRAGLAB_DATA_DIR) + "/campaigns/";
+const std::string kDatasets = std::string(DRAGLAB_DATA_DIR) + "/datasets/";
 
 struct Unit {
   double phi = 0, re = 0, d = 0, F = NAN, estimate = NAN, steps = NAN;
@@ -89,14 +90,32 @@ std::vector<Unit> read_export(const std::string& path, std::string* spec_hash) {
   return units;
 }
 
-const std::vector<std::string> kParts = {"d32", "d48_re100", "d48_re300", "d64", "d64_re300"};
+/// One committed part: folder (under data/campaigns/ and data/datasets/) and name.
+struct Part {
+  std::string folder, name;
+  std::string spec() const { return kCampaigns + folder + "/" + name + ".toml"; }
+  std::string data() const { return kDatasets + folder + "/" + name + ".csv"; }
+  std::string label() const { return folder + "/" + name; }
+};
+const std::vector<Part> kParts8 = {{"dense_d_sweep_8", "d32"},
+                                   {"dense_d_sweep_8", "d48_re100"},
+                                   {"dense_d_sweep_8", "d48_re300"},
+                                   {"dense_d_sweep_8", "d64"},
+                                   {"dense_d_sweep_8", "d64_re300"}};
+const std::vector<Part> kParts27 = {{"dense_d_sweep", "d32"}, {"dense_d_sweep", "d48_re100"}};
+
+std::vector<Part> all_parts() {
+  std::vector<Part> parts = kParts8;
+  parts.insert(parts.end(), kParts27.begin(), kParts27.end());
+  return parts;
+}
 
 TEST(CommittedDenseSweep, EachFileIsTheRunOfItsCommittedSpec) {
-  for (const std::string& part : kParts) {
-    SCOPED_TRACE(part);
-    const CampaignSpec spec = parse_campaign_spec(kSpecs + part + ".toml");
+  for (const Part& part : all_parts()) {
+    SCOPED_TRACE(part.label());
+    const CampaignSpec spec = parse_campaign_spec(part.spec());
     std::string hash;
-    const std::vector<Unit> units = read_export(kData + part + ".csv", &hash);
+    const std::vector<Unit> units = read_export(part.data(), &hash);
     EXPECT_EQ(hash, sha256_hex(spec.to_json()));
     EXPECT_EQ(units.size(), spec.phi.size() * spec.re.size() * spec.resolutions.size());
     for (const Unit& u : units) {
@@ -111,9 +130,9 @@ TEST(CommittedDenseSweep, EachFileIsTheRunOfItsCommittedSpec) {
 
 TEST(CommittedDenseSweep, EachRefinementMovesTheDragLessThanTheOneBefore) {
   std::map<double, std::vector<Unit>> at_re100;  // phi -> runs
-  for (const std::string& part : kParts) {
+  for (const Part& part : kParts8) {
     std::string hash;
-    for (const Unit& u : read_export(kData + part + ".csv", &hash)) {
+    for (const Unit& u : read_export(part.data(), &hash)) {
       if (u.status == "done" && u.re == 100.0) at_re100[u.phi].push_back(u);
     }
   }
@@ -131,12 +150,13 @@ TEST(CommittedDenseSweep, EachRefinementMovesTheDragLessThanTheOneBefore) {
 // Re 300 units took 6 - 9 times the prediction. The factor 3 is the model's stated reach (the
 // 60 calibration units at Re <= 25 lay within 2.6).
 TEST(CommittedDenseSweep, ThePlansStepModelPredictsEveryRunWithinAFactorThree) {
-  for (const std::string& part : kParts) {
-    const CampaignSpec spec = parse_campaign_spec(kSpecs + part + ".toml");
+  for (const Part& part : all_parts()) {
+    const CampaignSpec spec = parse_campaign_spec(part.spec());
     std::string hash;
-    for (const Unit& u : read_export(kData + part + ".csv", &hash)) {
+    for (const Unit& u : read_export(part.data(), &hash)) {
       if (u.status != "done") continue;
-      SCOPED_TRACE(part + ": phi " + std::to_string(u.phi) + ", Re " + std::to_string(u.re));
+      SCOPED_TRACE(part.label() + ": phi " + std::to_string(u.phi) + ", Re " +
+                   std::to_string(u.re));
       EXPECT_EQ(lbm::expects_unsteady_flow(u.phi, u.re), u.re == 300.0);
       const double predicted =
           lbm::predicted_steps(u.phi, u.re, u.d, lbm::collision_from_string(spec.collision));
