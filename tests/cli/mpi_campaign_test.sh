@@ -81,7 +81,10 @@ setsid timeout -s KILL 300 "$mpirun" --enable-recovery -np 3 \
 job=$!
 pids_to_kill+=("$job")
 victim=""
-for _ in $(seq 1 600); do
+# Polled while the job lives (it is killed at 300 s): on a loaded machine the ranks may take
+# long to start, so no fixed wait shorter than the job's own limit.
+for _ in $(seq 1 3000); do
+  kill -0 "$job" 2>/dev/null || break
   # rank 2 holding a unit: its token ends in rank2
   running=$(sqlite3 "$work/kill.db" "SELECT count(*) FROM campaign_units WHERE status = 'running' AND \
 claimed_by LIKE '%:rank2'" 2>/dev/null || echo 0)
