@@ -49,35 +49,6 @@ struct KernelParams {
 
 namespace detail {
 
-/// One opposite pair (i, ib = opposite) with c_i = (CX, CY, CZ). For the TRT kernel.
-template <typename T, bool kStokes, int CX, int CY, int CZ>
-DRAGLAB_LBM_INLINE void trt_pair(T gi, T gib, T& oi, T& oib, T w, T drho, T jx, T jy, T jz, T ux,
-                                 T uy, T uz, T ju, const KernelParams<T>& p) {
-  const T cj = T(CX) * jx + T(CY) * jy + T(CZ) * jz;
-  const T gp = T(0.5) * (gi + gib);
-  const T gm = T(0.5) * (gi - gib);
-  T eqp, fp;
-  if (kStokes) {
-    eqp = w * drho;
-    fp = T(0);
-  } else {
-    const T cu = T(CX) * ux + T(CY) * uy + T(CZ) * uz;
-    eqp = w * (drho + T(4.5) * cj * cu - T(1.5) * ju);
-    fp = w * p.force_even * (T(9) * cu * T(CX) - T(3) * ux);
-  }
-  const T eqm = T(3) * w * cj;
-  const T fm = T(3) * w * p.force_odd * T(CX);
-  const T rp = p.omega_plus * (gp - eqp);
-  const T rm = p.omega_minus * (gm - eqm);
-  oi = gi - rp - rm + fp + fm;
-  oib = gib - rp + rm + fp - fm;
-}
-
-}  // namespace detail
-
-/// Collides one node: g[0..18] in (shifted, pre-collision), o[0..18] out (shifted,
-/// post-collision, o[i] is the population leaving along c_i).
-///
 /// TRT in pair form, arranged for few operations (about 170 per node, against about 230 for the
 /// textbook form): with S = g_i + g_ib and D = g_i - g_ib (which also give the moments),
 ///   o_i = g_i + P + M,  o_ib = g_ib + P - M,
@@ -85,85 +56,86 @@ DRAGLAB_LBM_INLINE void trt_pair(T gi, T gib, T& oi, T& oib, T w, T drho, T jx, 
 /// where omega+ eq+ + F+ = C_w + cu (4.5 omega+ w c.j + 9 w (1 - omega+/2) G_x c_x), C_w =
 /// w (omega+ (drho - 1.5 j.u) - 3 (1 - omega+/2) G_x u_x) per weight class, and omega- eq- + F- =
 /// 3 w (omega- c.j + (1 - omega-/2) G_x c_x).
-template <typename T, CollisionKernel K, bool kStokes>
-DRAGLAB_LBM_INLINE void collide_node(const T (&g)[19], T (&o)[19], const KernelParams<T>& p) {
+template <typename T, bool kStokes>
+DRAGLAB_LBM_INLINE void collide_trt(const T (&g)[19], T (&o)[19], const KernelParams<T>& p) {
   constexpr T w0 = T(d3q19::kW0), wa = T(d3q19::kWAxis), wd = T(d3q19::kWDiag);
-  if (K == CollisionKernel::kTrt) {
-    const T s12 = g[1] + g[2], s34 = g[3] + g[4], s56 = g[5] + g[6], s78 = g[7] + g[8];
-    const T s910 = g[9] + g[10], s1112 = g[11] + g[12], s1314 = g[13] + g[14];
-    const T s1516 = g[15] + g[16], s1718 = g[17] + g[18];
-    const T d12 = g[1] - g[2], d34 = g[3] - g[4], d56 = g[5] - g[6], d78 = g[7] - g[8];
-    const T d910 = g[9] - g[10], d1112 = g[11] - g[12], d1314 = g[13] - g[14];
-    const T d1516 = g[15] - g[16], d1718 = g[17] - g[18];
-    const T drho =
-        ((g[0] + s12) + (s34 + s56)) + ((s78 + s910) + (s1112 + s1314)) + (s1516 + s1718);
-    const T jx = (d12 + d78) + (d910 + d1112) + d1314 + T(0.5) * p.force_x;
-    const T jy = (d34 + d78) - d910 + (d1516 + d1718);
-    const T jz = (d56 + d1112) - d1314 + (d1516 - d1718);
-    const T hp = T(-0.5) * p.omega_plus, hm = T(-0.5) * p.omega_minus;
-    // Odd parts: M = hm D + 3 w (omega- c.j + F-odd c_x).
-    const T wm_a = T(3) * wa * p.omega_minus, wm_d = T(3) * wd * p.omega_minus;
-    const T fo_a = T(3) * wa * p.force_odd, fo_d = T(3) * wd * p.force_odd;
-    // Diagonal combinations of j.
-    const T jxy_p = jx + jy, jxy_m = jx - jy, jxz_p = jx + jz, jxz_m = jx - jz;
-    const T jyz_p = jy + jz, jyz_m = jy - jz;
-    T c_a, c_d;  // C_w per weight class
-    T k_a, k_d;  // 4.5 omega+ w (multiplies (c.j)(c.u))
-    T f_a, f_d;  // 9 w (1 - omega+/2) G_x (multiplies c_x (c.u))
-    T ux = 0, uy = 0, uz = 0;
-    if (kStokes) {
-      c_a = p.omega_plus * wa * drho;
-      c_d = p.omega_plus * wd * drho;
-      o[0] = g[0] + p.omega_plus * (w0 * drho - g[0]);
-      k_a = k_d = f_a = f_d = T(0);
-    } else {
-      const T inv_rho = T(1) / (T(1) + drho);
-      ux = jx * inv_rho;
-      uy = jy * inv_rho;
-      uz = jz * inv_rho;
-      const T ju = jx * ux + jy * uy + jz * uz;
-      const T a = p.omega_plus * (drho - T(1.5) * ju) - T(3) * p.force_even * ux;
-      c_a = wa * a;
-      c_d = wd * a;
-      o[0] = g[0] - p.omega_plus * g[0] + w0 * a;
-      k_a = T(4.5) * wa * p.omega_plus;
-      k_d = T(4.5) * wd * p.omega_plus;
-      f_a = T(9) * wa * p.force_even;
-      f_d = T(9) * wd * p.force_even;
-    }
-    // One pair: cj = c.j, cu = c.u, cx = c_x (0 or +-1, compile-time), S, D.
-    auto pair = [&](T gi, T gib, T & oi, T & oib, T cj, T cu, int cx, bool axis)
-        __attribute__((always_inline)) {
-      const T S = gi + gib, D = gi - gib;
-      T q = axis ? c_a : c_d;
-      if (!kStokes) {
-        q += (axis ? k_a : k_d) * cj * cu;
-        if (cx != 0) q += (axis ? f_a : f_d) * T(cx) * cu;
-      }
-      const T P = hp * S + q;
-      T r = (axis ? wm_a : wm_d) * cj;
-      if (cx != 0) r += (axis ? fo_a : fo_d) * T(cx);
-      const T M = hm * D + r;
-      oi = gi + P + M;
-      oib = gib + P - M;
-    };
-    pair(g[1], g[2], o[1], o[2], jx, ux, 1, true);
-    pair(g[3], g[4], o[3], o[4], jy, uy, 0, true);
-    pair(g[5], g[6], o[5], o[6], jz, uz, 0, true);
-    pair(g[7], g[8], o[7], o[8], jxy_p, ux + uy, 1, false);
-    pair(g[9], g[10], o[9], o[10], jxy_m, ux - uy, 1, false);
-    pair(g[11], g[12], o[11], o[12], jxz_p, ux + uz, 1, false);
-    pair(g[13], g[14], o[13], o[14], jxz_m, ux - uz, 1, false);
-    pair(g[15], g[16], o[15], o[16], jyz_p, uy + uz, 0, false);
-    pair(g[17], g[18], o[17], o[18], jyz_m, uy - uz, 0, false);
-    (void)s56;
-    return;
+  const T s12 = g[1] + g[2], s34 = g[3] + g[4], s56 = g[5] + g[6], s78 = g[7] + g[8];
+  const T s910 = g[9] + g[10], s1112 = g[11] + g[12], s1314 = g[13] + g[14];
+  const T s1516 = g[15] + g[16], s1718 = g[17] + g[18];
+  const T d12 = g[1] - g[2], d34 = g[3] - g[4], d56 = g[5] - g[6], d78 = g[7] - g[8];
+  const T d910 = g[9] - g[10], d1112 = g[11] - g[12], d1314 = g[13] - g[14];
+  const T d1516 = g[15] - g[16], d1718 = g[17] - g[18];
+  const T drho = ((g[0] + s12) + (s34 + s56)) + ((s78 + s910) + (s1112 + s1314)) + (s1516 + s1718);
+  const T jx = (d12 + d78) + (d910 + d1112) + d1314 + T(0.5) * p.force_x;
+  const T jy = (d34 + d78) - d910 + (d1516 + d1718);
+  const T jz = (d56 + d1112) - d1314 + (d1516 - d1718);
+  const T hp = T(-0.5) * p.omega_plus, hm = T(-0.5) * p.omega_minus;
+  // Odd parts: M = hm D + 3 w (omega- c.j + F-odd c_x).
+  const T wm_a = T(3) * wa * p.omega_minus, wm_d = T(3) * wd * p.omega_minus;
+  const T fo_a = T(3) * wa * p.force_odd, fo_d = T(3) * wd * p.force_odd;
+  // Diagonal combinations of j.
+  const T jxy_p = jx + jy, jxy_m = jx - jy, jxz_p = jx + jz, jxz_m = jx - jz;
+  const T jyz_p = jy + jz, jyz_m = jy - jz;
+  T c_a, c_d;  // C_w per weight class
+  T k_a, k_d;  // 4.5 omega+ w (multiplies (c.j)(c.u))
+  T f_a, f_d;  // 9 w (1 - omega+/2) G_x (multiplies c_x (c.u))
+  T ux = 0, uy = 0, uz = 0;
+  if (kStokes) {
+    c_a = p.omega_plus * wa * drho;
+    c_d = p.omega_plus * wd * drho;
+    o[0] = g[0] + p.omega_plus * (w0 * drho - g[0]);
+    k_a = k_d = f_a = f_d = T(0);
+  } else {
+    const T inv_rho = T(1) / (T(1) + drho);
+    ux = jx * inv_rho;
+    uy = jy * inv_rho;
+    uz = jz * inv_rho;
+    const T ju = jx * ux + jy * uy + jz * uz;
+    const T a = p.omega_plus * (drho - T(1.5) * ju) - T(3) * p.force_even * ux;
+    c_a = wa * a;
+    c_d = wd * a;
+    o[0] = g[0] - p.omega_plus * g[0] + w0 * a;
+    k_a = T(4.5) * wa * p.omega_plus;
+    k_d = T(4.5) * wd * p.omega_plus;
+    f_a = T(9) * wa * p.force_even;
+    f_d = T(9) * wd * p.force_even;
   }
-  // Regularized, in the same pair form: with the node scalar A = drho - 1.5 j.u - 3 F+ u_x
-  // (F+ = (1 - omega+/2) G_x) and, per weight class, n_w = 4.5 w (1 - omega+),
-  //   o_i = P + M,  o_ib = P - M,
-  //   P = w A + cu (4.5 w c.j + 9 w F+ c_x) + n_w Q_i : Pi_neq,
-  //   M = 3 w c.j + c_x w (3 F- - 1.5 (1 - omega+) G_x)      (F- = (1 - omega-/2) G_x).
+  // One pair: cj = c.j, cu = c.u, cx = c_x (0 or +-1, compile-time), S, D.
+  auto pair = [&](T gi, T gib, T & oi, T & oib, T cj, T cu, int cx, bool axis)
+      __attribute__((always_inline)) {
+    const T S = gi + gib, D = gi - gib;
+    T q = axis ? c_a : c_d;
+    if (!kStokes) {
+      q += (axis ? k_a : k_d) * cj * cu;
+      if (cx != 0) q += (axis ? f_a : f_d) * T(cx) * cu;
+    }
+    const T P = hp * S + q;
+    T r = (axis ? wm_a : wm_d) * cj;
+    if (cx != 0) r += (axis ? fo_a : fo_d) * T(cx);
+    const T M = hm * D + r;
+    oi = gi + P + M;
+    oib = gib + P - M;
+  };
+  pair(g[1], g[2], o[1], o[2], jx, ux, 1, true);
+  pair(g[3], g[4], o[3], o[4], jy, uy, 0, true);
+  pair(g[5], g[6], o[5], o[6], jz, uz, 0, true);
+  pair(g[7], g[8], o[7], o[8], jxy_p, ux + uy, 1, false);
+  pair(g[9], g[10], o[9], o[10], jxy_m, ux - uy, 1, false);
+  pair(g[11], g[12], o[11], o[12], jxz_p, ux + uz, 1, false);
+  pair(g[13], g[14], o[13], o[14], jxz_m, ux - uz, 1, false);
+  pair(g[15], g[16], o[15], o[16], jyz_p, uy + uz, 0, false);
+  pair(g[17], g[18], o[17], o[18], jyz_m, uy - uz, 0, false);
+}
+
+/// Regularized, in the same pair form: with the node scalar A = drho - 1.5 j.u - 3 F+ u_x
+/// (F+ = (1 - omega+/2) G_x) and, per weight class, n_w = 4.5 w (1 - omega+),
+///   o_i = P + M,  o_ib = P - M,
+///   P = w A + cu (4.5 w c.j + 9 w F+ c_x) + n_w Q_i : Pi_neq,
+///   M = 3 w c.j + c_x w (3 F- - 1.5 (1 - omega+) G_x)      (F- = (1 - omega-/2) G_x).
+template <typename T, bool kStokes>
+DRAGLAB_LBM_INLINE void collide_regularized(const T (&g)[19], T (&o)[19],
+                                            const KernelParams<T>& p) {
+  constexpr T w0 = T(d3q19::kW0), wa = T(d3q19::kWAxis), wd = T(d3q19::kWDiag);
   const T s12 = g[1] + g[2], s34 = g[3] + g[4], s56 = g[5] + g[6], s78 = g[7] + g[8];
   const T s910 = g[9] + g[10], s1112 = g[11] + g[12], s1314 = g[13] + g[14];
   const T s1516 = g[15] + g[16], s1718 = g[17] + g[18];
@@ -228,6 +200,19 @@ DRAGLAB_LBM_INLINE void collide_node(const T (&g)[19], T (&o)[19], const KernelP
   pair(o[13], o[14], jx - jz, ux - uz, dxz - exz, 1, false);
   pair(o[15], o[16], jy + jz, uy + uz, dyz + eyz, 0, false);
   pair(o[17], o[18], jy - jz, uy - uz, dyz - eyz, 0, false);
+}
+
+}  // namespace detail
+
+/// Collides one node: g[0..18] in (shifted, pre-collision), o[0..18] out (shifted,
+/// post-collision, o[i] is the population leaving along c_i).
+template <typename T, CollisionKernel K, bool kStokes>
+DRAGLAB_LBM_INLINE void collide_node(const T (&g)[19], T (&o)[19], const KernelParams<T>& p) {
+  if constexpr (K == CollisionKernel::kTrt) {
+    detail::collide_trt<T, kStokes>(g, o, p);
+  } else {
+    detail::collide_regularized<T, kStokes>(g, o, p);
+  }
 }
 
 }  // namespace lbm
