@@ -159,9 +159,11 @@ void print_dataset_table(const Dataset& d) {
 }
 
 /// Builds the dataset of a campaign, printing what was left out; returns it.
-Dataset build_and_report(const CliContext& ctx, Database& db, std::int64_t campaign_id) {
+Dataset build_and_report(const CliContext& ctx, Database& db,
+                         const std::vector<std::int64_t>& campaign_ids,
+                         const campaign::BuildDatasetOptions& options = {}) {
   std::vector<std::string> skipped;
-  const Dataset d = campaign::build_dataset(db, campaign_id, &skipped);
+  const Dataset d = campaign::build_dataset(db, campaign_ids, options, &skipped);
   for (const auto& s : skipped) ctx.warn("dataset: left out " + s);
   const auto method = nlohmann::json::parse(d.method, nullptr, false);
   if (method.is_object() && method.contains("notes")) {
@@ -188,7 +190,9 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
   }
   const int jobs =
       c.jobs > 0 ? c.jobs : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
-  if (c.node_update_ns == 0.0) ctx.info("campaign plan: timing the engine on this machine (~1 s)");
+  if (c.node_update_ns == 0.0) {
+    ctx.info("campaign plan: timing the engine on this machine (~2 s: TRT and rr)");
+  }
   const campaign::CampaignPlan plan = campaign::plan_campaign(spec, jobs, c.node_update_ns * 1e-9);
   if (ctx.json) {
     nlohmann::json points = nlohmann::json::array();
@@ -211,6 +215,7 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                     {"units", plan.units},
                     {"jobs", plan.jobs},
                     {"node_update_seconds", plan.node_update_seconds},
+                    {"rr_node_update_seconds", plan.rr_node_update_seconds},
                     {"core_seconds", plan.core_seconds},
                     {"wall_seconds", plan.wall_seconds},
                     {"largest_unit_memory_bytes", plan.largest_unit_memory_bytes},
@@ -273,10 +278,12 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
   };
   const std::string db_path = ctx.resolved_db_path();
   ctx.info(fmt::format(
-      "campaign {}: {} phi x {} Re x {} realizations x {} resolutions = {} units "
-      "(database {})",
-      spec.name, spec.phi.size(), spec.re.size(), spec.realizations, spec.resolutions.size(),
-      spec.phi.size() * spec.re.size() * spec.realizations * spec.resolutions.size(), db_path));
+      "campaign {}: {} phi x {} Re x {} realizations x {} = {} units (database {})", spec.name,
+      spec.phi.size(), spec.re.size(), spec.realizations,
+      spec.resolution_rule ? fmt::format("each point's resolutions (the rule, d {} to {})",
+                                         spec.min_resolution, spec.max_resolution)
+                           : fmt::format("{} resolutions", spec.resolutions.size()),
+      spec.unit_count(), db_path));
   if (distributed) {
     ctx.info(fmt::format("MPI: {} ranks; rank 0 ({}) holds the database, ranks 1..{} run the units",
                          mpi::size(), mpi::host_name(), mpi::size() - 1));
@@ -304,7 +311,7 @@ void run_campaign_command(const CliContext& ctx, const RunCommand& c) {
   j["session"] = nlohmann::json::parse(st.session.ToJson());
   std::unique_ptr<Database> db = ctx.open_database();
   if (st.units_pending + st.units_running == 0 && st.units_done > 0) {
-    const Dataset d = build_and_report(ctx, *db, st.id);
+    const Dataset d = build_and_report(ctx, *db, {st.id});
     j["dataset_id"] = d.id;
     j["dataset_hash"] = d.hash;
     j["dataset_points"] = d.points.size();
@@ -402,15 +409,29 @@ void run_export(const CliContext& ctx, const ExportCommand& c) {
   ctx.info(fmt::format("wrote {} units of campaign {} to {}", units.count, st.name, c.out));
 }
 
-void run_dataset_build(const CliContext& ctx, const std::string& id) {
-  std::unique_ptr<Database> db = ctx.open_database();
-  const campaign::CampaignStatus st = campaign::campaign_status(*db, id);
-  if (st.units_pending + st.units_running > 0) {
-    ctx.warn(fmt::format("campaign {} has {} units not run yet: the dataset uses the {} finished",
-                         st.name, st.units_pending + st.units_running,
-                         st.units_done + st.units_failed));
+struct DatasetBuildCommand {
+  std::vector<std::string> campaigns;
+  campaign::BuildDatasetOptions options;
+};
+
+void run_dataset_build(const CliContext& ctx, const DatasetBuildCommand& c) {
+  if (c.campaigns.size() > 1 && c.options.name.empty()) {
+    throw UsageError(
+        "dataset build: several campaigns (the parts of one grid) make one dataset: name it with "
+        "--name");
   }
-  const Dataset d = build_and_report(ctx, *db, st.id);
+  std::unique_ptr<Database> db = ctx.open_database();
+  std::vector<std::int64_t> ids;
+  for (const std::string& id : c.campaigns) {
+    const campaign::CampaignStatus st = campaign::campaign_status(*db, id);
+    if (st.units_pending + st.units_running > 0) {
+      ctx.warn(fmt::format("campaign {} has {} units not run yet: the dataset uses the {} finished",
+                           st.name, st.units_pending + st.units_running,
+                           st.units_done + st.units_failed));
+    }
+    ids.push_back(st.id);
+  }
+  const Dataset d = build_and_report(ctx, *db, ids, c.options);
   if (ctx.json) {
     ctx.print_json(dataset_json(d, true));
   } else {
@@ -552,7 +573,8 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
     cmd->add_option("--jobs", o->jobs, "Workers the prediction assumes (0 = all cores)")
         ->capture_default_str();
     cmd->add_option("--node-update-ns", o->node_update_ns,
-                    "Time per fluid-node update on one core, ns (0 = measure it here, ~1 s)")
+                    "Time per fluid-node update on one core, ns, for every operator (0 = measure "
+                    "TRT's and rr's here, ~2 s)")
         ->capture_default_str();
     cmd->footer(
         "Prediction: fluid nodes x the engine's step model (lbm::predicted_steps) x the\n"
@@ -594,12 +616,18 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
       "  draglab dataset show 3f2a9c --json\n  draglab dataset export 3f2a9c --out quick.csv\n"
       "  draglab dataset import my_dns.csv");
   {
-    auto* cmd = dataset->add_subcommand("build",
-                                        "Build (and store) a campaign's dataset from its "
-                                        "finished units");
-    auto id = std::make_shared<std::string>();
-    cmd->add_option("campaign", *id, "Campaign id or name")->required();
-    cmd->callback([&ctx, id] { ctx.action = [&ctx, id] { run_dataset_build(ctx, *id); }; });
+    auto* cmd = dataset->add_subcommand(
+        "build",
+        "Build (and store) a dataset from the finished units of a campaign, or of several "
+        "campaigns that are parts of one grid");
+    auto o = std::make_shared<DatasetBuildCommand>();
+    cmd->add_option("campaign", o->campaigns, "Campaign ids or names (one, or the parts)")
+        ->required();
+    cmd->add_option("--name", o->options.name,
+                    "Name of the dataset (required for several campaigns)");
+    cmd->add_flag("--allow-mixed-code", o->options.allow_mixed_code,
+                  "Accept units computed by several code versions (the dataset records them)");
+    cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_dataset_build(ctx, *o); }; });
   }
   {
     auto* cmd = dataset->add_subcommand("list", "List datasets, newest first");

@@ -289,7 +289,7 @@ std::int64_t find_campaign(const Database& db, const std::string& name, std::str
 /// One unit to create, with its cost estimate (creation order: most expensive first).
 struct PlannedUnit {
   int phi_index, re_index, realization, resolution_index;
-  double cost;
+  double resolution, cost;
 };
 
 std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::string& spec_json,
@@ -297,11 +297,12 @@ std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::
   std::vector<PlannedUnit> plan;
   for (int i = 0; i < static_cast<int>(spec.phi.size()); ++i) {
     for (int j = 0; j < static_cast<int>(spec.re.size()); ++j) {
+      const std::vector<double> resolutions = spec.point_resolutions(spec.phi[i], spec.re[j]);
       for (int r = 0; r < spec.realizations; ++r) {
-        for (int k = 0; k < static_cast<int>(spec.resolutions.size()); ++k) {
+        for (int k = 0; k < static_cast<int>(resolutions.size()); ++k) {
+          const double d = resolutions[k];
           plan.push_back(
-              {i, j, r, k,
-               internal::unit_cost_estimate(spec, spec.phi[i], spec.re[j], spec.resolutions[k])});
+              {i, j, r, k, d, internal::unit_cost_estimate(spec, spec.phi[i], spec.re[j], d)});
         }
       }
     }
@@ -324,7 +325,7 @@ std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::
     u.reset();
     u.bind(1, id).bind(2, p.phi_index).bind(3, p.re_index).bind(4, p.realization);
     u.bind(5, p.resolution_index).bind(6, spec.phi[p.phi_index]).bind(7, spec.re[p.re_index]);
-    u.bind(8, spec.resolutions[p.resolution_index]);
+    u.bind(8, p.resolution);
     u.bind(9, static_cast<std::int64_t>(
                   internal::packing_seed(spec.seed, p.phi_index, p.realization)));
     u.run();
@@ -335,11 +336,15 @@ std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::
 
 /// Memory of the largest unit times the workers, against the machine: refused before any work.
 void check_memory(const CampaignSpec& spec, int workers) {
-  const double d = *std::max_element(spec.resolutions.begin(), spec.resolutions.end());
-  double nodes = 0.0;
+  double nodes = 0.0, d = 0.0;
   for (double phi : spec.phi) {
     const int n = internal::packing_options(spec, phi, 1).n;
-    nodes = std::max(nodes, std::pow(std::cbrt(n * M_PI / (6.0 * phi)) * d, 3));
+    for (double re : spec.re) {
+      for (double point_d : spec.point_resolutions(phi, re)) {
+        const double point_nodes = std::pow(std::cbrt(n * M_PI / (6.0 * phi)) * point_d, 3);
+        if (point_nodes > nodes) nodes = point_nodes, d = point_d;
+      }
+    }
   }
   const double bytes =
       lbm::estimated_run_bytes(nodes, lbm::precision_from_string(spec.precision)) * workers;

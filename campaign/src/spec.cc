@@ -1,4 +1,5 @@
 // Campaign specs: TOML parsing (toml++), validation, canonical JSON (docs/campaigns.md).
+#include <algorithm>
 #include <cctype>
 #include <climits>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "draglab/core/files.h"
 #include "draglab/core/toml_schema.h"
 #include "draglab/lbm/lbm.h"
+#include "draglab/lbm/resolution.h"
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
@@ -27,6 +29,8 @@ constexpr double kMinPhi = 0.05, kMaxPhi = 0.6;
 constexpr double kMaxRe = 1000.0;
 using lbm::kMaxResolution;
 using lbm::kMinResolution;
+/// With resolutions = "rule", a point beyond max_resolution also runs at max_resolution / this.
+constexpr double kRuleCoarseRatio = 1.5;
 
 using core::format_number;
 
@@ -43,8 +47,8 @@ const core::toml_schema::Schema& sections() {
       {"packing",
        {"spheres", "box_size", "distribution", "size_ratio", "large_fraction", "sigma", "min_gap"}},
       {"lbm",
-       {"resolutions", "collision", "boundary", "tolerance", "max_steps", "precision",
-        "ranks_per_unit"}},
+       {"resolutions", "min_resolution", "max_resolution", "collision", "boundary", "tolerance",
+        "max_steps", "precision", "ranks_per_unit"}},
       {"dataset", {"extrapolation"}},
   };
   return s;
@@ -127,8 +131,28 @@ bool CampaignSpec::IsValid(std::string* error) const {
     return fail(error, "[packing] min_gap = " + format_number(min_gap) +
                            " is outside [0, 0.5] diameters (0 = no forced gap)");
   }
-  if (!check_list(resolutions, "[lbm] resolutions", kMinResolution, kMaxResolution,
-                  "lattice units per diameter", error)) {
+  if (resolution_rule) {
+    if (!resolutions.empty()) {
+      return fail(error, "[lbm] resolutions = \"rule\" leaves the list of resolutions empty");
+    }
+    if (!(min_resolution >= kMinResolution && min_resolution <= kMaxResolution)) {
+      return fail(error, "[lbm] min_resolution = " + format_number(min_resolution) +
+                             " is outside [" + format_number(kMinResolution) + ", " +
+                             format_number(kMaxResolution) + "] lattice units per diameter");
+    }
+    if (!(max_resolution >= min_resolution && max_resolution <= kMaxResolution)) {
+      return fail(error, "[lbm] max_resolution = " + format_number(max_resolution) +
+                             " is outside [min_resolution = " + format_number(min_resolution) +
+                             ", " + format_number(kMaxResolution) + "] lattice units per diameter");
+    }
+    if (max_resolution / kRuleCoarseRatio < kMinResolution) {
+      return fail(error, "[lbm] max_resolution = " + format_number(max_resolution) +
+                             " leaves no coarser resolution for the points the rule cannot "
+                             "promise (it needs >= " +
+                             format_number(kMinResolution * kRuleCoarseRatio) + ")");
+    }
+  } else if (!check_list(resolutions, "[lbm] resolutions", kMinResolution, kMaxResolution,
+                         "lattice units per diameter", error)) {
     return false;
   }
   if (collision != "auto" && collision != "trt" && collision != "bgk" && collision != "rr") {
@@ -156,7 +180,7 @@ bool CampaignSpec::IsValid(std::string* error) const {
     return fail(error, "[dataset] extrapolation = '" + extrapolation +
                            "' is not one of richardson, inverse_d, finest");
   }
-  if (extrapolation != "finest" && resolutions.size() < 2) {
+  if (!resolution_rule && extrapolation != "finest" && resolutions.size() < 2) {
     return fail(error, "[dataset] extrapolation = '" + extrapolation +
                            "' needs at least 2 [lbm] resolutions (3 for the measured order of "
                            "richardson); with one resolution use extrapolation = \"finest\"");
@@ -208,6 +232,41 @@ bool CampaignSpec::IsValid(std::string* error) const {
   return true;
 }
 
+std::vector<double> CampaignSpec::point_resolutions(double point_phi, double point_re) const {
+  if (!resolution_rule) {
+    std::vector<double> d = resolutions;
+    std::sort(d.begin(), d.end());
+    return d;
+  }
+  const auto even_above = [](double d) { return 2.0 * std::ceil(d / 2.0 - 1e-9); };
+  const lbm::ResolutionNeed need =
+      lbm::resolution_needed(point_phi, point_re, lbm::collision_from_string(collision));
+  const double d = std::max(min_resolution, even_above(need.d));
+  if (d <= max_resolution) return {d};
+  // Beyond what the spec affords: the finest it affords and a coarser one, to extrapolate from.
+  return {std::max(kMinResolution, even_above(max_resolution / kRuleCoarseRatio)), max_resolution};
+}
+
+double CampaignSpec::largest_resolution() const {
+  double largest = 0.0;
+  for (double p : phi) {
+    for (double r : re) {
+      for (double d : point_resolutions(p, r)) largest = std::max(largest, d);
+    }
+  }
+  return largest;
+}
+
+std::int64_t CampaignSpec::unit_count() const {
+  std::int64_t units = 0;
+  for (double p : phi) {
+    for (double r : re) {
+      units += static_cast<std::int64_t>(point_resolutions(p, r).size()) * realizations;
+    }
+  }
+  return units;
+}
+
 std::string CampaignSpec::to_json() const {
   // nlohmann's object keys are sorted and doubles print in shortest round-trip form: the text,
   // and so the spec hash, is canonical.
@@ -230,6 +289,11 @@ std::string CampaignSpec::to_json() const {
         {"max_steps", max_steps}}},
       {"dataset", {{"extrapolation", extrapolation}}},
   };
+  if (resolution_rule) {
+    j["lbm"]["resolutions"] = "rule";
+    j["lbm"]["min_resolution"] = min_resolution;
+    j["lbm"]["max_resolution"] = max_resolution;
+  }
   // Written only where it changes what a unit computes: older specs keep their text and hash.
   if (precision != "double") j["lbm"]["precision"] = precision;
   return j.dump();
@@ -253,7 +317,13 @@ CampaignSpec internal::spec_from_json(const std::string& text) {
   s.sigma = p.at("sigma").get<double>();
   s.min_gap = p.at("min_gap").get<double>();
   const auto& l = j.at("lbm");
-  s.resolutions = l.at("resolutions").get<std::vector<double>>();
+  if (l.at("resolutions").is_string()) {
+    s.resolution_rule = true;
+    s.min_resolution = l.at("min_resolution").get<double>();
+    s.max_resolution = l.at("max_resolution").get<double>();
+  } else {
+    s.resolutions = l.at("resolutions").get<std::vector<double>>();
+  }
   s.collision = l.at("collision").get<std::string>();
   s.boundary = l.at("boundary").get<std::string>();
   s.tolerance = l.at("tolerance").get<double>();
@@ -309,7 +379,20 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
     if (id == "packing.large_fraction") s.large_fraction = number();
     if (id == "packing.sigma") s.sigma = number();
     if (id == "packing.min_gap") s.min_gap = number();
-    if (id == "lbm.resolutions") s.resolutions = numbers();
+    if (id == "lbm.resolutions") {
+      if (node.is_string()) {
+        if (text() != "rule") {
+          bad(field + " = \"" + text() +
+              "\" is neither a list of resolutions nor \"rule\" (each point's d from the "
+              "engine's resolution rule)");
+        }
+        s.resolution_rule = true;
+      } else {
+        s.resolutions = numbers();
+      }
+    }
+    if (id == "lbm.min_resolution") s.min_resolution = number();
+    if (id == "lbm.max_resolution") s.max_resolution = number();
     if (id == "lbm.collision") s.collision = text();
     if (id == "lbm.boundary") s.boundary = text();
     if (id == "lbm.tolerance") s.tolerance = number();
@@ -338,6 +421,10 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
       const std::size_t dot = id.find('.');
       bad(origin + ": [" + id.substr(0, dot) + "] " + id.substr(dot + 1) + " is required");
     }
+  }
+  if (!s.resolution_rule &&
+      (given.count("lbm.min_resolution") || given.count("lbm.max_resolution"))) {
+    bad(origin + ": [lbm] min_resolution and max_resolution apply only to resolutions = \"rule\"");
   }
   if (given.count("packing.spheres") && given.count("packing.box_size")) {
     bad(origin + ": [packing] spheres and box_size contradict each other: give one of them");

@@ -238,3 +238,150 @@ TEST_F(SyntheticCampaign, ExportHoldsEveryUnitInOrderAtFullPrecision) {
 }  // namespace
 }  // namespace campaign
 }  // namespace draglab
+
+namespace draglab {
+namespace campaign {
+namespace {
+
+/// Campaigns that are parts of one grid (slices of phi), with unit rows written by hand.
+class DatasetParts : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    db_path_ = dir_.file("parts.db");
+    DatabaseOptions o;
+    o.seed_literature = false;
+    db_ = std::make_unique<Database>(db_path_, o);
+  }
+  static CampaignSpec slice(const std::string& name, std::vector<double> phi) {
+    CampaignSpec s;
+    s.name = name;
+    s.phi = std::move(phi);
+    s.re = {0.0};
+    s.realizations = 2;
+    s.resolutions = {8, 16};
+    s.extrapolation = "inverse_d";
+    return s;
+  }
+  std::int64_t add(const CampaignSpec& spec) {
+    db::Statement c(db_->handle(),
+                    "INSERT INTO campaigns (name, spec_json, spec_hash, created_at, code_version) "
+                    "VALUES (?, ?, ?, 't', 'v')");
+    c.bind(1, spec.name).bind(2, spec.to_json()).bind(3, "hash-" + spec.name).run();
+    return sqlite3_last_insert_rowid(db_->handle());
+  }
+  /// Every unit of `spec` done, F(d) = F_inf(phi) (1 + 1/d) + 0.1 realization, by `version`.
+  void finish(std::int64_t id, const CampaignSpec& spec, const std::string& version) {
+    for (std::size_t i = 0; i < spec.phi.size(); ++i) {
+      for (int r = 0; r < spec.realizations; ++r) {
+        for (std::size_t k = 0; k < spec.resolutions.size(); ++k) {
+          const double d = spec.resolutions[k];
+          db::Statement s(
+              db_->handle(),
+              "INSERT INTO campaign_units (campaign_id, phi_index, re_index, "
+              "realization, resolution_index, phi, re_target, resolution, seed, status, "
+              "F, re, error_estimate, wall_s, converged, code_version, claimed_by) "
+              "VALUES (?, ?, 0, ?, ?, ?, 0, ?, 1, 'done', ?, 0, 0.01, 2.0, 1, ?, "
+              "'host-a:12:0')");
+          s.bind(1, id).bind(2, static_cast<int>(i)).bind(3, r).bind(4, static_cast<int>(k));
+          s.bind(5, spec.phi[i]).bind(6, d);
+          s.bind(7, (10.0 * spec.phi[i] + 0.1 * r) * (1.0 + 1.0 / d));
+          s.bind(8, version);
+          s.run();
+        }
+      }
+    }
+  }
+  /// The message of the Error(kInvalidArgument) that building from `ids` throws ("" if none).
+  std::string refusal(const std::vector<std::int64_t>& ids, const BuildDatasetOptions& o) {
+    try {
+      build_dataset(*db_, ids, o);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::kInvalidArgument) << e.what();
+      return e.what();
+    }
+    return "";
+  }
+  campaign_test::TempDir dir_;
+  std::string db_path_;
+  std::unique_ptr<Database> db_;
+};
+
+TEST_F(DatasetParts, PartsMakeTheDatasetOneCampaignOfTheWholeGridMakes) {
+  const CampaignSpec whole = slice("whole", {0.1, 0.2, 0.3});
+  const CampaignSpec low = slice("low", {0.1, 0.2}), high = slice("high", {0.3});
+  const std::int64_t w = add(whole), a = add(low), b = add(high);
+  finish(w, whole, "1.0 (abc)");
+  finish(a, low, "1.0 (abc)");
+  finish(b, high, "1.0 (abc)");
+  BuildDatasetOptions o;
+  o.name = "standard";
+  const Dataset parts = build_dataset(*db_, {b, a}, o);
+  // Parts in either order, or the whole grid in one campaign: the same points, so the same
+  // dataset (its hash covers the points; the stored one is returned).
+  EXPECT_EQ(build_dataset(*db_, {a, b}, o).hash, parts.hash);
+  EXPECT_EQ(build_dataset(*db_, w).id, parts.id);
+  ASSERT_EQ(parts.points.size(), 3u);
+  EXPECT_EQ(parts.points[0].phi, 0.1);
+  EXPECT_EQ(parts.points[2].phi, 0.3);
+  // inverse_d through F_inf (1 + 1/d) at d 8, 16: the mean limit 10 phi + 0.05.
+  EXPECT_NEAR(parts.points[1].F, 2.05, 1e-12);
+  // The provenance of each part: campaign, spec hash, versions, hosts, time, units.
+  const nlohmann::json method = nlohmann::json::parse(parts.method);
+  ASSERT_EQ(method.at("parts").size(), 2u);
+  EXPECT_EQ(method["parts"][0]["campaign"], "high");
+  EXPECT_EQ(method["parts"][0]["spec_hash"], "hash-high");
+  EXPECT_EQ(method["parts"][1]["code_versions"], nlohmann::json::array({"1.0 (abc)"}));
+  EXPECT_EQ(method["parts"][1]["hosts"], nlohmann::json::array({"host-a"}));
+  EXPECT_DOUBLE_EQ(method["parts"][1]["unit_seconds"].get<double>(), 2 * 2 * 2 * 2.0);
+  EXPECT_EQ(method.at("units_done"), 12);
+  EXPECT_FALSE(method.contains("mixed_code_versions"));
+}
+
+TEST_F(DatasetParts, APointInTwoPartsAnotherSpecOrAnotherCodeVersionIsNamed) {
+  BuildDatasetOptions o;
+  o.name = "standard";
+  const CampaignSpec low = slice("low", {0.1, 0.2}), again = slice("again", {0.2, 0.3});
+  const std::int64_t a = add(low), b = add(again);
+  finish(a, low, "1.0 (abc)");
+  finish(b, again, "1.0 (abc)");
+  std::string m = refusal({a, b}, o);
+  EXPECT_NE(m.find("phi = 0.2, Re = 0 is in two parts, campaigns 'low' and 'again'"),
+            std::string::npos)
+      << m;
+  // Other packings: not the same grid, the key named.
+  CampaignSpec bigger = slice("bigger", {0.3});
+  bigger.spheres = 27;
+  const std::int64_t c = add(bigger);
+  finish(c, bigger, "1.0 (abc)");
+  m = refusal({a, c}, o);
+  EXPECT_NE(m.find("'bigger' is not a part of the same grid as 'low': [packing] spheres is 27"),
+            std::string::npos)
+      << m;
+  // Another resolution budget, realizations or step limit is a slice's own choice.
+  CampaignSpec finer = slice("finer", {0.4});
+  finer.resolutions = {12, 24};
+  finer.realizations = 3;
+  finer.max_steps = 7;
+  const std::int64_t f = add(finer);
+  finish(f, finer, "1.0 (abc)");
+  EXPECT_EQ(refusal({a, f}, o), "");
+  // Units of another code version: named, unless the mix is allowed (and then recorded).
+  const CampaignSpec later = slice("later", {0.5});
+  const std::int64_t l = add(later);
+  finish(l, later, "1.1 (def)");
+  m = refusal({a, l}, o);
+  EXPECT_NE(m.find("2 code versions ('low': 1.0 (abc); 'later': 1.1 (def))"), std::string::npos)
+      << m;
+  o.allow_mixed_code = true;
+  const Dataset mixed = build_dataset(*db_, {a, l}, o);
+  EXPECT_EQ(nlohmann::json::parse(mixed.method).at("mixed_code_versions"),
+            nlohmann::json::array({"1.0 (abc)", "1.1 (def)"}));
+  // Several campaigns need a name; none is not a dataset.
+  EXPECT_NE(refusal({a, f}, BuildDatasetOptions()).find("needs a name"), std::string::npos);
+  EXPECT_NE(refusal({}, o).find("no campaign"), std::string::npos);
+  EXPECT_NE(refusal({a, a}, o).find("named twice"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace campaign
+}  // namespace draglab

@@ -137,6 +137,36 @@ TEST(CampaignPlan, MeasuresTheTimePerUpdateWhenNotGiven) {
   const CampaignPlan plan = plan_campaign(small_spec(), 1);
   EXPECT_GT(plan.node_update_seconds, 1e-10);  // faster than 10 G updates/s per core: no
   EXPECT_LT(plan.node_update_seconds, 1e-5);   // slower than 0.1 M updates/s: no
+  EXPECT_GT(plan.rr_node_update_seconds, 1e-10);
+  EXPECT_LT(plan.rr_node_update_seconds, 1e-5);
+  // A given time stands for every operator.
+  const CampaignPlan given = plan_campaign(small_spec(), 1, 3e-8);
+  EXPECT_EQ(given.node_update_seconds, 3e-8);
+  EXPECT_EQ(given.rr_node_update_seconds, 3e-8);
+}
+
+TEST(CampaignPlan, TheResolutionRulePlansEachPointAtItsOwnResolutions) {
+  CampaignSpec spec = small_spec();
+  spec.resolutions.clear();
+  spec.resolution_rule = true;
+  spec.min_resolution = 12;
+  spec.max_resolution = 24;
+  spec.phi = {0.2, 0.6};
+  spec.re = {0.0, 300.0};
+  spec.collision = "auto";
+  const CampaignPlan plan = plan_campaign(spec, 2, 1e-8);
+  EXPECT_EQ(plan.units, spec.unit_count());
+  std::size_t rows = 0;
+  for (double phi : spec.phi) {
+    for (double re : spec.re) rows += spec.point_resolutions(phi, re).size();
+  }
+  ASSERT_EQ(plan.points.size(), rows);
+  for (const PlannedPoint& p : plan.points) {
+    const std::vector<double> d = spec.point_resolutions(p.phi, p.re);
+    EXPECT_NE(std::find(d.begin(), d.end(), p.resolution), d.end());
+    // A point the rule can promise runs at the rule's d: never "under-resolved" or worse.
+    if (d.size() == 1) EXPECT_EQ(p.resolution_verdict, "ok") << p.phi << " " << p.re;
+  }
 }
 
 }  // namespace

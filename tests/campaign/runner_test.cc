@@ -511,6 +511,55 @@ TEST(CampaignRunner, FloatUnitsRecordTheirPrecisionAndAgreeWithDouble) {
   }
 }
 
+TEST(CampaignRunner, TheResolutionRuleRunsEachPointAtItsOwnResolutions) {
+  // resolutions = "rule" within [6, 10]: phi 0.3 in Stokes flow needs d >= 5.1 (its pores'
+  // hydraulic diameter spans 8 nodes): one unit per realization at the floor, 6; phi 0.5 needs
+  // 12, beyond the cap: 10 and 10 / 1.5 -> 8, extrapolated in d.
+  TempDir dir;
+  CampaignSpec spec;
+  spec.name = "rule";
+  spec.phi = {0.3, 0.5};
+  spec.re = {0};
+  spec.realizations = 2;
+  spec.spheres = 8;
+  spec.resolution_rule = true;
+  spec.min_resolution = 6;
+  spec.max_resolution = 10;
+  spec.extrapolation = "richardson";
+  std::string error;
+  ASSERT_TRUE(spec.IsValid(&error)) << error;
+  ASSERT_EQ(spec.unit_count(), 6);
+  RunCampaignOptions options;
+  options.jobs = 2;
+  const std::string db_path = dir.file("rule.db");
+  const CampaignStatus st = run_campaign(db_path, spec, options);
+  ASSERT_EQ(st.units_done, 6);
+  RawDb raw(db_path);
+  EXPECT_EQ(raw.rows("SELECT DISTINCT resolution FROM campaign_units WHERE phi = 0.3"),
+            (std::vector<std::string>{"6.0"}));
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM campaign_units WHERE phi = 0.5 AND resolution = 8 "
+                        "AND resolution_index = 0"),
+            2);
+  EXPECT_EQ(raw.integer("SELECT count(*) FROM campaign_units WHERE phi = 0.5 AND resolution = 10 "
+                        "AND resolution_index = 1"),
+            2);
+  Database db(db_path);
+  const Dataset data = build_dataset(db, st.id);
+  ASSERT_EQ(data.points.size(), 2u);
+  const DatasetPoint& dilute = data.points[0];
+  EXPECT_EQ(dilute.resolutions, std::vector<double>{6.0});
+  EXPECT_EQ(dilute.extrapolation, "finest");
+  const DatasetPoint& dense = data.points[1];
+  EXPECT_EQ(dense.resolutions, (std::vector<double>{8.0, 10.0}));
+  EXPECT_EQ(dense.extrapolation, "inverse_d");  // two resolutions: Richardson needs three
+  // The line through the two realization means, by hand: F_inf = (10 F10 - 8 F8) / 2.
+  EXPECT_NEAR(dense.F, (10.0 * dense.F_at_resolution[1] - 8.0 * dense.F_at_resolution[0]) / 2.0,
+              1e-9 * dense.F);
+  EXPECT_NEAR(dense.F_discretisation_error, std::fabs(dense.F - dense.F_at_resolution[1]),
+              1e-9 * dense.F);
+  EXPECT_NE(data.method.find("\"resolutions\":\"rule\""), std::string::npos) << data.method;
+}
+
 TEST(CampaignRunner, SecondProcessOnTheSameCampaignIsRefused) {
   TempDir dir;
   const std::string db = dir.file("lock.db"), spec = dir.file("tiny.toml");

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
 #include "draglab/error.h"
+#include "draglab/lbm/resolution.h"
 
 namespace draglab {
 namespace campaign {
@@ -213,6 +215,75 @@ TEST(CampaignSpec, FloatPrecisionIsPartOfTheIdentityAndDoubleKeepsOlderHashes) {
   EXPECT_NE(parse_error(edit("max_steps = 50000", "max_steps = 50000\nprecision = \"half\""))
                 .find("[lbm] precision = 'half' is not one of double, float"),
             std::string::npos);
+}
+
+TEST(CampaignSpec, TheResolutionRuleGivesEachPointItsOwnResolutions) {
+  // resolutions = "rule": d from lbm::resolution_needed, rounded up to an even number, within
+  // [min_resolution, max_resolution]; beyond max_resolution two resolutions to extrapolate from.
+  std::string text = edit("resolutions = [10, 14, 20]",
+                          "resolutions = \"rule\"\nmin_resolution = 12\nmax_resolution = 32");
+  text = text.replace(text.find("phi = [0.1, 0.3]"), 16, "phi = [0.1, 0.6]");
+  text = text.replace(text.find("collision = \"trt\""), 17, "collision = \"auto\"");
+  text = text.replace(text.find("re = [0, 20]"), 12, "re = [0, 300]");
+  const CampaignSpec s = parse_campaign_spec_text(text, "spec.toml");
+  EXPECT_TRUE(s.resolution_rule);
+  EXPECT_TRUE(s.resolutions.empty());
+  // phi 0.1, Stokes: the gap bound is (8 / (2/3 x 0.9/0.1)) = 1.3: the floor, 12.
+  EXPECT_EQ(s.point_resolutions(0.1, 0.0), std::vector<double>{12.0});
+  // phi 0.6, Stokes: the pores' hydraulic diameter (2/3)(0.4/0.6) d spans 8 nodes at d = 18.
+  EXPECT_EQ(s.point_resolutions(0.6, 0.0), std::vector<double>{18.0});
+  // Every point at or above the rule's d, by less than the rounding to an even number.
+  for (double phi : {0.1, 0.3, 0.5, 0.6}) {
+    for (double re : {0.0, 10.0, 30.0, 100.0, 300.0, 1000.0}) {
+      SCOPED_TRACE(testing::Message() << "phi " << phi << " Re " << re);
+      const double need = lbm::resolution_needed(phi, re, lbm::Collision::kAuto).d;
+      const std::vector<double> d = s.point_resolutions(phi, re);
+      if (need <= 32.0) {
+        ASSERT_EQ(d.size(), 1u);
+        EXPECT_GE(d[0], std::max(12.0, need));
+        EXPECT_LT(d[0], std::max(12.0, need) + 2.0);
+      } else {
+        // phi 0.6, Re 300 needs about 62: 32 and 32 / 1.5 -> 22.
+        EXPECT_EQ(d, (std::vector<double>{22.0, 32.0}));
+      }
+    }
+  }
+  EXPECT_EQ(s.largest_resolution(), 32.0);
+  // Units: 2 realizations x (phi 0.1: Stokes and Re 300 (d 28), one each; phi 0.6: Stokes one,
+  // Re 300 two).
+  EXPECT_EQ(s.unit_count(), 2 * (1 + 1 + 1 + 2));
+  // The mode and its bounds are part of the identity, and survive the stored JSON.
+  const std::string json = s.to_json();
+  EXPECT_NE(json.find("\"resolutions\":\"rule\""), std::string::npos) << json;
+  EXPECT_EQ(internal::spec_from_json(json).to_json(), json);
+  const CampaignSpec wider = parse_campaign_spec_text(
+      text.replace(text.find("max_resolution = 32"), 19, "max_resolution = 48"), "spec.toml");
+  EXPECT_NE(wider.to_json(), json);
+  // A list keeps its old identity (no rule keys written).
+  EXPECT_EQ(parse_campaign_spec_text(kValid, "spec.toml").to_json().find("min_resolution"),
+            std::string::npos);
+}
+
+TEST(CampaignSpec, TheResolutionRuleIsCheckedLikeEveryOtherField) {
+  const auto rule = [](const std::string& extra) {
+    return edit("resolutions = [10, 14, 20]", "resolutions = \"rule\"" + extra);
+  };
+  EXPECT_EQ(parse_error(rule("")), "");
+  std::string m = parse_error(edit("resolutions = [10, 14, 20]", "resolutions = \"auto\""));
+  EXPECT_NE(m.find("[lbm] resolutions = \"auto\" is neither a list of resolutions nor \"rule\""),
+            std::string::npos)
+      << m;
+  m = parse_error(rule("\nmax_resolution = 8"));
+  EXPECT_NE(m.find("[lbm] max_resolution = 8 is outside [min_resolution = 12"), std::string::npos)
+      << m;
+  m = parse_error(rule("\nmin_resolution = 2"));
+  EXPECT_NE(m.find("[lbm] min_resolution = 2 is outside [4, 512]"), std::string::npos) << m;
+  m = parse_error(rule("\nmin_resolution = 4\nmax_resolution = 5"));
+  EXPECT_NE(m.find("leaves no coarser resolution"), std::string::npos) << m;
+  m = parse_error(edit("max_steps = 50000", "max_steps = 50000\nmax_resolution = 40"));
+  EXPECT_NE(m.find("[lbm] min_resolution and max_resolution apply only to resolutions = \"rule\""),
+            std::string::npos)
+      << m;
 }
 
 TEST(CampaignSpec, ForcedGapThatJamsIsRefusedWithTheLimit) {

@@ -48,6 +48,15 @@ struct CampaignSpec {
   double min_gap =
       0.0;  ///< [packing] forced min surface gap in d; 0 = none (hard-sphere structure).
   std::vector<double> resolutions;  ///< [lbm] resolutions d (lattice units per diameter), >= 4.
+  /// [lbm] resolutions = "rule": each (phi, Re) point gets its own d from the engine's
+  /// resolution rule (lbm::resolution_needed for the spec's collision), rounded up to an even
+  /// number and held within [min_resolution, max_resolution]. Where the rule asks for more than
+  /// max_resolution it cannot promise its accuracy: the point then runs at two resolutions,
+  /// max_resolution and about max_resolution / 1.5, extrapolated in d (point_resolutions).
+  /// `resolutions` is empty then.
+  bool resolution_rule = false;
+  double min_resolution = 12.0;     ///< [lbm] min_resolution, with "rule" only.
+  double max_resolution = 32.0;     ///< [lbm] max_resolution, with "rule" only.
   std::string collision = "auto";   ///< [lbm] auto (per unit: lbm::choose_collision), trt, bgk, rr.
   std::string boundary = "ibb";     ///< [lbm] ibb or bb.
   double tolerance = 1e-5;          ///< [lbm] convergence tolerance (relative change per T).
@@ -62,6 +71,12 @@ struct CampaignSpec {
   int ranks_per_unit = 1;
   std::string extrapolation = "richardson";  ///< [dataset] richardson, inverse_d or finest.
   bool IsValid(std::string* error) const;
+  /// The resolutions the point (phi, Re) runs at, ascending: `resolutions`, or the rule's.
+  std::vector<double> point_resolutions(double phi, double re) const;
+  /// The largest resolution of any point.
+  double largest_resolution() const;
+  /// Units of the whole grid (realizations x each point's resolutions).
+  std::int64_t unit_count() const;
   /// Canonical JSON text (stored with the campaign; its hash identifies the spec).
   std::string to_json() const;
 };
@@ -210,8 +225,10 @@ struct CampaignPlan {
   std::vector<PlannedPoint> points;
   std::int64_t units = 0;
   int jobs = 1;
-  double node_update_seconds = 0.0;  ///< Seconds per fluid-node update, one core.
-  double core_seconds = 0.0;         ///< Sum over units.
+  double node_update_seconds = 0.0;  ///< Seconds per fluid-node update, one core (TRT, BGK).
+  /// The same for the regularized operator (its wall correction costs per boundary link).
+  double rr_node_update_seconds = 0.0;
+  double core_seconds = 0.0;  ///< Sum over units.
   /// Longest-first schedule of the units on `jobs` workers (as the runner orders them).
   double wall_seconds = 0.0;
   double largest_unit_memory_bytes = 0.0;
@@ -225,7 +242,8 @@ struct CampaignPlan {
 };
 
 /// Plans `spec` (which must be valid) for `jobs` workers (>= 1). node_update_seconds > 0 uses
-/// that value; 0 measures it with a short run (about a second, one thread). Throws
+/// that value for every operator; 0 measures TRT's and rr's with short runs (about two seconds,
+/// one thread). Throws
 /// Error(kInvalidArgument) for an invalid spec or jobs outside [1, 1024].
 CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_update_seconds = 0.0);
 
@@ -258,6 +276,20 @@ std::string export_species_csv(const Database& db, std::int64_t campaign_id,
 /// (store_dataset) and returns it. Points whose units all failed are left out and listed in
 /// *skipped (if given). Throws Error(kInvalidArgument) if no point has a finished unit.
 Dataset build_dataset(Database& db, std::int64_t campaign_id,
+                      std::vector<std::string>* skipped = nullptr);
+
+/// A dataset computed in parts: several campaigns, each a slice of one grid (its own points,
+/// realizations and resolutions; the same packings, operator, tolerance and precision). Refused
+/// (Error(kInvalidArgument), naming the parts): a point in two parts, parts whose units would
+/// compute differently (the spec key is named), and units of more than one code version unless
+/// allow_mixed_code (the dataset's method then lists the versions). The method records each part
+/// (campaign, spec hash, code versions, hosts, unit seconds, units).
+struct BuildDatasetOptions {
+  std::string name;               ///< Required for several campaigns; else the campaign's name.
+  bool allow_mixed_code = false;  ///< Accept units of several code versions (recorded).
+};
+Dataset build_dataset(Database& db, const std::vector<std::int64_t>& campaign_ids,
+                      const BuildDatasetOptions& options,
                       std::vector<std::string>* skipped = nullptr);
 
 }  // namespace campaign
