@@ -224,6 +224,8 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                     {"refused_units", plan.refused_units},
                     {"under_resolved_units", plan.under_resolved_units},
                     {"unstable_units", plan.unstable_units},
+                    {"unpackable_units", plan.unpackable_units},
+                    {"packing_failures", plan.packing_failures},
                     {"points", points}});
   } else {
     std::cout << fmt::format("campaign {}\n", spec.name) << plan.FullReport();

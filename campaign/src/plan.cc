@@ -75,6 +75,50 @@ double measure_node_update_seconds(lbm::Precision precision, lbm::Collision coll
   return seconds;
 }
 
+/// The generator's message on one line, its first attempts only.
+std::string one_line(const std::string& message) {
+  constexpr std::size_t kLength = 200;
+  std::string line;
+  for (char c : message) {
+    if (c == '\n') c = ' ';
+    if (c == ' ' && !line.empty() && line.back() == ' ') continue;
+    line += c;
+  }
+  return line.size() > kLength ? line.substr(0, kLength) + " ..." : line;
+}
+
+/// Generates every packing the units will use (one per phi and realization; cheap beside any
+/// unit): a packing the generator cannot make fails all its units at run time, so the plan says
+/// so before any work.
+void check_packings(const CampaignSpec& spec, CampaignPlan* plan) {
+  for (int i = 0; i < static_cast<int>(spec.phi.size()); ++i) {
+    std::vector<int> failed;
+    std::string first_reason;
+    for (int r = 0; r < spec.realizations; ++r) {
+      const arrays::RandomPackingOptions po =
+          internal::packing_options(spec, spec.phi[i], internal::packing_seed(spec.seed, i, r));
+      try {
+        arrays::generate_random_packing(po);
+      } catch (const Error& e) {
+        failed.push_back(r);
+        if (first_reason.empty()) first_reason = e.what();
+      }
+    }
+    if (failed.empty()) continue;
+    std::int64_t units = 0;
+    for (double re : spec.re) {
+      units +=
+          static_cast<std::int64_t>(failed.size() * spec.point_resolutions(spec.phi[i], re).size());
+    }
+    plan->unpackable_units += units;
+    std::string which;
+    for (int r : failed) which += (which.empty() ? "" : ", ") + std::to_string(r);
+    plan->packing_failures.push_back("phi = " + core::format_number(spec.phi[i]) + ", realization" +
+                                     (failed.size() > 1 ? "s " : " ") + which + ": " +
+                                     one_line(first_reason));
+  }
+}
+
 }  // namespace
 
 CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_update_seconds) {
@@ -151,6 +195,7 @@ CampaignPlan plan_campaign(const CampaignSpec& spec, int jobs, double node_updat
       }
     }
   }
+  check_packings(spec, &plan);
   // Longest first onto the least loaded worker, as the runner hands out its units.
   std::sort(unit_seconds.begin(), unit_seconds.end(), std::greater<double>());
   std::priority_queue<double, std::vector<double>, std::greater<double>> load;
@@ -186,6 +231,11 @@ std::string CampaignPlan::BriefReport() const {
                              : std::string()) +
          (under_resolved_units > 0
               ? "; " + std::to_string(under_resolved_units) + " units under-resolved"
+              : std::string()) +
+         (unpackable_units > 0
+              ? "; " + std::to_string(unpackable_units) +
+                    " units WILL FAIL: their packings cannot be generated (more spheres per box, "
+                    "or another seed)"
               : std::string());
 }
 
@@ -213,6 +263,7 @@ std::string CampaignPlan::FullReport() const {
   out << "time per fluid-node update (one worker of " << jobs
       << ", measured): " << format_fixed("%.3g", node_update_seconds * 1e9) << " ns (trt), "
       << format_fixed("%.3g", rr_node_update_seconds * 1e9) << " ns (rr)\n";
+  for (const std::string& f : packing_failures) out << "packing fails: " << f << "\n";
   out << BriefReport() << "\n";
   return out.str();
 }
