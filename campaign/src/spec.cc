@@ -47,8 +47,8 @@ const core::toml_schema::Schema& sections() {
       {"packing",
        {"spheres", "box_size", "distribution", "size_ratio", "large_fraction", "sigma", "min_gap"}},
       {"lbm",
-       {"resolutions", "min_resolution", "max_resolution", "collision", "boundary", "tolerance",
-        "max_steps", "precision", "ranks_per_unit"}},
+       {"resolutions", "min_resolution", "max_resolution", "target_error", "collision", "boundary",
+        "tolerance", "max_steps", "precision", "ranks_per_unit"}},
       {"dataset", {"extrapolation"}},
   };
   return s;
@@ -145,6 +145,10 @@ bool CampaignSpec::IsValid(std::string* error) const {
                              " is outside [min_resolution = " + format_number(min_resolution) +
                              ", " + format_number(kMaxResolution) + "] lattice units per diameter");
     }
+    if (!(target_error >= 0.0 && target_error < 1.0)) {
+      return fail(error, "[lbm] target_error = " + format_number(target_error) +
+                             " is outside [0, 1) (a relative error; 0 = the accuracy rules alone)");
+    }
     if (max_resolution / kRuleCoarseRatio < kMinResolution) {
       return fail(error, "[lbm] max_resolution = " + format_number(max_resolution) +
                              " leaves no coarser resolution for the points the rule cannot "
@@ -239,10 +243,17 @@ std::vector<double> CampaignSpec::point_resolutions(double point_phi, double poi
     return d;
   }
   const auto even_above = [](double d) { return 2.0 * std::ceil(d / 2.0 - 1e-9); };
-  const lbm::ResolutionNeed need =
-      lbm::resolution_needed(point_phi, point_re, lbm::collision_from_string(collision));
-  const double d = std::max(min_resolution, even_above(need.d));
-  if (d <= max_resolution) return {d};
+  const lbm::Collision operator_asked = lbm::collision_from_string(collision);
+  const lbm::ResolutionNeed need = lbm::resolution_needed(point_phi, point_re, operator_asked);
+  const auto meets_target = [&](double d) {
+    return target_error <= 0.0 ||
+           lbm::planned_discretisation_error(point_phi, point_re, d, operator_asked,
+                                             lbm::boundary_from_string(boundary),
+                                             lbm::precision_from_string(precision)) <= target_error;
+  };
+  for (double d = std::max(min_resolution, even_above(need.d)); d <= max_resolution; d += 2.0) {
+    if (meets_target(d)) return {d};
+  }
   // Beyond what the spec affords: the finest it affords and a coarser one, to extrapolate from.
   return {std::max(kMinResolution, even_above(max_resolution / kRuleCoarseRatio)), max_resolution};
 }
@@ -293,6 +304,7 @@ std::string CampaignSpec::to_json() const {
     j["lbm"]["resolutions"] = "rule";
     j["lbm"]["min_resolution"] = min_resolution;
     j["lbm"]["max_resolution"] = max_resolution;
+    if (target_error > 0.0) j["lbm"]["target_error"] = target_error;
   }
   // Written only where it changes what a unit computes: older specs keep their text and hash.
   if (precision != "double") j["lbm"]["precision"] = precision;
@@ -321,6 +333,7 @@ CampaignSpec internal::spec_from_json(const std::string& text) {
     s.resolution_rule = true;
     s.min_resolution = l.at("min_resolution").get<double>();
     s.max_resolution = l.at("max_resolution").get<double>();
+    s.target_error = l.value("target_error", 0.0);
   } else {
     s.resolutions = l.at("resolutions").get<std::vector<double>>();
   }
@@ -393,6 +406,7 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
     }
     if (id == "lbm.min_resolution") s.min_resolution = number();
     if (id == "lbm.max_resolution") s.max_resolution = number();
+    if (id == "lbm.target_error") s.target_error = number();
     if (id == "lbm.collision") s.collision = text();
     if (id == "lbm.boundary") s.boundary = text();
     if (id == "lbm.tolerance") s.tolerance = number();
@@ -423,8 +437,11 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
     }
   }
   if (!s.resolution_rule &&
-      (given.count("lbm.min_resolution") || given.count("lbm.max_resolution"))) {
-    bad(origin + ": [lbm] min_resolution and max_resolution apply only to resolutions = \"rule\"");
+      (given.count("lbm.min_resolution") || given.count("lbm.max_resolution") ||
+       given.count("lbm.target_error"))) {
+    bad(origin +
+        ": [lbm] min_resolution, max_resolution and target_error apply only to resolutions = "
+        "\"rule\"");
   }
   if (given.count("packing.spheres") && given.count("packing.box_size")) {
     bad(origin + ": [packing] spheres and box_size contradict each other: give one of them");

@@ -1,6 +1,8 @@
 // resolution.cc: see draglab/lbm/resolution.h.
 #include "draglab/lbm/resolution.h"
+
 #include "draglab/core/text.h"
+#include "error_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -154,6 +156,31 @@ ResolutionNeed resolution_needed(double phi, double re, Collision collision, dou
 
 bool expects_unsteady_flow(double phi, double re) {
   return re / (1.0 - phi) >= kUnsteadySphereRe && re * (2.0 / 3.0) / phi >= kUnsteadyPoreRe;
+}
+
+double planned_discretisation_error(double phi, double re, double d, Collision requested,
+                                    Boundary boundary, Precision precision) {
+  const Collision collision = choose_collision(phi, re, d, requested).collision;
+  const RunOptions defaults;
+  ErrorModelInput em;
+  em.boundary = boundary;
+  em.collision = collision;
+  em.tau = re > 0.0 ? plan_velocity(phi, re, d, collision, kDefaultMachTarget, 0.0, false).tau
+                    : (collision == Collision::kTrt ? 1.5 : 1.0);
+  // As the driver: rr's reflected values corrected to TRT's wall where its own Lambda is smaller.
+  em.wall_corrected = collision == Collision::kRegularized && boundary == Boundary::kInterpolated &&
+                      defaults.rr_wall_correction &&
+                      2.0 * defaults.magic / (em.tau - 0.5) - 1.0 > 0.0;
+  em.magic = collision == Collision::kTrt || em.wall_corrected ? defaults.magic
+             : collision == Collision::kBgk                    ? (em.tau - 0.5) * (em.tau - 0.5)
+                                                               : 0.5 * (em.tau - 0.5);
+  em.d = d;
+  em.phi = phi;
+  em.re = re;
+  em.precision = precision;
+  return widen_for_resolution(discretisation_error_estimate(em), d,
+                              resolution_needed(phi, re, requested), boundary)
+      .error;
 }
 
 }  // namespace lbm

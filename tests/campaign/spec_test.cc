@@ -264,6 +264,49 @@ TEST(CampaignSpec, TheResolutionRuleGivesEachPointItsOwnResolutions) {
             std::string::npos);
 }
 
+TEST(CampaignSpec, ATargetErrorRaisesEachPointToTheResolutionThatMeetsIt) {
+  // target_error: the smallest even d from the rule's up to max_resolution whose a-priori
+  // discretisation error (lbm::planned_discretisation_error) meets the target; beyond it, two
+  // resolutions. The error model is second order in 1/d for the interpolated wall, so the
+  // target moves finite-Re points up and leaves Stokes points at the rule's d.
+  std::string text = edit("resolutions = [10, 14, 20]",
+                          "resolutions = \"rule\"\nmin_resolution = 12\nmax_resolution = 48\n"
+                          "target_error = 0.03");
+  text = text.replace(text.find("collision = \"trt\""), 17, "collision = \"auto\"");
+  const CampaignSpec s = parse_campaign_spec_text(text, "spec.toml");
+  EXPECT_EQ(s.target_error, 0.03);
+  const auto planned = [&s](double phi, double re, double d) {
+    return lbm::planned_discretisation_error(phi, re, d, lbm::Collision::kAuto,
+                                             lbm::Boundary::kInterpolated, lbm::Precision::kDouble);
+  };
+  int raised = 0;
+  for (double phi : {0.1, 0.3, 0.4, 0.6}) {
+    for (double re : {0.0, 10.0, 30.0, 300.0}) {
+      SCOPED_TRACE(testing::Message() << "phi " << phi << " Re " << re);
+      const std::vector<double> d = s.point_resolutions(phi, re);
+      const double rule = std::max(12.0, lbm::resolution_needed(phi, re, lbm::Collision::kAuto).d);
+      if (d.size() == 1) {
+        EXPECT_LE(planned(phi, re, d[0]), 0.03);
+        // The smallest that meets it: two lattice units less either misses it or is below the
+        // rule's d.
+        EXPECT_TRUE(d[0] - 2.0 < rule || planned(phi, re, d[0] - 2.0) > 0.03);
+        raised += d[0] >= rule + 2.0;
+      } else {
+        EXPECT_EQ(d, (std::vector<double>{32.0, 48.0}));
+        EXPECT_GT(planned(phi, re, 48.0), 0.03);
+      }
+    }
+  }
+  EXPECT_GT(raised, 0);  // the target does raise some points (phi 0.4 at Re 30 to d 24)
+  EXPECT_EQ(s.point_resolutions(0.4, 30.0), std::vector<double>{24.0});
+  EXPECT_EQ(internal::spec_from_json(s.to_json()).to_json(), s.to_json());
+  EXPECT_NE(s.to_json().find("\"target_error\":0.03"), std::string::npos);
+  EXPECT_NE(
+      parse_error(edit("resolutions = [10, 14, 20]", "resolutions = \"rule\"\ntarget_error = 1.5"))
+          .find("[lbm] target_error = 1.5 is outside [0, 1)"),
+      std::string::npos);
+}
+
 TEST(CampaignSpec, TheResolutionRuleIsCheckedLikeEveryOtherField) {
   const auto rule = [](const std::string& extra) {
     return edit("resolutions = [10, 14, 20]", "resolutions = \"rule\"" + extra);
@@ -281,7 +324,8 @@ TEST(CampaignSpec, TheResolutionRuleIsCheckedLikeEveryOtherField) {
   m = parse_error(rule("\nmin_resolution = 4\nmax_resolution = 5"));
   EXPECT_NE(m.find("leaves no coarser resolution"), std::string::npos) << m;
   m = parse_error(edit("max_steps = 50000", "max_steps = 50000\nmax_resolution = 40"));
-  EXPECT_NE(m.find("[lbm] min_resolution and max_resolution apply only to resolutions = \"rule\""),
+  EXPECT_NE(m.find("[lbm] min_resolution, max_resolution and target_error apply only to "
+                   "resolutions = \"rule\""),
             std::string::npos)
       << m;
 }

@@ -55,8 +55,13 @@ struct CampaignSpec {
   /// max_resolution and about max_resolution / 1.5, extrapolated in d (point_resolutions).
   /// `resolutions` is empty then.
   bool resolution_rule = false;
-  double min_resolution = 12.0;     ///< [lbm] min_resolution, with "rule" only.
-  double max_resolution = 32.0;     ///< [lbm] max_resolution, with "rule" only.
+  double min_resolution = 12.0;  ///< [lbm] min_resolution, with "rule" only.
+  double max_resolution = 32.0;  ///< [lbm] max_resolution, with "rule" only.
+  /// [lbm] target_error, with "rule" only: the largest a-priori discretisation error
+  /// (lbm::planned_discretisation_error) a point may have at one resolution; a point whose rule
+  /// d leaves more runs at the smallest d up to max_resolution that meets it, or, if none does,
+  /// at two resolutions. 0 = the accuracy rules alone decide.
+  double target_error = 0.0;
   std::string collision = "auto";   ///< [lbm] auto (per unit: lbm::choose_collision), trt, bgk, rr.
   std::string boundary = "ibb";     ///< [lbm] ibb or bb.
   double tolerance = 1e-5;          ///< [lbm] convergence tolerance (relative change per T).

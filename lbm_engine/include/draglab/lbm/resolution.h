@@ -107,6 +107,13 @@ struct ResolutionNeed {
 /// TRT's ends).
 ResolutionNeed resolution_needed(double phi, double re, Collision collision, double kappa = 0.0);
 
+/// The a-priori relative discretisation error (RunResult::discretisation_error, before any run)
+/// of one run at (phi, Re, d) with the operator `requested` resolves to, the planned tau and the
+/// default wall: the engine's error model, widened below the accuracy rules as a run widens it.
+/// For planning (how many resolutions a point needs); a run's own estimate uses its measured Re.
+double planned_discretisation_error(double phi, double re, double d, Collision requested,
+                                    Boundary boundary, Precision precision);
+
 /// Whether a run at (phi, Re) is expected to end in unsteady flow, time-averaged over
 /// RunOptions::average_time d/U after its start-up: where both the sphere-scale Reynolds number
 /// Re_p = Re/(1 - phi) reaches kUnsteadySphereRe and the pores' Re_h = Re (2/3)/phi reaches
