@@ -110,13 +110,15 @@ Part read_part(const Database& db, std::int64_t campaign_id) {
   return part;
 }
 
-/// The spec's keys that say what a unit computes: everything but the slice of the grid and its
-/// resolutions, as JSON (section -> key -> value).
+/// The spec's keys that say what a unit computes: everything but the slice of the grid, its
+/// resolutions and its box size (numerical parameters a part chooses for its points, as d), as
+/// JSON (section -> key -> value).
 nlohmann::json unit_identity(const CampaignSpec& spec) {
   nlohmann::json j = nlohmann::json::parse(spec.to_json());
   j.erase("campaign");
   j.erase("dataset");
   for (const char* key : {"phi", "re", "realizations"}) j["grid"].erase(key);
+  for (const char* key : {"spheres", "box_size"}) j["packing"].erase(key);
   for (const char* key : {"resolutions", "min_resolution", "max_resolution", "max_steps"}) {
     j["lbm"].erase(key);
   }
@@ -308,6 +310,10 @@ nlohmann::json part_json(const Part& part) {
   return {{"campaign", part.spec.name},
           {"campaign_id", part.status.id},
           {"spec_hash", part.status.spec_hash},
+          {"spheres",
+           part.spec.box_size > 0.0 ? nlohmann::json(nullptr) : nlohmann::json(part.spec.spheres)},
+          {"box_size",
+           part.spec.box_size > 0.0 ? nlohmann::json(part.spec.box_size) : nlohmann::json(nullptr)},
           {"code_versions", part.code_versions},
           {"hosts", part.hosts},
           {"unit_seconds", part.unit_seconds},

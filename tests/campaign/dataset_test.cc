@@ -348,23 +348,35 @@ TEST_F(DatasetParts, APointInTwoPartsAnotherSpecOrAnotherCodeVersionIsNamed) {
   EXPECT_NE(m.find("phi = 0.2, Re = 0 is in two parts, campaigns 'low' and 'again'"),
             std::string::npos)
       << m;
-  // Other packings: not the same grid, the key named.
-  CampaignSpec bigger = slice("bigger", {0.3});
-  bigger.spheres = 27;
-  const std::int64_t c = add(bigger);
-  finish(c, bigger, "1.0 (abc)");
+  // Other packings (another seed) or another operator: not the same grid, the key named.
+  CampaignSpec reseeded = slice("reseeded", {0.3});
+  reseeded.seed = 27;
+  const std::int64_t c = add(reseeded);
+  finish(c, reseeded, "1.0 (abc)");
   m = refusal({a, c}, o);
-  EXPECT_NE(m.find("'bigger' is not a part of the same grid as 'low': [packing] spheres is 27"),
+  EXPECT_NE(m.find("'reseeded' is not a part of the same grid as 'low': [grid] seed is 27"),
             std::string::npos)
       << m;
-  // Another resolution budget, realizations or step limit is a slice's own choice.
+  CampaignSpec other_operator = slice("bgk", {0.35});
+  other_operator.collision = "bgk";
+  const std::int64_t g = add(other_operator);
+  finish(g, other_operator, "1.0 (abc)");
+  m = refusal({a, g}, o);
+  EXPECT_NE(m.find("[lbm] collision is \"bgk\" there and \"auto\" in 'low'"), std::string::npos)
+      << m;
+  // Another resolution budget, box, realizations or step limit is a slice's own choice (each
+  // part's box is recorded).
   CampaignSpec finer = slice("finer", {0.4});
   finer.resolutions = {12, 24};
   finer.realizations = 3;
   finer.max_steps = 7;
+  finer.spheres = 27;
   const std::int64_t f = add(finer);
   finish(f, finer, "1.0 (abc)");
   EXPECT_EQ(refusal({a, f}, o), "");
+  const nlohmann::json boxes = nlohmann::json::parse(build_dataset(*db_, {a, f}, o).method);
+  EXPECT_EQ(boxes["parts"][0]["spheres"], 16);
+  EXPECT_EQ(boxes["parts"][1]["spheres"], 27);
   // Units of another code version: named, unless the mix is allowed (and then recorded).
   const CampaignSpec later = slice("later", {0.5});
   const std::int64_t l = add(later);
