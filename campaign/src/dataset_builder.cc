@@ -396,9 +396,12 @@ Dataset build_dataset(Database& db, const std::vector<std::int64_t>& campaign_id
                  std::to_string(notes.single_realization_points) +
                  " point(s) with a single converged realization use the engine's per-sphere "
                  "spread / sqrt(N) instead"},
-      {"discretisation_error", spec.extrapolation == "finest"
-                                   ? "engine error_estimate x F at the resolution"
-                                   : "|F_inf - F(finest resolution)|"},
+      {"discretisation_error",
+       spec.extrapolation == "finest" ? "engine error_estimate x F at the resolution"
+       : spec.resolution_rule
+           ? "|F_inf - F(finest resolution)| where a point has several resolutions, the engine "
+             "error_estimate x F where it has one"
+           : "|F_inf - F(finest resolution)|"},
   };
   if (parts.size() > 1) {
     // Each part's own spec, versions, machines and time: the provenance of a dataset computed
