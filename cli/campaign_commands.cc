@@ -226,6 +226,7 @@ void run_plan_command(const CliContext& ctx, const PlanCommand& c) {
                     {"unstable_units", plan.unstable_units},
                     {"unpackable_units", plan.unpackable_units},
                     {"packing_failures", plan.packing_failures},
+                    {"packings_checked", plan.packings_checked},
                     {"points", points}});
   } else {
     std::cout << fmt::format("campaign {}\n", spec.name) << plan.FullReport();

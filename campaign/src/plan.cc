@@ -91,6 +91,15 @@ std::string one_line(const std::string& message) {
 /// unit): a packing the generator cannot make fails all its units at run time, so the plan says
 /// so before any work.
 void check_packings(const CampaignSpec& spec, CampaignPlan* plan) {
+  // Beyond this many spheres in all the packings the check could take longer than the plan is
+  // meant to (large boxes, many realizations): it is skipped, and the report says so.
+  constexpr double kMaxCheckedSpheres = 20000.0;
+  double spheres = 0.0;
+  for (double phi : spec.phi) {
+    spheres += static_cast<double>(internal::packing_options(spec, phi, 1).n) * spec.realizations;
+  }
+  if (spheres > kMaxCheckedSpheres) return;
+  plan->packings_checked = true;
   for (int i = 0; i < static_cast<int>(spec.phi.size()); ++i) {
     std::vector<int> failed;
     std::string first_reason;
@@ -264,6 +273,10 @@ std::string CampaignPlan::FullReport() const {
       << ", measured): " << format_fixed("%.3g", node_update_seconds * 1e9) << " ns (trt), "
       << format_fixed("%.3g", rr_node_update_seconds * 1e9) << " ns (rr)\n";
   for (const std::string& f : packing_failures) out << "packing fails: " << f << "\n";
+  if (!packings_checked) {
+    out << "packings not generated (too many spheres for a quick check): a packing that cannot "
+           "be made fails its units at run time\n";
+  }
   out << BriefReport() << "\n";
   return out.str();
 }

@@ -188,8 +188,14 @@ TEST(CampaignPlan, APackingTheGeneratorCannotMakeIsReportedBeforeAnyWork) {
             std::string::npos)
       << jammed.packing_failures[0];
   EXPECT_NE(jammed.BriefReport().find("6 units WILL FAIL"), std::string::npos);
+  EXPECT_TRUE(jammed.packings_checked);
   spec.spheres = 27;
   EXPECT_EQ(plan_campaign(spec, 2, 1e-8).unpackable_units, 0);
+  // Too many spheres in all for a quick check (6 x 3 x 5000): skipped, and said.
+  spec.spheres = 5000;
+  const CampaignPlan large = plan_campaign(spec, 2, 1e-8);
+  EXPECT_FALSE(large.packings_checked);
+  EXPECT_NE(large.FullReport().find("packings not generated"), std::string::npos);
 }
 
 }  // namespace

@@ -246,6 +246,9 @@ struct CampaignPlan {
   /// per phi the realizations that fail with the generator's first reason.
   std::int64_t unpackable_units = 0;
   std::vector<std::string> packing_failures;
+  /// False where the packings hold too many spheres in all to be generated quickly (> 20 000):
+  /// then none was checked.
+  bool packings_checked = false;
   std::string BriefReport() const;
   std::string FullReport() const;
 };
