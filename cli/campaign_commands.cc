@@ -412,6 +412,27 @@ void run_export(const CliContext& ctx, const ExportCommand& c) {
   ctx.info(fmt::format("wrote {} units of campaign {} to {}", units.count, st.name, c.out));
 }
 
+struct ImportCommand {
+  std::string spec, units;
+};
+
+void run_import(const CliContext& ctx, const ImportCommand& c) {
+  const campaign::CampaignSpec spec = campaign::parse_campaign_spec(resolve_spec_path(c.spec));
+  campaign::check_units_file(spec, c.units);  // before the database is opened, or created
+  std::unique_ptr<Database> db = ctx.open_database();
+  const campaign::ImportSummary summary = campaign::import_campaign(*db, spec, c.units);
+  if (ctx.json) {
+    ctx.print_json(nlohmann::json::parse(summary.ToJson()));
+    return;
+  }
+  std::cout << summary.BriefReport() << "\n";
+  if (summary.pending > 0) {
+    std::cout << fmt::format(
+        "the {} units not finished run with: draglab campaign run {} --resume\n", summary.pending,
+        c.spec);
+  }
+}
+
 struct DatasetBuildCommand {
   std::vector<std::string> campaigns;
   campaign::BuildDatasetOptions options;
@@ -609,6 +630,26 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
         "  draglab campaign export quick --csv --out units.csv\n"
         "  draglab campaign export bidisperse --species --out species.csv");
     cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_export(ctx, *o); }; });
+  }
+
+  {
+    auto* cmd = campaign->add_subcommand(
+        "import",
+        "Restore a campaign from its spec and the CSV of its units (campaign export --csv): "
+        "finished units as they were, the others pending for --resume");
+    auto o = std::make_shared<ImportCommand>();
+    cmd->add_option("spec", o->spec, "The spec file (TOML) the units were run from")->required();
+    cmd->add_option("units", o->units, "The units CSV (campaign export --csv)")->required();
+    cmd->footer(
+        "A dataset computed in parts keeps each part's units in the repository; on another\n"
+        "machine, import them, resume the parts not finished, and build the dataset:\n"
+        "  draglab --db s.db campaign import data/campaigns/standard/standard_re100.toml \\\n"
+        "      data/datasets/standard/standard_re100.csv\n"
+        "  draglab --db s.db campaign run data/campaigns/standard/standard_re100.toml --resume\n"
+        "Refused with exit 2, nothing stored: a header without the export's columns, a cell\n"
+        "that is not a finite number, a unit twice or missing, a row that is not a unit of the\n"
+        "spec (phi, Re, d or seed differ), a campaign of that name already in the database.");
+    cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_import(ctx, *o); }; });
   }
 
   CLI::App* dataset = app.add_subcommand(

@@ -292,7 +292,7 @@ struct PlannedUnit {
   double resolution, cost;
 };
 
-std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::string& spec_json,
+std::int64_t insert_campaign(Database& db, const CampaignSpec& spec, const std::string& spec_json,
                              const std::string& spec_hash) {
   std::vector<PlannedUnit> plan;
   for (int i = 0; i < static_cast<int>(spec.phi.size()); ++i) {
@@ -309,7 +309,6 @@ std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::
   }
   std::stable_sort(plan.begin(), plan.end(),
                    [](const PlannedUnit& a, const PlannedUnit& b) { return a.cost > b.cost; });
-  Transaction tx(db.handle(), Transaction::Kind::kWrite);
   Statement c(db.handle(),
               "INSERT INTO campaigns (name, spec_json, spec_hash, created_at, code_version) "
               "VALUES (?, ?, ?, ?, ?)");
@@ -330,6 +329,13 @@ std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::
                   internal::packing_seed(spec.seed, p.phi_index, p.realization)));
     u.run();
   }
+  return id;
+}
+
+std::int64_t create_campaign(Database& db, const CampaignSpec& spec, const std::string& spec_json,
+                             const std::string& spec_hash) {
+  Transaction tx(db.handle(), Transaction::Kind::kWrite);
+  const std::int64_t id = insert_campaign(db, spec, spec_json, spec_hash);
   tx.commit();
   return id;
 }

@@ -74,6 +74,14 @@ OpenedCampaign open_campaign(const std::string& db_path, const CampaignSpec& spe
                              const RunCampaignOptions& options, int workers_per_node);
 
 DatabaseOptions worker_db_options();
+/// Writes the campaign row and one pending unit per (phi, Re, realization, resolution) of the
+/// spec (most expensive first), inside the caller's transaction; returns the campaign's id.
+std::int64_t insert_campaign(Database& db, const CampaignSpec& spec, const std::string& spec_json,
+                             const std::string& spec_hash);
+/// The id of the campaign named `name` (0 if none), and its spec hash.
+std::int64_t find_campaign(const Database& db, const std::string& name, std::string* spec_hash);
+/// Database schema version 4 or later, else Error(kDatabase) naming `draglab db migrate`.
+void require_campaign_tables(const Database& db);
 
 /// Claims the next pending unit (most expensive first) for `token`; false when none is left.
 bool claim_next(Database& db, std::int64_t campaign_id, const std::string& token,

@@ -35,6 +35,10 @@ cp "$data/scenes/dpm_bubble_quick.toml" "$in/dpm.toml"
 cp "$data/scenes/dbm_tiny.toml" "$in/dbm.toml"
 cp "$data/scenes/dpm_tiny.toml" "$in/dpm_tiny.toml"
 cp "$data/scenes/tfm_bubble.toml" "$in/tfm.toml"
+# A committed part of the standard dataset: its spec, another part's spec and its units.
+cp "$data/campaigns/standard/standard_re100.toml" "$in/part.toml"
+cp "$data/campaigns/standard/standard_low.toml" "$in/part_low.toml"
+cp "$data/datasets/standard/standard_re100.csv" "$in/part_units.csv"
 # A damaged packing that crashes libhdf5 itself (fuzz/regressions/README.md).
 cp "$data/../fuzz/regressions/libhdf5_global_heap_read.h5" "$in/crashes_libhdf5.h5"
 $D dataset import "$in/good.csv" >/dev/null 2>&1 || { echo "fixture: import failed"; exit 1; }

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -274,6 +275,34 @@ struct UnitsExport {
   std::string json;  ///< A JSON array of objects, one per unit (result_json parsed).
 };
 UnitsExport export_units(const Database& db, std::int64_t campaign_id);
+/// A campaign restored from its spec and the CSV of its units (`campaign export --csv`): the
+/// way a dataset computed in parts keeps its units in the repository rather than in a database a
+/// machine may lose. Finished units come back as the file has them (their values to the bit, so
+/// a dataset built from them has the same id); the others come back pending, for `campaign run
+/// --resume` (their checkpoints do not travel with the file). Refused (Error(kInvalidArgument),
+/// naming the file, line and column; nothing is stored): a header without exactly the columns
+/// of the export, a row whose field count differs, a cell that is not a finite number where the
+/// schema has a number, a done unit without its drag, error estimate, code version or record, a
+/// failed unit without its diagnosis, a row that is not a unit of this spec (its phi, Re, d or
+/// seed differ, or its indices lie outside the grid), a unit twice or missing, a spec-hash
+/// comment ("# Spec hash (SHA-256 of the canonical spec): ...") that is not this spec's, and a
+/// campaign of the same name already in the database.
+struct ImportSummary {
+  std::int64_t campaign_id = 0;
+  std::string name, spec_hash;
+  std::int64_t units = 0, done = 0, failed = 0, pending = 0;
+  std::set<std::string> code_versions;  ///< Of the finished units.
+  std::string BriefReport() const;
+  std::string ToJson() const;
+};
+ImportSummary import_campaign(Database& db, const CampaignSpec& spec,
+                              const std::string& units_path);
+/// The checks of import_campaign that need no database (all but the name already in one): for a
+/// command line that must refuse bad input before it opens, or creates, a database.
+void check_units_file(const CampaignSpec& spec, const std::string& units_path);
+/// The columns a units file has ("name TYPE", the schema's order and declared types).
+std::vector<std::string> units_file_columns();
+
 /// The drag of each size class of each finished unit of a campaign over polydisperse packings
 /// (lbm::SpeciesDrag, from the unit's record): CSV with a header, one row per unit and class:
 /// unit id, phi, re_target, re (achieved, on the Sauter mean), resolution, realization, the class's
