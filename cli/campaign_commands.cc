@@ -42,6 +42,8 @@ struct ExportCommand {
   std::string id;
   bool csv = false;
   bool species = false;
+  bool provenance = false;
+  std::vector<std::string> notes;
   std::string out;
 };
 
@@ -383,6 +385,8 @@ void run_status(const CliContext& ctx, const std::string& id) {
 
 /// Every column of every unit, straight from the table.
 void run_export(const CliContext& ctx, const ExportCommand& c) {
+  if (c.provenance && !c.csv) throw UsageError("--provenance is for --csv (JSON has the status)");
+  if (!c.notes.empty() && !c.provenance) throw UsageError("--note goes with --provenance");
   if (!c.out.empty()) core::check_output_file(c.out, "--out");
   std::unique_ptr<Database> db = ctx.open_database(true);
   const campaign::CampaignStatus st = campaign::campaign_status(*db, c.id);
@@ -399,11 +403,13 @@ void run_export(const CliContext& ctx, const ExportCommand& c) {
     return;
   }
   const campaign::UnitsExport units = campaign::export_units(*db, st.id);
-  const std::string text = c.csv ? units.csv
-                                 : nlohmann::json({{"campaign", status_json(st)},
-                                                   {"units", nlohmann::json::parse(units.json)}})
-                                           .dump(2) +
-                                       "\n";
+  const std::string text =
+      c.csv ? (c.provenance ? campaign::units_provenance(*db, st.id, c.notes) : std::string()) +
+                  units.csv
+            : nlohmann::json(
+                  {{"campaign", status_json(st)}, {"units", nlohmann::json::parse(units.json)}})
+                      .dump(2) +
+                  "\n";
   if (c.out.empty()) {
     std::cout << text;
     return;
@@ -624,9 +630,18 @@ void add_campaign_commands(CLI::App& app, CliContext& ctx) {
     cmd->add_flag("--species", o->species,
                   "CSV of the drag of each size class of each finished unit (polydisperse "
                   "packings): y, x, F_i with its own diameter, the mixture's F");
+    cmd->add_flag("--provenance", o->provenance,
+                  "With --csv: '#' lines above the table: spec hash, code versions and hosts of "
+                  "the finished units, their core-seconds, unit counts, this machine (for a "
+                  "shipped part; campaign import checks the spec hash)");
+    cmd->add_option("--note", o->notes,
+                    "With --provenance: one more '#' line (the command, a predicted cost); "
+                    "repeatable");
     cmd->add_option("--out", o->out, "Output file (default: stdout)");
     cmd->footer(
         "Examples:\n  draglab campaign export 1 > units.json\n"
+        "  draglab campaign export standard_re100 --csv --provenance --note 'Command: ...' "
+        "--out part.csv\n"
         "  draglab campaign export quick --csv --out units.csv\n"
         "  draglab campaign export bidisperse --species --out species.csv");
     cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { run_export(ctx, *o); }; });

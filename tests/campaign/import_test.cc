@@ -144,6 +144,35 @@ TEST_F(CampaignImport, APartNotFinishedComesBackWithItsRestPendingForResume) {
   EXPECT_EQ(st.spec_hash, s.spec_hash);
 }
 
+TEST_F(CampaignImport, AnExportWithItsProvenanceImportsAgain) {
+  const CampaignSpec spec = parse_campaign_spec(spec_of("standard_re100"));
+  const ImportSummary first = import_campaign(*db_, spec, units_of("standard_re100"));
+  const std::string header =
+      units_provenance(*db_, first.campaign_id, {"Command: draglab campaign run ..."});
+  EXPECT_NE(header.find("# Spec hash (SHA-256 of the canonical spec): " + first.spec_hash + "\n"),
+            std::string::npos)
+      << header;
+  EXPECT_NE(header.find("# Units: " + std::to_string(first.units) + ", done " +
+                        std::to_string(first.done) + ", failed " + std::to_string(first.failed) +
+                        ", not run " + std::to_string(first.pending)),
+            std::string::npos)
+      << header;
+  EXPECT_NE(header.find("# Command: draglab campaign run ...\n"), std::string::npos) << header;
+  for (const std::string& version : first.code_versions) {
+    EXPECT_NE(header.find(version), std::string::npos) << header;
+  }
+  const std::string file = dir_.file("exported.csv");
+  campaign_test::write_file(file, header + export_units(*db_, first.campaign_id).csv);
+  DatabaseOptions o;
+  o.seed_literature = false;
+  Database other(dir_.file("other.db"), o);
+  const ImportSummary again = import_campaign(other, spec, file);
+  EXPECT_EQ(again.done, first.done);
+  EXPECT_EQ(again.pending, first.pending);
+  EXPECT_EQ(rows_without_ids(export_units(other, again.campaign_id).csv),
+            rows_without_ids(export_units(*db_, first.campaign_id).csv));
+}
+
 TEST_F(CampaignImport, EveryMalformedFileIsRefusedNamingFileLineAndColumn) {
   const std::string part = "standard_re100";
   struct Case {

@@ -275,6 +275,12 @@ struct UnitsExport {
   std::string json;  ///< A JSON array of objects, one per unit (result_json parsed).
 };
 UnitsExport export_units(const Database& db, std::int64_t campaign_id);
+/// '#' comment lines to put above a units CSV that is shipped: the campaign, its spec hash (the
+/// line campaign import checks), the code versions and hosts of its finished units, their run
+/// time in core-seconds with the first start and last finish, the unit counts, this machine, and
+/// `notes` (one line each: the command, a predicted cost).
+std::string units_provenance(const Database& db, std::int64_t campaign_id,
+                             const std::vector<std::string>& notes);
 /// A campaign restored from its spec and the CSV of its units (`campaign export --csv`): the
 /// way a dataset computed in parts keeps its units in the repository rather than in a database a
 /// machine may lose. Finished units come back as the file has them (their values to the bit, so
