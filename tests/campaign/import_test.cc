@@ -198,6 +198,19 @@ TEST_F(CampaignImport, EveryMalformedFileIsRefusedNamingFileLineAndColumn) {
     }
   }
   ASSERT_GT(done_line, 0);
+  // The lines of the header and of the spec-hash comment.
+  int header_line = 0, hash_line = 0;
+  {
+    std::istringstream lines(text);
+    int n = 0;
+    for (std::string l; std::getline(lines, l);) {
+      ++n;
+      if (hash_line == 0 && l.rfind("# Spec hash", 0) == 0) hash_line = n;
+      if (header_line == 0 && l.rfind("id,", 0) == 0) header_line = n;
+    }
+  }
+  ASSERT_GT(header_line, 0);
+  ASSERT_GT(hash_line, 0);
   const auto with_F = [&](const std::string& value) {
     std::vector<std::size_t> commas;
     for (std::size_t i = 0; i < done_row.size() && commas.size() < 16; ++i) {
@@ -212,7 +225,7 @@ TEST_F(CampaignImport, EveryMalformedFileIsRefusedNamingFileLineAndColumn) {
        {"unknown column 'Fd'"}},
       {"missing_column",
        [&](std::string t) { return replace_first(t, ",mflups,", ","); },
-       {"line 8", "column 'mflups' is missing"}},
+       {"line " + std::to_string(header_line) + ": column 'mflups' is missing"}},
       {"extra_field",
        [&](std::string t) { return replace_first(t, done_row, done_row + ",1"); },
        {line, "28 fields, the header has 27"}},
@@ -233,7 +246,8 @@ TEST_F(CampaignImport, EveryMalformedFileIsRefusedNamingFileLineAndColumn) {
        {"is missing"}},
       {"other_spec_hash",
        [&](std::string t) { return replace_first(t, "canonical spec): 8", "canonical spec): 9"); },
-       {"line 3", "the file is a run of another spec"}},
+       {"line " + std::to_string(hash_line) + ": the file names spec hash",
+        "the file is a run of another spec"}},
       {"unknown_status",
        [&](std::string t) { return replace_first(t, ",done,", ",finished,"); },
        {line, "column 'status'"}},
@@ -281,7 +295,29 @@ TEST_F(CampaignImport, TheCommandLineRefusesBadInputWithExit2BeforeCreatingAData
             0)
       << err;
   EXPECT_NE(out.find("imported campaign 'standard_re100'"), std::string::npos) << out;
-  EXPECT_NE(out.find("--resume"), std::string::npos) << out;
+  // A part with units not finished says how to run them.
+  const std::string with_pending = variant("standard_re100", "pending", [](std::string t) {
+    const std::size_t at = t.find(",failed,");
+    const std::size_t row = t.rfind('\n', at) + 1;
+    const std::size_t end = t.find('\n', at);
+    std::vector<std::string> f;
+    std::string cell;
+    std::istringstream fields(t.substr(row, end - row));
+    for (int i = 0; i < 12 && std::getline(fields, cell, ','); ++i) f.push_back(cell);
+    f[10] = "pending";
+    std::string pending;
+    for (const std::string& c : f) pending += c + ",";
+    return t.substr(0, row) + pending + std::string(14, ',') + t.substr(end);
+  });
+  const std::string other = dir_.file("other.db");
+  EXPECT_EQ(campaign_test::run_cli(
+                {"--db", other, "campaign", "import", spec_of("standard_re100"), with_pending},
+                dir_.path(), &out, &err),
+            0)
+      << err;
+  EXPECT_NE(out.find("1 to run"), std::string::npos) << out;
+  EXPECT_NE(out.find("campaign run " + spec_of("standard_re100") + " --resume"), std::string::npos)
+      << out;
 }
 
 }  // namespace
