@@ -7,20 +7,22 @@
 # exported to data/datasets/standard/standard.csv.
 #
 #   scripts/standard_dataset.sh [--db FILE] [--run PART]... [--jobs N] [--draglab BIN]
-#                               [--allow-mixed-code]
+#                               [--run-with BIN] [--allow-mixed-code]
 #
 # --db: the database (default standard.db; parts already in it are not imported again).
 # --run PART: run this part (repeatable; in the order given). Its units are exported to
 #   data/datasets/standard/PART.csv when the run ends, also when it ends early (SIGTERM or a
 #   failure), so that what finished is kept.
-# --draglab BIN: the draglab that runs the parts (default build/cli/draglab); the code version of
-#   each unit is recorded, and a dataset of parts run by different versions needs
-#   --allow-mixed-code (recorded in the dataset's method).
+# --draglab BIN: the draglab that imports, exports and builds (default build/cli/draglab).
+# --run-with BIN: the draglab that runs the parts (default the --draglab one), e.g. the build of
+#   the commit that ran the other parts. The code version of each unit is recorded, and a dataset
+#   of parts run by different versions needs --allow-mixed-code (recorded in the dataset's method).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 db="standard.db"
 jobs=2
 draglab="$root/build/cli/draglab"
+runner=""
 mixed=()
 run=()
 while [[ $# -gt 0 ]]; do
@@ -29,11 +31,13 @@ while [[ $# -gt 0 ]]; do
     --run) run+=("$2"); shift 2 ;;
     --jobs) jobs="$2"; shift 2 ;;
     --draglab) draglab="$2"; shift 2 ;;
+    --run-with) runner="$2"; shift 2 ;;
     --allow-mixed-code) mixed=(--allow-mixed-code); shift ;;
-    *) echo "standard_dataset.sh: unknown option '$1' (--db, --run, --jobs, --draglab, --allow-mixed-code)" >&2
+    *) echo "standard_dataset.sh: unknown option '$1' (--db, --run, --jobs, --draglab, --run-with, --allow-mixed-code)" >&2
        exit 2 ;;
   esac
 done
+runner="${runner:-$draglab}"
 specs="$root/data/campaigns/standard"
 units="$root/data/datasets/standard"
 for part in "${run[@]}"; do
@@ -53,12 +57,12 @@ done
 # 2. The parts to run: the plan's prediction, the run, the export (also after an early end).
 for part in "${run[@]}"; do
   spec="$specs/$part.toml"
-  predicted="$("$draglab" --json campaign plan "$spec" --jobs "$jobs" 2>/dev/null |
+  predicted="$("$runner" --json campaign plan "$spec" --jobs "$jobs" 2>/dev/null |
     /usr/bin/python3 -c 'import json,sys; t=sys.stdin.read(); p=json.JSONDecoder().raw_decode(t[t.index("{"):])[0]; print("%.0f core-seconds, %.1f min on %d workers" % (p["core_seconds"], p["wall_seconds"] / 60, p["jobs"]))')"
   echo "standard_dataset.sh: $part: predicted $predicted" >&2
   command="draglab --db standard.db campaign run data/campaigns/standard/$part.toml --resume --jobs $jobs --threads-per-unit 1 --checkpoint-interval 300"
   rc=0
-  dl campaign run "$spec" --resume --jobs "$jobs" --threads-per-unit 1 --checkpoint-interval 300 || rc=$?
+  "$runner" --db "$db" campaign run "$spec" --resume --jobs "$jobs" --threads-per-unit 1 --checkpoint-interval 300 || rc=$?
   dl campaign export "$part" --csv --provenance \
     --note "Command: $command (this run's units; earlier units came back with campaign import)" \
     --note "Predicted by draglab campaign plan --jobs $jobs just before this run: $predicted (every unit of the part)" \

@@ -21,6 +21,7 @@
 //    correction restarts the window on which its unsteadiness is judged.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -63,6 +64,23 @@ bool stationary_fluctuating(const std::vector<double>& x, std::size_t window, do
 /// `steps_per_sample`. Infinite when the error is not known yet.
 double averaging_steps_left(double time_left_steps, double used, double relative_standard_error,
                             double tolerance, double steps_per_sample);
+
+/// The fraction a run reports as its progress: the largest of its estimates since its phase (the
+/// start-up, or the average, restarted with it) began. The estimates move back and forth with the
+/// MSER start-up and the standard error, and a line that followed them promised two ETAs.
+class PhaseProgress {
+ public:
+  /// The fraction to report for this estimate (clamped to [0, 1]).
+  double Show(double estimate) {
+    shown_ = std::max(shown_, std::min(std::max(estimate, 0.0), 1.0));
+    return shown_;
+  }
+  /// A new phase: its estimates start afresh (and may be lower).
+  void Restart() { shown_ = 0.0; }
+
+ private:
+  double shown_ = 0.0;
+};
 
 /// Corrections of the force inside Re's band (towards its middle third) once Re has reached
 /// it: a steady flow needs one or two.

@@ -991,6 +991,7 @@ class RunChecks {
     }
     loop_.averaging = true;
     loop_.averaging_start = step;
+    shown_progress_.Restart();
     result_.warnings.push_back("unsteady flow from step " + std::to_string(step) +
                                ": the force is held and F time-averaged");
     return Next::kGoOn;
@@ -1026,6 +1027,7 @@ class RunChecks {
         loop_.series_body.clear();
         loop_.averaging_start = loop_.step;
         ++loop_.averaging_restarts;
+        shown_progress_.Restart();
         return Next::kNextCheck;
       }
       if (average_F_.standard_error <= options_.average_tolerance * std::abs(average_F_.mean)) {
@@ -1036,7 +1038,7 @@ class RunChecks {
       const double se = average_F_.mean != 0.0
                             ? average_F_.standard_error / std::abs(average_F_.mean)
                             : std::numeric_limits<double>::infinity();
-      progress_(AveragingFraction(averaged_time, se),
+      progress_(shown_progress_.Show(AveragingFraction(averaged_time, se)),
                 "step " + std::to_string(loop_.step) +
                     ": averaging, F = " + format_fixed("%.6g", average_F_.mean) + " +- " +
                     format_fixed("%.2g", 100.0 * se) + " % over " +
@@ -1117,11 +1119,11 @@ class RunChecks {
       fraction = std::max(
           fraction, std::clamp(std::log(relative_change) / std::log(options_.tolerance), 0.0, 1.0));
     }
-    progress_(std::min(fraction, 1.0), "step " + std::to_string(loop_.step) +
-                                           ": F = " + format_fixed("%.6g", loop_.F_mean) +
-                                           ", Re = " + format_fixed("%.4g", loop_.re_lattice) +
-                                           ", change/T = " + format_fixed("%.2g", relative_change) +
-                                           ", " + format_fixed("%.4g", result_.mflups) + " MFLUPS");
+    progress_(shown_progress_.Show(fraction),
+              "step " + std::to_string(loop_.step) + ": F = " + format_fixed("%.6g", loop_.F_mean) +
+                  ", Re = " + format_fixed("%.4g", loop_.re_lattice) +
+                  ", change/T = " + format_fixed("%.2g", relative_change) + ", " +
+                  format_fixed("%.4g", result_.mflups) + " MFLUPS");
   }
 
  private:
@@ -1157,6 +1159,7 @@ class RunChecks {
   const std::vector<double>& body_force_;
   const ProgressCallback& progress_;
   Clock::time_point last_progress_;
+  PhaseProgress shown_progress_;
   MomentSummary m_;
   TimeAverage average_F_, average_re_;
   double sum_fx_ = 0.0;         ///< Sum of the bodies' x-forces at this check.

@@ -19,10 +19,13 @@
 //     the force, averages F after the start-up and stops with a blocking standard error
 //     <= 0.5 % after >= 20 d/U, with no controller restart. The mean must lie inside the band the
 //     instantaneous F swept (19.4 - 19.9 measured before the averaging existed) and Re within
-//     re_tolerance of 100 (with its own standard error).
+//     re_tolerance of 100 (with its own standard error). Its progress, reported while it
+//     averages, never goes back.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "validation_support.h"
 
@@ -87,8 +90,14 @@ TEST(FiniteReStability, CentralWallBlowsUpNearOneHalfWhereBouzidiHolds) {
 TEST(FiniteReStability, UnsteadyFlowIsTimeAveragedToHalfAPerCent) {
   const arrays::Packing packing = make_random_packing(0.3, 16, 1);
   RunOptions o = finite_re(100.0);
-  const RunResult r = run(packing, 16.0, o);
+  std::vector<double> averaging_progress;
+  const RunResult r = run(packing, 16.0, o, [&](double fraction, const std::string& status) {
+    if (status.find(": averaging") != std::string::npos) averaging_progress.push_back(fraction);
+  });
   report("phi 0.3, d 16, Re 100", format_run(r) + "\n" + r.FullReport());
+  // One progress estimate while averaging: it never goes back (no restart of the average here).
+  EXPECT_FALSE(averaging_progress.empty());
+  EXPECT_TRUE(std::is_sorted(averaging_progress.begin(), averaging_progress.end()));
   ASSERT_TRUE(r.converged) << r.diagnosis;
   EXPECT_TRUE(r.unsteady);
   EXPECT_LE(r.F_time_error, 5e-3 * r.F);
