@@ -58,9 +58,16 @@ std::vector<std::string> laws_for(const Scene& scene, const SceneArgs& args, con
 }
 
 nlohmann::json umf_json(const consumers::MinFluidizationResult& r) {
-  return {{"law", r.law},         {"umf_m_s", r.umf_m_s},       {"re_mf", r.re_mf},
-          {"eps_mf", r.eps_mf},   {"archimedes", r.archimedes}, {"F_mf", r.F_mf},
-          {"beta_mf", r.beta_mf}, {"iterations", r.iterations}};
+  return {{"law", r.law},
+          {"umf_m_s", r.umf_m_s},
+          {"re_mf", r.re_mf},
+          {"eps_mf", r.eps_mf},
+          {"archimedes", r.archimedes},
+          {"F_mf", r.F_mf},
+          {"beta_mf", r.beta_mf},
+          {"iterations", r.iterations},
+          {"extrapolation",
+           r.extrapolation.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.extrapolation)}};
 }
 
 void run_umf(const CliContext& ctx, const SceneArgs& args) {
@@ -72,7 +79,7 @@ void run_umf(const CliContext& ctx, const SceneArgs& args) {
   std::vector<consumers::MinFluidizationResult> results;
   for (const auto& ref : laws_for(scene, args, *db)) {
     std::string warning;
-    auto law = db->load(ref, RangePolicy::kError, &warning);
+    auto law = db->load(ref, range_policy_from_string(scene.range_policy), &warning);
     if (!warning.empty()) ctx.warn(warning);
     results.push_back(consumers::minimum_fluidization(*law, scene.particles, scene.gas, options));
     rows.push_back(umf_json(results.back()));
@@ -92,6 +99,10 @@ void run_umf(const CliContext& ctx, const SceneArgs& args) {
   for (const auto& r : results) {
     std::cout << fmt::format("{:<24} {:>10.4f} {:>9.2f} {:>10.4g} {:>12.4g}\n", r.law, r.umf_m_s,
                              r.re_mf, r.F_mf, r.beta_mf);
+  }
+  for (const auto& r : results) {
+    if (!r.extrapolation.empty())
+      std::cout << r.law << " EXTRAPOLATED: " << r.extrapolation << "\n";
   }
 }
 

@@ -2,6 +2,7 @@
 """Bubble and segregation of a bed of two sizes, per drag law, from a sensitivity study.
 
 Usage: /usr/bin/python3 draglab_binary_bed.py SENSITIVITY.json --out DIR [--table TABLE.md]
+                                              [--csv SERIES.csv]
 
 SENSITIVITY.json is what `draglab sensitivity SCENE --realizations N` writes for a DPM scene
 with size classes (data/scenes/dpm_binary.toml): per law, the runs of N packings (seeds), each
@@ -12,7 +13,9 @@ class minus that of the largest, over the mean height of all particles; docs/dpm
   - the table (stdout, and TABLE.md with --table): per law the bubble diameter at t_ref (the
     study's estimate with its uncertainty: the packings' spread and the grid's cell), and the
     segregation index at t_ref and at the end of the run, mean +- standard error over the
-    packings, and its change over the run.
+    packings, its change over the run, and that change minus the first law's on the same packing
+    (paired: the packings' own spread cancels), mean +- standard error;
+  - with --csv, every run's series: law, seed, t_s, bubble_diameter_m, segregation_index.
 Needs python3-matplotlib and python3-numpy (Debian; run with /usr/bin/python3). A file without
 a law, runs or the segregation series stops the script with one line naming the key: exit 2.
 """
@@ -56,7 +59,7 @@ def load(path):
                 fail("%s: law %s, seed %s: no series.segregation_index (a bed of one size?)"
                      % (path, law.get("law"), r.get("seed")))
             series.append((np.asarray(s["t_s"]), np.asarray(s["segregation_index"]),
-                           np.asarray(s["bubble_diameter_m"])))
+                           np.asarray(s["bubble_diameter_m"]), r.get("seed")))
         out.append((law, series))
     return data, out
 
@@ -64,7 +67,7 @@ def load(path):
 def main(argv):
     args = argv[1:]
     if not args or args[0].startswith("--"):
-        fail("usage: SENSITIVITY.json --out DIR [--table TABLE.md]")
+        fail("usage: SENSITIVITY.json --out DIR [--table TABLE.md] [--csv SERIES.csv]")
     path = args[0]
     opts = dict(zip(args[1::2], args[2::2]))
     if "--out" not in opts:
@@ -72,33 +75,51 @@ def main(argv):
     data, laws = load(path)
     t_ref = data.get("t_ref_s")
     rows = []
+    first_change = None
     for law, series in laws:
-        n = min(len(t) for t, _, _ in series)
+        n = min(len(t) for t, _, _, _ in series)
         t = series[0][0][:n]
-        seg = np.array([s[:n] for _, s, _ in series])
+        seg = np.array([s[:n] for _, s, _, _ in series])
         i_ref = int(np.argmin(np.abs(t - t_ref))) if t_ref is not None else n - 1
         at_ref = mean_se(seg[:, i_ref])
         at_end = mean_se(seg[:, -1])
-        change = mean_se(seg[:, -1] - seg[:, 0])
+        changes = seg[:, -1] - seg[:, 0]
+        change = mean_se(changes)
+        paired = None
+        if first_change is None:
+            first_change = changes
+        elif len(changes) == len(first_change):
+            paired = mean_se(changes - first_change)
         rows.append((law["law"], law.get("d_estimate_m"), law.get("uncertainty_m"), len(series),
-                     at_ref, at_end, change))
-    lines = ["| law | packings | bubble D at t_ref | segregation at t_ref | at the end | change over the run |",
-             "|---|---|---|---|---|---|"]
-    for name, d, u, k, ref, end, change in rows:
+                     at_ref, at_end, change, paired))
+    first = rows[0][0]
+    lines = ["| law | packings | bubble D at t_ref | segregation at t_ref | at the end | "
+             "change over the run | change minus %s's, per packing |" % first,
+             "|---|---|---|---|---|---|---|"]
+    for name, d, u, k, ref, end, change, paired in rows:
         dtxt = "%.1f ± %.1f mm" % (1e3 * d, 1e3 * u) if d is not None and u is not None else "-"
-        lines.append("| %s | %d | %s | %+.4f ± %.4f | %+.4f ± %.4f | %+.4f ± %.4f |"
-                     % (name, k, dtxt, ref[0], ref[1], end[0], end[1], change[0], change[1]))
+        ptxt = "%+.4f ± %.4f" % paired if paired is not None else ""
+        lines.append("| %s | %d | %s | %+.4f ± %.4f | %+.4f ± %.4f | %+.4f ± %.4f | %s |"
+                     % (name, k, dtxt, ref[0], ref[1], end[0], end[1], change[0], change[1], ptxt))
     print("\n".join(lines))
     if "--table" in opts:
         with open(opts["--table"], "w") as f:
             f.write("\n".join(lines) + "\n")
+
+    if "--csv" in opts:
+        with open(opts["--csv"], "w") as f:
+            f.write("law,seed,t_s,bubble_diameter_m,segregation_index\n")
+            for law, series in laws:
+                for t, seg, d, seed in series:
+                    for k in range(len(t)):
+                        f.write("%s,%s,%.6g,%.6g,%.6g\n" % (law["law"], seed, t[k], d[k], seg[k]))
 
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
     for law, series in laws:
-        n = min(len(t) for t, _, _ in series)
+        n = min(len(t) for t, _, _, _ in series)
         t = series[0][0][:n]
         for ax, k in ((ax1, 1), (ax2, 2)):
             v = np.array([s[k][:n] for s in series]) * (1e3 if k == 2 else 1.0)

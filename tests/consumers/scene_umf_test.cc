@@ -156,6 +156,32 @@ TEST_F(SceneUmfTest, OutsideTheValidityBoxIsAClearError) {
   }
 }
 
+// Asked to extrapolate (a scene's range_policy = "extrapolate"), U_mf is solved with the formula
+// as is beyond the law's box, and the result says which box it left: the same root of
+// 18 Re F = eps Ar (checked with the law evaluated directly), and inside the box the same U_mf
+// as under the default policy.
+TEST_F(SceneUmfTest, ExtrapolatingBeyondTheBoxSolvesTheFormulaAndSaysSo) {
+  SceneParticles steel = glass();
+  steel.diameter_m = 8e-3;
+  steel.density_kg_m3 = 7800.0;
+  MinFluidizationOptions o;
+  o.eps_mf = 0.42;
+  auto hkl = db_->load("hill_koch_ladd@1", RangePolicy::kExtrapolate);  // Re <= 300
+  const MinFluidizationResult r = minimum_fluidization(*hkl, steel, air(), o);
+  EXPECT_GT(r.re_mf, 300.0);
+  EXPECT_NE(r.extrapolation.find("Re in [0, 300]"), std::string::npos) << r.extrapolation;
+  EXPECT_NE(r.BriefReport().find("EXTRAPOLATED"), std::string::npos) << r.BriefReport();
+  const double F = hkl->F(1.0 - o.eps_mf, r.re_mf);
+  EXPECT_NEAR(18.0 * r.re_mf * F / (o.eps_mf * r.archimedes), 1.0, 1e-9);
+  EXPECT_DOUBLE_EQ(r.F_mf, F);
+
+  auto inside = db_->load("bvk2007@1", RangePolicy::kExtrapolate);
+  const MinFluidizationResult a = minimum_fluidization(*inside, glass(), air(), o);
+  const MinFluidizationResult b = minimum_fluidization(*db_->load("bvk2007@1"), glass(), air(), o);
+  EXPECT_TRUE(a.extrapolation.empty()) << a.extrapolation;
+  EXPECT_NEAR(a.umf_m_s / b.umf_m_s, 1.0, 1e-10);
+}
+
 TEST_F(SceneUmfTest, BadInputNamesTheField) {
   auto law = db_->load("ergun@1");
   MinFluidizationOptions o;

@@ -75,6 +75,7 @@ std::string DpmResult::BriefReport() const {
     << ", momentum mismatch " << Num(momentum_mismatch) << ", action-reaction max "
     << Num(max_action_reaction_mismatch_n) << " N, eps clamps " << void_fraction_clamps
     << ", drag out of range " << law_out_of_range;
+  if (!umf_extrapolation.empty()) s << "\n  U_mf EXTRAPOLATED: " << umf_extrapolation;
   return s.str();
 }
 
@@ -239,6 +240,7 @@ void DpmSimulation::Start(Particles settled) {
   result_.scene = s.name;
   result_.scene_hash = s.hash();
   result_.umf_m_s = derived.umf.umf_m_s;
+  result_.umf_extrapolation = derived.umf.extrapolation;
   result_.eps_mf = s.eps_mf;
   result_.t_ref_s = s.time.t_ref_s;
   {
@@ -261,7 +263,9 @@ void DpmSimulation::Start(Particles settled) {
     MinFluidizationOptions mo;
     mo.eps_mf = std::clamp(result_.eps_packing, 0.21, 0.89);
     try {
-      result_.umf_packing_m_s = minimum_fluidization(*law_, s.particles, s.gas, mo).umf_m_s;
+      const MinFluidizationResult packing = minimum_fluidization(*law_, s.particles, s.gas, mo);
+      result_.umf_packing_m_s = packing.umf_m_s;
+      if (result_.umf_extrapolation.empty()) result_.umf_extrapolation = packing.extrapolation;
     } catch (const Error& e) {
       if (s.distributor.mode == BackgroundMode::kUmfPacking && opt_.background_override_m_s < 0.0)
         throw Error(e.code(),

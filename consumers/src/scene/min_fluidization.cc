@@ -105,6 +105,7 @@ std::string MinFluidizationResult::BriefReport() const {
     << ", Ar = " << format_number(archimedes, 4) << ", F = " << format_number(F_mf, 4)
     << ", beta = " << format_number(beta_mf, 4) << " kg/m^3/s, " << iterations
     << " Brent iterations)";
+  if (!extrapolation.empty()) s << "; EXTRAPOLATED: " << extrapolation;
   return s.str();
 }
 
@@ -135,12 +136,14 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   const double eps = options.eps_mf, phi = 1.0 - eps;
   const ValidityBox& box = law.record().validity;
   const std::string ref = law.reference();
-  if (!box.phi.contains(phi)) {
-    throw Error(
-        ErrorCode::kOutOfValidity,
-        ref + ": the bed at eps_mf = " + format_number(eps) + " (phi = " + format_number(phi) +
-            ") is outside the law's validity range phi in [" + format_number(box.phi.min) + ", " +
-            format_number(box.phi.max) + "]; use an eps_mf inside it or another law");
+  // Asked to extrapolate, the formula is solved as is beyond the box (the result says so).
+  const bool extrapolate = law.range_policy() == RangePolicy::kExtrapolate;
+  if (!extrapolate && !box.phi.contains(phi)) {
+    throw Error(ErrorCode::kOutOfValidity,
+                ref + ": the bed at eps_mf = " + format_number(eps) + " (phi = " +
+                    format_number(phi) + ") is outside the law's validity range phi in [" +
+                    format_number(box.phi.min) + ", " + format_number(box.phi.max) +
+                    "]; use an eps_mf inside it, another law, or range_policy = \"extrapolate\"");
   }
   // Monodisperse particles: every polydispersity input y_i = d_i/<d> is 1.
   std::vector<double> extra(static_cast<std::size_t>(law.num_extra_inputs()), 1.0);
@@ -166,7 +169,8 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
 
   // Bracket: the first sign change on a log grid over the law's Re range (the residual of a
   // physical law grows monotonically with Re; the scan also copes with one that does not).
-  const double re_lo = box.re.min, re_hi = box.re.max;
+  const double re_lo = extrapolate ? 0.0 : box.re.min;
+  const double re_hi = extrapolate ? std::max(box.re.max, kExtrapolatedReMax) : box.re.max;
   double a = re_lo, fa = residual(re_lo);
   if (fa > 0.0) {
     throw Error(ErrorCode::kOutOfValidity,
@@ -196,8 +200,8 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
                     " (U = " + format_number(u_hi, 4) +
                     " m/s) does not yet carry the bed's weight (Ar = " + format_number(ar, 4) +
                     ", eps_mf = " + format_number(eps) +
-                    "): U_mf lies outside its validity box; use a law valid at higher Re or "
-                    "smaller/lighter particles");
+                    "): U_mf lies outside its validity box; use a law valid at higher Re, "
+                    "smaller/lighter particles, or range_policy = \"extrapolate\"");
   }
   MinFluidizationResult r;
   bool converged = false;
@@ -217,6 +221,12 @@ MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles&
   r.F_mf = bed_F(r.re_mf);
   r.beta_mf = 18.0 * phi * eps * r.F_mf * mu / (d * d);
   r.residual = residual(r.re_mf);
+  if (!box.phi.contains(phi) || !box.re.contains(r.re_mf)) {
+    r.extrapolation = "outside the law's validity box (phi in [" + format_number(box.phi.min) +
+                      ", " + format_number(box.phi.max) + "], Re in [" + format_number(box.re.min) +
+                      ", " + format_number(box.re.max) +
+                      "]): the formula evaluated as is (range_policy = \"extrapolate\")";
+  }
   return r;
 }
 

@@ -89,6 +89,9 @@ struct DpmResult {
   /// U_mf at it (background "umf_packing" uses the latter).
   double eps_packing = 0.0;
   double umf_packing_m_s = 0.0;
+  /// Empty when the law's U_mf lies inside its validity box; otherwise (range_policy =
+  /// "extrapolate") the box it lies outside (MinFluidizationResult::extrapolation).
+  std::string umf_extrapolation;
   double t_ref_s = 0.0;            ///< After jet start.
   double bubble_diameter_m = 0.0;  ///< At t_ref (nearest sample); 0 if none found.
   bool bubble_at_t_ref = false;    ///< A sample at t_ref existed and held a bubble.

@@ -248,6 +248,10 @@ Scene parse_scene(const std::string& toml_text, const std::string& origin = "<sc
 /// Reads and parses a scene file; a missing file is Error(kNotFound).
 Scene load_scene(const std::string& path);
 
+/// The largest Re_mf minimum_fluidization looks for beyond a law's box when asked to extrapolate
+/// (a bed of 1 cm glass beads in air fluidizes near Re 2 000).
+constexpr double kExtrapolatedReMax = 1e5;
+
 /// Options of minimum_fluidization.
 struct MinFluidizationOptions {
   double eps_mf = 0.42;               ///< Bed gas fraction at minimum fluidization, (0.2, 0.9).
@@ -267,6 +271,9 @@ struct MinFluidizationResult {
   double beta_mf = 0.0;     ///< beta at U_mf [kg m^-3 s^-1].
   double residual = 0.0;    ///< (18 Re F - eps Ar) / (eps Ar) at the solution.
   int iterations = 0;       ///< Brent iterations (bracketing excluded).
+  /// Empty inside the law's validity box; otherwise (only under RangePolicy::kExtrapolate) the
+  /// box the solution lies outside.
+  std::string extrapolation;
   std::string BriefReport() const;
 };
 
@@ -274,6 +281,8 @@ struct MinFluidizationResult {
 /// Throws Error(kInvalidArgument) for bad particle/gas values or options, Error(kOutOfValidity)
 /// when 1 - eps_mf is outside the law's phi range or no root lies inside its Re range (the
 /// message names the law, the range and a remedy), Error(kInternal) if Brent does not converge.
+/// A law loaded with RangePolicy::kExtrapolate is solved beyond its box instead (Re up to
+/// kExtrapolatedReMax), and the result's `extrapolation` says so.
 MinFluidizationResult minimum_fluidization(const Law& law, const SceneParticles& particles,
                                            const SceneGas& gas,
                                            const MinFluidizationOptions& options);
