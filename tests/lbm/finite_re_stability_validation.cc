@@ -15,7 +15,8 @@
 //     (tau = 0.5135, the velocity the former budget chose): CLI blows up, and the run reports a
 //     numerical instability with the cell Reynolds number and a larger d; BFL at the same tau
 //     holds 30 000 steps.
-//  3. Unsteady flow. phi 0.3, 16 spheres, d 16, Re 100: the flow does not settle; the run holds
+//  3. Unsteady flow. phi 0.3, 16 spheres, d 16, Re 100, TRT: the flow does not settle; the run
+//  holds
 //     the force, averages F after the start-up and stops with a blocking standard error
 //     <= 0.5 % after >= 20 d/U, with no controller restart. The mean must lie inside the band the
 //     instantaneous F swept (19.4 - 19.9 measured before the averaging existed) and Re within
@@ -90,6 +91,9 @@ TEST(FiniteReStability, CentralWallBlowsUpNearOneHalfWhereBouzidiHolds) {
 TEST(FiniteReStability, UnsteadyFlowIsTimeAveragedToHalfAPerCent) {
   const arrays::Packing packing = make_random_packing(0.3, 16, 1);
   RunOptions o = finite_re(100.0);
+  // TRT named: the band below was measured with it, and auto runs rr here (kappa Re/d 30.7 > 23),
+  // whose mean lies 3.4 % lower, within its wall error estimate (docs/validation.md).
+  o.collision = Collision::kTrt;
   std::vector<double> averaging_progress;
   const RunResult r = run(packing, 16.0, o, [&](double fraction, const std::string& status) {
     if (status.find(": averaging") != std::string::npos) averaging_progress.push_back(fraction);
