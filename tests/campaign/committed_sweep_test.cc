@@ -181,7 +181,8 @@ namespace {
 // database and exported to data/datasets/standard/NAME.csv) and the dataset built from them
 // (data/datasets/standard/standard.csv; docs/campaigns.md, "A dataset in parts").
 const std::vector<Part> kStandardParts = {{"standard", "standard_low"},
-                                          {"standard", "standard_re100"}};
+                                          {"standard", "standard_re100"},
+                                          {"standard", "standard_re300_mid"}};
 const std::string kStandardDataset = kDatasets + "standard/standard.csv";
 
 TEST(CommittedStandard, EachPartIsTheRunOfItsCommittedSpecAtTheRulesResolutions) {

@@ -105,7 +105,7 @@ TEST_F(CampaignImport, TheFileListsTheColumnsOfTheSchema) {
 
 TEST_F(CampaignImport, TheCommittedPartsComeBackToTheBitAndRebuildTheCommittedDataset) {
   std::vector<std::int64_t> ids;
-  for (const std::string part : {"standard_low", "standard_re100"}) {
+  for (const std::string part : {"standard_low", "standard_re100", "standard_re300_mid"}) {
     SCOPED_TRACE(part);
     const ImportSummary summary =
         import_campaign(*db_, parse_campaign_spec(spec_of(part)), units_of(part));
