@@ -221,6 +221,7 @@ UnitOutcome execute_unit(const CampaignSpec& spec, const ClaimedUnit& unit, int 
       result = lbm::run_case(packing, co, progress);
     }
     out.run = result.run;
+    out.earlier_parts_s = out.run.earlier_parts_wall_s;
     if (!stale.empty()) out.run.warnings.push_back("started afresh: " + stale);
     out.done = out.run.converged && std::isfinite(out.run.F);
     out.diagnosis = out.run.converged ? "" : out.run.diagnosis;
@@ -268,7 +269,7 @@ bool commit_unit(Database& db, const ClaimedUnit& unit, const std::string& token
   bind_or_null(s, 4, o.done ? o.run.beta_d2_over_mu : NAN);
   bind_or_null(s, 5, o.done ? o.run.re : NAN);
   bind_or_null(s, 6, o.done ? o.run.error_estimate : NAN);
-  s.bind(7, o.run.steps).bind(8, o.wall_s);
+  s.bind(7, o.run.steps).bind(8, o.wall_s + o.earlier_parts_s);
   bind_or_null(s, 9, o.run.mflups);
   s.bind(10, o.done ? 1 : 0).bind(11, o.diagnosis).bind(12, o.packing_hash);
   s.bind(13, kDragDbVersion).bind(14, o.result.dump()).bind(15, unit.id).bind(16, token);
@@ -516,6 +517,7 @@ nlohmann::json outcome_to_json(const UnitOutcome& o) {
           {"diagnosis", o.diagnosis},
           {"packing_hash", o.packing_hash},
           {"wall_s", o.wall_s},
+          {"earlier_parts_s", o.earlier_parts_s},
           {"result", o.result},
           {"F", number(o.run.F)},
           {"beta_d2_over_mu", number(o.run.beta_d2_over_mu)},
@@ -531,6 +533,7 @@ UnitOutcome outcome_from_json(const nlohmann::json& j) {
   o.diagnosis = j.at("diagnosis").get<std::string>();
   o.packing_hash = j.at("packing_hash").get<std::string>();
   o.wall_s = j.at("wall_s").get<double>();
+  o.earlier_parts_s = j.value("earlier_parts_s", 0.0);
   o.result = j.at("result");
   o.run.F = number_from(j, "F");
   o.run.beta_d2_over_mu = number_from(j, "beta_d2_over_mu");

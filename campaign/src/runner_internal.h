@@ -53,6 +53,9 @@ struct UnitOutcome {
   std::string diagnosis;
   std::string packing_hash;
   double wall_s = 0.0;
+  /// A unit resumed from its checkpoint: the wall seconds of its earlier parts (the unit's cost,
+  /// stored as its wall_s, is this part's plus these).
+  double earlier_parts_s = 0.0;
   nlohmann::json result;
 };
 

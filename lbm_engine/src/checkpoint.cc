@@ -90,6 +90,7 @@ Json state_json(const LoopState& s) {
   j["history"] = doubles_json(history);
   j["warnings"] = s.warnings;
   j["measured_pore_speed_ratio"] = double_bits(s.measured_pore_speed_ratio);
+  j["elapsed_s"] = double_bits(s.elapsed_s);
   return j;
 }
 
@@ -125,6 +126,8 @@ LoopState json_state(const Json& j) {
   s.warnings = j.at("warnings").get<std::vector<std::string>>();
   // (absent from the first checkpoints: the run then measures kappa again)
   s.measured_pore_speed_ratio = bits_double(j.value("measured_pore_speed_ratio", std::uint64_t{0}));
+  // (absent from checkpoints written before the runs kept their time: the earlier parts count 0)
+  s.elapsed_s = bits_double(j.value("elapsed_s", std::uint64_t{0}));
   return s;
 }
 

@@ -67,6 +67,9 @@ struct LoopState {
   /// The pore-speed ratio kappa a Stokes run measured for the velocity plan (0: none), so that
   /// a resumed run plans with it instead of running that Stokes run again.
   double measured_pore_speed_ratio = 0.0;
+  /// Wall seconds of the run up to its last save, over every part (a resumed run's cost is that
+  /// of its earlier parts plus its own).
+  double elapsed_s = 0.0;
 };
 
 /// What must be equal for a run to resume from a checkpoint, as (name, value) text pairs (the

@@ -374,13 +374,14 @@ class RunCheckpoint {
   /// What a checkpoint saves: the loop's state and the result's history, Mach and the loop's
   /// warnings (those from `warnings_from` on), and the solver's state.
   RunCheckpoint(const RunOptions& options, const mpi::Communicator& group, SolverBase* solver,
-                LoopState* loop, RunResult* result)
+                LoopState* loop, RunResult* result, std::chrono::steady_clock::time_point started)
       : options_(options),
         group_(group),
         solver_(solver),
         loop_(loop),
         result_(result),
-        warnings_from_(result->warnings.size()) {
+        warnings_from_(result->warnings.size()),
+        started_(started) {
     if (options.checkpoint.empty()) return;
     path_ = checkpoint_file(options, group);
     const std::string other = checkpoint_of_other_ranks(options.checkpoint, group.size());
@@ -402,6 +403,8 @@ class RunCheckpoint {
     if (resume_from_checkpoint(path_, fingerprint_, group_, solver_, loop_, result_)) {
       owned_ = true;
       saved_step_ = loop_->step;
+      earlier_parts_s_ = loop_->elapsed_s;
+      result_->earlier_parts_wall_s = earlier_parts_s_;
     }
     last_ = Clock::now();
   }
@@ -427,6 +430,8 @@ class RunCheckpoint {
     loop_->mach_max = result_->mach_max;
     loop_->warnings.assign(result_->warnings.begin() + static_cast<std::ptrdiff_t>(warnings_from_),
                            result_->warnings.end());
+    loop_->elapsed_s =
+        earlier_parts_s_ + std::chrono::duration<double>(Clock::now() - started_).count();
     on_all_ranks(group_,
                  [&] { save_run_checkpoint(path_, fingerprint_, *loop_, solver_->state()); });
     owned_ = true;
@@ -453,6 +458,8 @@ class RunCheckpoint {
   bool owned_ = false, keep_ = false;
   std::int64_t saved_step_ = 0;
   Clock::time_point last_ = Clock::now();
+  Clock::time_point started_;     ///< This part's start.
+  double earlier_parts_s_ = 0.0;  ///< The wall seconds of the parts before this one.
 };
 
 /// The force that brings Re to target_re: a secant step in log G against log Re through the last
@@ -1307,7 +1314,7 @@ RunResult run_impl(const arrays::VoxelGrid& grid, double phi_exact, const RunOpt
 
   // Checkpoint: resume from it (the same run only), then rewrite it now and then.
   loop.measured_pore_speed_ratio = plan != nullptr && plan->kappa_measured ? plan->kappa : 0.0;
-  checkpoint = std::make_unique<RunCheckpoint>(options, group, solver, &loop, &result);
+  checkpoint = std::make_unique<RunCheckpoint>(options, group, solver, &loop, &result, start);
   if (checkpoint->enabled()) {
     checkpoint->Resume(
         run_fingerprint(grid, lattice, links, options, settings, result, interval, group));

@@ -241,8 +241,10 @@ std::string RunResult::FullReport() const {
       << (ranks > 1 ? " on " + std::to_string(ranks) + " ranks" : std::string()) << "\n";
   if (resumed_from_step > 0 || checkpoints_written > 0) {
     out << "checkpoint           "
-        << (resumed_from_step > 0 ? "resumed at step " + std::to_string(resumed_from_step)
-                                  : std::string("started afresh"))
+        << (resumed_from_step > 0
+                ? "resumed at step " + std::to_string(resumed_from_step) +
+                      " (the earlier parts: " + format_fixed("%.4g", earlier_parts_wall_s) + " s)"
+                : std::string("started afresh"))
         << ", " << checkpoints_written << " written\n";
   }
   for (const std::string& w : warnings) out << "warning              " << w << "\n";
@@ -320,6 +322,7 @@ std::string RunResult::ToJson(const RunOptions& o) const {
   if (ranks > 1) j["ranks"] = ranks;  // a one-rank run's record stays as it always was
   if (!o.checkpoint.empty()) {
     j["resumed_from_step"] = resumed_from_step;
+    j["earlier_parts_wall_s"] = earlier_parts_wall_s;
     j["checkpoints_written"] = checkpoints_written;
   }
   j["d_hydrodynamic"] =

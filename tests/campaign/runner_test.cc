@@ -290,6 +290,13 @@ TEST(CampaignRunner, UnitKilledMidRunGoesOnFromItsCheckpoint) {
   EXPECT_EQ(fresh["resumed_from_step"].get<long long>(), 0);
   EXPECT_EQ(resumed["F"].get<double>(), fresh["F"].get<double>());  // the same bits
   EXPECT_EQ(resumed["steps"], fresh["steps"]);
+  // The unit's cost counts the killed part too, up to its checkpoint.
+  const double earlier = resumed["earlier_parts_wall_s"].get<double>();
+  EXPECT_GT(earlier, 0.0) << resumed.dump();
+  EXPECT_EQ(fresh["earlier_parts_wall_s"].get<double>(), 0.0);
+  EXPECT_GE(
+      std::stod(RawDb(db).rows("SELECT wall_s FROM campaign_units WHERE status = 'done'").at(0)),
+      resumed["lbm_wall_s"].get<double>() + earlier);
 }
 
 // A resumed unit reports at once the progress its checkpoint holds; the ETA extrapolates the

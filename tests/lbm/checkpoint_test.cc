@@ -158,6 +158,10 @@ TEST(Checkpoint, RunStoppedOnRequestSavesItsStateAndGoesOnToTheSameBits) {
   const RunResult resumed = run(sc.grid, sc.packing.phi(), o);
   ASSERT_TRUE(resumed.converged) << format_run(resumed);
   EXPECT_EQ(resumed.resumed_from_step, stopped.steps);
+  // The first part's time comes back with the checkpoint (the run's cost is both parts').
+  EXPECT_GT(resumed.earlier_parts_wall_s, 0.0);
+  EXPECT_LE(resumed.earlier_parts_wall_s, stopped.wall_s);
+  EXPECT_EQ(reference.earlier_parts_wall_s, 0.0);
   EXPECT_EQ(resumed.F, reference.F);  // the same bits
   EXPECT_EQ(resumed.steps, reference.steps);
   EXPECT_FALSE(exists(o.checkpoint));

@@ -295,6 +295,9 @@ struct RunResult {
   std::int64_t characteristic_steps = 0;  ///< Steps per characteristic time (see run()).
   std::size_t memory_bytes = 0;           ///< Populations plus lattice tables.
   std::int64_t resumed_from_step = 0;     ///< The checkpoint's step it went on from (0: none).
+  /// A resumed run: the wall seconds of its earlier parts, up to the checkpoint it went on from
+  /// (wall_s is this part's; the run's cost is their sum).
+  double earlier_parts_wall_s = 0.0;
   int checkpoints_written = 0;
   /// request_stop() ended the run at a check (its checkpoint, if it keeps one, holds the step).
   bool stopped_on_request = false;
