@@ -76,6 +76,36 @@ TEST(SceneParse, SeedSceneDeclaresTheSeedBed) {
   EXPECT_NE(q.hash(), s.hash());
 }
 
+// data/scenes/dpm_binary_seed.toml is the seed's bed (dpm_bubble.toml: box, bed height, gas, jet
+// and time line) with its 2.5 mm beads replaced by 1.5 and 3 mm glass at equal volume (issue 36),
+// and dpm_binary.toml the same beads in the quick scene's box.
+TEST(SceneParse, BinarySeedSceneIsTheSeedBedWithTwoSizes) {
+  const std::string dir = std::string(DRAGLAB_DATA_DIR) + "/scenes/";
+  const Scene seed = load_scene(dir + "dpm_bubble.toml");
+  const Scene bin = load_scene(dir + "dpm_binary_seed.toml");
+  EXPECT_DOUBLE_EQ(bin.geometry.width_m, seed.geometry.width_m);
+  EXPECT_DOUBLE_EQ(bin.geometry.height_m, seed.geometry.height_m);
+  EXPECT_DOUBLE_EQ(bin.geometry.depth_m, seed.geometry.depth_m);
+  EXPECT_DOUBLE_EQ(bin.bed_height_mf_m(), seed.bed_height_mf_m());
+  EXPECT_DOUBLE_EQ(bin.particles.density_kg_m3, seed.particles.density_kg_m3);
+  EXPECT_DOUBLE_EQ(bin.gas.density_kg_m3, seed.gas.density_kg_m3);
+  EXPECT_DOUBLE_EQ(bin.gas.viscosity_pa_s, seed.gas.viscosity_pa_s);
+  EXPECT_DOUBLE_EQ(bin.jet.slot_width_m, seed.jet.slot_width_m);
+  EXPECT_DOUBLE_EQ(bin.jet.velocity_m_s, seed.jet.velocity_m_s);
+  EXPECT_DOUBLE_EQ(bin.jet.start_s, seed.jet.start_s);
+  EXPECT_DOUBLE_EQ(bin.jet.duration_s, seed.jet.duration_s);
+  EXPECT_DOUBLE_EQ(bin.time.t_ref_s, seed.time.t_ref_s);
+  EXPECT_DOUBLE_EQ(bin.time.duration_s, seed.time.duration_s);
+  ASSERT_TRUE(bin.polydisperse());
+  const Scene quick = load_scene(dir + "dpm_binary.toml");
+  EXPECT_EQ(bin.particles.diameters_m, quick.particles.diameters_m);
+  EXPECT_EQ(bin.particles.volume_fractions, quick.particles.volume_fractions);
+  EXPECT_EQ(bin.laws, quick.laws);
+  // Equal volumes of 1.5 and 3 mm spheres: 8 small per large; the solids volume
+  // 0.58 * 0.15 * 0.015 * 0.22 = 2.871e-4 m^3 holds 81 233 small and 10 154 large.
+  EXPECT_NEAR(static_cast<double>(bin.particle_count()), 91387.0, 2.0);
+}
+
 // data/scenes/dpm_tiny.toml, the shared scene of the fast tests: the bed the tests' comments
 // describe (tests derive their variants from it key by key, so a change here shows up there).
 TEST(SceneParse, TinySceneDeclaresTheTestBed) {
