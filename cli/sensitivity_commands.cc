@@ -65,6 +65,7 @@ struct SensitivityArgs {
   double t_ref_s = -1.0;  // --t-ref: the snapshot time after injection (not given: the scene's)
   bool t_ref_given = false;
   std::string out_dir;
+  bool resume = false;  // --resume: keep the finished runs in DIR/state, go on from them
   bool no_figure = false;
   std::string beside;  // --beside OTHER/sensitivity.json: fig5.png, OTHER's panels above these
   bool work_precision = false;
@@ -164,8 +165,22 @@ void print_sensitivity_table(const workflows::SensitivitySummary& s) {
   for (const auto& p : s.packings) {
     if (p.particles == 0) continue;
     std::cout << fmt::format(
-        "  packing seed {}: {} particles, settled bed {} cm, settling {:.1f} s\n", p.seed,
-        p.particles, cm(p.settled_bed_height_m), p.settle_wall_s);
+        "  packing seed {}: {} particles, settled bed {} cm, settling {:.1f} s{}\n", p.seed,
+        p.particles, cm(p.settled_bed_height_m), p.settle_wall_s,
+        p.reused ? " (kept from an earlier part of the study)" : "");
+  }
+  int kept = 0, runs = 0;
+  for (const auto& lr : s.laws) {
+    for (const auto& r : lr.runs) {
+      ++runs;
+      kept += r.reused ? 1 : 0;
+    }
+  }
+  if (kept > 0) {
+    std::cout << fmt::format(
+        "  {} of {} runs kept from an earlier part of the study (--resume); their wall times are "
+        "those of that part\n",
+        kept, runs);
   }
 }
 
@@ -224,6 +239,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
     if (args.law.empty()) throw UsageError("--work-precision needs --law NAME@V (one law)");
     if (args.law.find(',') != std::string::npos)
       throw UsageError("--law: --work-precision takes one NAME@V, got '" + args.law + "'");
+    if (args.resume) throw UsageError("--resume applies to the law table, not --work-precision");
   } else {
     std::vector<std::string> given;
     if (!args.law.empty()) given.push_back("--law");
@@ -308,6 +324,7 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
 
   workflows::StudyOutput output;
   output.out_dir = args.out_dir.empty() ? "out/" + scene.name + "_sensitivity" : args.out_dir;
+  if (args.resume) sens.state_directory = output.out_dir + "/state";
   output.figure = !args.no_figure;
   output.beside = args.beside;
   output.quiet = ctx.quiet;
@@ -384,6 +401,11 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
       ->each([args](const std::string&) { args->duration_given = true; });
   cmd->add_option("--out", args->out_dir,
                   "Output folder for the JSON data and the PNG (default out/<scene>_sensitivity)");
+  cmd->add_flag("--resume", args->resume,
+                "Keep each finished run and settled packing in DIR/state as the study goes, and "
+                "take from there what the same study already finished: a long study stopped "
+                "part-way (killed, or a session's end) goes on where it was when run again with "
+                "the same command, with the results of an uninterrupted one");
   cmd->add_flag("--no-figure", args->no_figure,
                 "Write the JSON data only (draw later with /usr/bin/python3 "
                 "scripts/draglab_fig4.py DATA.json DIR)");
@@ -414,6 +436,8 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --uncertainty grids --json\n"
       "  draglab sensitivity data/scenes/tfm_bubble.toml --laws gidaspow@1,hill_koch_ladd@1 "
       "--beside out/dpm_bubble_sensitivity/sensitivity.json\n"
+      "  draglab sensitivity data/scenes/dpm_binary_seed.toml --laws bvk2007@1 --out out/binary "
+      "--resume   (run again after a stop to go on)\n"
       "  draglab sensitivity data/scenes/dpm_bubble_quick.toml --work-precision --law ergun@1 "
       "--grids 8x24,12x36 --contact-steps 20,40\n"
       "  draglab sensitivity data/scenes/tfm_bubble.toml --work-precision --law gidaspow@1 "

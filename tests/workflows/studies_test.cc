@@ -8,11 +8,18 @@
 // bundle holds exactly the numbers of the summary; the two runs' bubbles are those of
 // `scene run` with the same seed (determinism, checked by the command line's test); bad input
 // (an unknown law) is refused before any run and leaves no folder.
+// A study with a state folder (SensitivityOptions::state_directory) stopped part-way (here: one
+// run's file removed, as a kill before it finished would leave it) goes on from what it kept:
+// the kept run is taken as it was, the missing one runs from the kept packing, and every number
+// is that of the uninterrupted study, bit for bit (the DPM is deterministic for one seed); a
+// damaged packing file is settled again; another duration finds no kept run.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "draglab/consumers/scene.h"
 #include "draglab/core/files.h"
@@ -64,6 +71,89 @@ TEST(SensitivityStudy, TwoPackingsOneLawSavedAsRun) {
   EXPECT_EQ(b["laws"][0]["uncertainty_m"].get<double>(), law.diameter.total_m);
   EXPECT_EQ(b["laws"][0]["runs"].size(), 2u);
   EXPECT_EQ(study.ToJson(scene, output.out_dir)["data"], study.bundle_path);
+}
+
+/// The files of `dir` whose names start with `prefix`.
+std::vector<std::string> FilesStartingWith(const std::string& dir, const std::string& prefix) {
+  std::vector<std::string> out;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) == 0) out.push_back(entry.path().string());
+  }
+  return out;
+}
+
+void ExpectSameRun(const workflows::SensitivityRun& a, const workflows::SensitivityRun& b) {
+  EXPECT_EQ(a.seed, b.seed);
+  EXPECT_EQ(a.bubble_diameter_m, b.bubble_diameter_m);  // bit for bit
+  EXPECT_EQ(a.gas_steps, b.gas_steps);
+  EXPECT_EQ(a.dem_steps, b.dem_steps);
+  EXPECT_EQ(a.momentum_mismatch, b.momentum_mismatch);
+  ASSERT_EQ(a.series.size(), b.series.size());
+  for (std::size_t k = 0; k < a.series.size(); ++k) {
+    EXPECT_EQ(a.series[k].bubble_diameter_m, b.series[k].bubble_diameter_m) << k;
+    EXPECT_EQ(a.series[k].bed_height_m, b.series[k].bed_height_m) << k;
+  }
+}
+
+TEST(SensitivityStudy, ResumedStudyGoesOnFromItsStateFolderToTheSameBits) {
+  test::TempDir dir;
+  Database db(dir.file("s.db"));
+  const consumers::Scene scene = consumers::load_scene(kTinyScene);
+  workflows::SensitivityOptions options;
+  options.laws = {"ergun@1"};
+  options.realizations = 2;
+  options.state_directory = dir.file("out/state");
+  workflows::StudyOutput output;
+  output.out_dir = dir.file("out");
+  output.figure = false;
+  const workflows::SensitivitySummary first =
+      workflows::run_sensitivity_study(db, scene, options, output).summary;
+  ASSERT_EQ(first.laws.at(0).runs.size(), 2u);
+  for (const auto& r : first.laws[0].runs) EXPECT_FALSE(r.reused);
+  for (const auto& p : first.packings) EXPECT_FALSE(p.reused);
+  const std::string state = options.state_directory;
+  const std::string second_seed = "seed" + std::to_string(scene.seed + 1);
+  ASSERT_EQ(FilesStartingWith(state, "ergun_1_").size(), 2u);
+  ASSERT_EQ(FilesStartingWith(state, "packing_").size(), 2u);
+
+  // Stopped before the second packing's run had finished.
+  const std::vector<std::string> second_run = FilesStartingWith(state, "ergun_1_" + second_seed);
+  ASSERT_EQ(second_run.size(), 1u);
+  std::filesystem::remove(second_run[0]);
+  const workflows::SensitivitySummary resumed =
+      workflows::run_sensitivity_study(db, scene, options, output).summary;
+  ASSERT_EQ(resumed.laws.at(0).runs.size(), 2u);
+  EXPECT_TRUE(resumed.laws[0].runs[0].reused);
+  EXPECT_FALSE(resumed.laws[0].runs[1].reused);
+  EXPECT_TRUE(resumed.packings.at(0).reused);  // not needed: its only run was kept
+  EXPECT_TRUE(resumed.packings.at(1).reused);  // read back, not settled again
+  EXPECT_EQ(resumed.packings[1].particles, first.packings[1].particles);
+  EXPECT_EQ(resumed.packings[1].settled_bed_height_m, first.packings[1].settled_bed_height_m);
+  for (int k = 0; k < 2; ++k) ExpectSameRun(resumed.laws[0].runs[k], first.laws[0].runs[k]);
+  EXPECT_EQ(resumed.laws[0].diameter.total_m, first.laws[0].diameter.total_m);
+  EXPECT_EQ(resumed.laws[0].umf_m_s, first.laws[0].umf_m_s);
+  ASSERT_TRUE(resumed.laws[0].has_snapshot);
+  EXPECT_EQ(resumed.laws[0].snapshot.x, first.laws[0].snapshot.x);
+  EXPECT_EQ(resumed.laws[0].snapshot.void_fraction.values,
+            first.laws[0].snapshot.void_fraction.values);
+
+  // A damaged packing file is settled again, to the same packing.
+  std::filesystem::remove(FilesStartingWith(state, "ergun_1_" + second_seed).at(0));
+  const std::string packing = FilesStartingWith(state, "packing_" + second_seed).at(0);
+  std::filesystem::resize_file(packing, std::filesystem::file_size(packing) / 2);
+  const workflows::SensitivitySummary resettled =
+      workflows::run_sensitivity_study(db, scene, options, output).summary;
+  EXPECT_FALSE(resettled.packings.at(1).reused);
+  ExpectSameRun(resettled.laws.at(0).runs.at(1), first.laws[0].runs[1]);
+
+  // Another duration is another study: no run is kept for it, the packings are.
+  options.run.duration_s = 0.05;
+  const workflows::SensitivitySummary shorter =
+      workflows::run_sensitivity_study(db, scene, options, output).summary;
+  for (const auto& r : shorter.laws.at(0).runs) EXPECT_FALSE(r.reused);
+  for (const auto& p : shorter.packings) EXPECT_TRUE(p.reused);
+  EXPECT_EQ(FilesStartingWith(state, "ergun_1_").size(), 4u);
 }
 
 TEST(SensitivityStudy, BadInputLeavesNoFolder) {

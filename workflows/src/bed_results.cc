@@ -155,7 +155,8 @@ nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
     packings.push_back({{"seed", p.seed},
                         {"particles", p.particles},
                         {"settled_bed_height_m", p.settled_bed_height_m},
-                        {"settle_wall_s", p.settle_wall_s}});
+                        {"settle_wall_s", p.settle_wall_s},
+                        {"reused", p.reused}});
   }
   nlohmann::json laws = nlohmann::json::array();
   for (const auto& lr : s.laws) {
@@ -198,6 +199,7 @@ nlohmann::json sensitivity_bundle_json(const consumers::Scene& scene,
                       {"max_relative_gas_mass_imbalance", r.max_relative_mass_imbalance},
                       {"void_fraction_clamps", r.void_fraction_clamps},
                       {"drag_out_of_range", r.drag_out_of_range},
+                      {"reused", r.reused},
                       {"headline", headline_json(r.headline)},
                       {"series", series}});
     }

@@ -15,8 +15,10 @@
 #include <utility>
 #include <vector>
 
+#include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/error.h"
+#include "study_state.h"
 
 namespace draglab {
 namespace workflows {
@@ -184,6 +186,36 @@ std::shared_ptr<const BedRealization> Realize(const BedModel& model, const Scene
   return realization;
 }
 
+/// What the study keeps of a run (study_state.h).
+detail::StoredRun Stored(const BedResult& r, const Scene& s, std::uint64_t seed,
+                         const SensitivityPacking& packing) {
+  detail::StoredRun stored;
+  stored.run = MakeRun(r, s, seed);
+  stored.packing = packing;
+  stored.umf_m_s = r.metrics.umf_m_s;
+  stored.background_m_s = r.metrics.background_m_s;
+  stored.background_mode = r.background_mode;
+  stored.has_snapshot = r.has_snapshot;
+  if (r.has_snapshot) stored.snapshot = r.snapshot;
+  return stored;
+}
+
+/// One run of a study: its scene (grid and seed), law, folder tag and key, and what the state
+/// folder had of it.
+struct StudyRunSlot {
+  Scene scene;
+  std::size_t law = 0;
+  std::string tag;
+  std::string key;
+  detail::StoredRun stored;
+  bool stored_found = false;
+};
+
+/// A unit the state folder had: done at once.
+void ReportReused(const BedProgress& progress) {
+  if (progress) progress(1.0, "kept");
+}
+
 /// Progress over `total` equal units (a settling or a run each). The stage text is the unit's
 /// label, "LABEL (k of N)", constant over the unit, so that a caller can time and announce it.
 class StudyProgress {
@@ -205,6 +237,44 @@ class StudyProgress {
   int total_;
   int done_ = 0;
 };
+
+/// The realization of `seed` for the runs in `slots`: taken from the state folder or prepared
+/// (and kept there), and only if one of the runs is still to be done; its record either way.
+SensitivityPacking PrepareRealization(const BedModel& model, const Scene& scene, std::uint64_t seed,
+                                      const std::string& law, const LawLoader& load_law,
+                                      const detail::StudyState& state,
+                                      const std::vector<StudyRunSlot>& slots, StudyProgress* study,
+                                      std::shared_ptr<const BedRealization>* realization) {
+  const std::string kind = model.realization_kind();
+  const bool needed = std::any_of(slots.begin(), slots.end(),
+                                  [](const StudyRunSlot& slot) { return !slot.stored_found; });
+  if (!needed) {
+    SensitivityPacking info = slots.front().stored.packing;
+    info.reused = true;
+    ReportReused(study->Unit(PrepareText(kind, seed) + ", kept"));
+    return info;
+  }
+  Scene seeded = scene;
+  seeded.seed = seed;
+  const std::string label = kind + "_seed" + std::to_string(seed);
+  const std::string key = detail::realization_key(model, seeded, law);
+  *realization = state.LoadRealization(model, label, key);
+  if (*realization && (*realization)->seed == seed) {
+    SensitivityPacking info;
+    info.seed = seed;
+    info.particles = (*realization)->particles;
+    info.settled_bed_height_m = (*realization)->bed_height_m;
+    info.settle_wall_s = (*realization)->prepare_wall_s;
+    info.reused = true;
+    ReportReused(study->Unit(PrepareText(kind, seed) + ", kept"));
+    return info;
+  }
+  SensitivityPacking info;
+  *realization =
+      Realize(model, seeded, Load(load_law, law), study->Unit(PrepareText(kind, seed)), &info);
+  state.SaveRealization(model, label, key, **realization);
+  return info;
+}
 
 void CheckLawList(const std::vector<std::string>& laws, const std::string& field, std::string* why,
                   bool* ok) {
@@ -513,6 +583,8 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   const int n_seeds = method == UncertaintyMethod::kGrids ? 1 : options.realizations;
   for (int k = 0; k < n_seeds; ++k) seeds.push_back(scene.seed + static_cast<std::uint64_t>(k));
 
+  if (!options.state_directory.empty())
+    core::check_output_directory(options.state_directory, "the study's state folder");
   // Fail fast: every law loads and has a U_mf and stable steps on every grid.
   for (const auto& ref : laws) {
     const auto law = Load(load_law, ref);
@@ -527,43 +599,56 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
   summary.eps_threshold = scene.bubble.eps_threshold;
   summary.realization_kind = model.realization_kind();
   for (const Scene& gs : grid_scenes) summary.grids.push_back(GridOf(gs));
-  const std::string kind = model.realization_kind();
 
   summary.laws.resize(laws.size());
   for (std::size_t i = 0; i < laws.size(); ++i) summary.laws[i].law = laws[i];
   StudyProgress study(
       progress,
       static_cast<int>(seeds.size() * ((realized ? 1 : 0) + grid_scenes.size() * laws.size())));
+  const detail::StudyState state(options.state_directory);
   for (const std::uint64_t seed : seeds) {
-    // Prepared once per seed; every law and grid of that seed starts from it.
-    std::shared_ptr<const BedRealization> realization;
-    if (realized) {
-      Scene seeded = scene;
-      seeded.seed = seed;
-      SensitivityPacking info;
-      realization = Realize(model, seeded, Load(load_law, laws.front()),
-                            study.Unit(PrepareText(kind, seed)), &info);
-      summary.packings.push_back(info);
-    }
+    // The runs of this seed the state folder already has.
+    std::vector<StudyRunSlot> slots;
     for (const Scene& grid_scene : grid_scenes) {
       Scene run_scene = grid_scene;
       run_scene.seed = seed;
       const std::string grid = to_string(GridOf(run_scene));
       const std::string tag = realized ? "seed" + std::to_string(seed) + "_" + grid : grid;
       for (std::size_t i = 0; i < laws.size(); ++i) {
-        const BedResult r = run_bed_model(run_scene, Load(load_law, laws[i]),
-                                          RunOptions(options.run, run_scene, laws[i], tag),
-                                          study.Unit(laws[i] + " " + tag), realization.get());
-        SensitivityLawResult& lr = summary.laws[i];
-        lr.runs.push_back(MakeRun(r, run_scene, realized ? seed : 0));
-        lr.wall_s += r.wall_s;
-        if (lr.runs.size() == 1) {
-          lr.umf_m_s = r.metrics.umf_m_s;
-          lr.background_m_s = r.metrics.background_m_s;
-          lr.background_mode = r.background_mode;
-          lr.has_snapshot = r.has_snapshot;
-          if (r.has_snapshot) lr.snapshot = r.snapshot;
-        }
+        StudyRunSlot slot{
+            run_scene, i, tag, detail::run_key(model, run_scene, laws[i], options.run), {}, false};
+        slot.stored_found = state.LoadRun(laws[i] + "_" + tag, slot.key, &slot.stored);
+        slots.push_back(std::move(slot));
+      }
+    }
+    // Prepared (or taken from the state folder) once per seed, only if a run of it is to be
+    // done; every law and grid of that seed starts from it.
+    std::shared_ptr<const BedRealization> realization;
+    if (realized) {
+      summary.packings.push_back(PrepareRealization(model, scene, seed, laws.front(), load_law,
+                                                    state, slots, &study, &realization));
+    }
+    for (StudyRunSlot& slot : slots) {
+      const std::string& law = laws[slot.law];
+      if (slot.stored_found) {
+        ReportReused(study.Unit(law + " " + slot.tag + ", kept"));
+      } else {
+        const BedResult r = run_bed_model(slot.scene, Load(load_law, law),
+                                          RunOptions(options.run, slot.scene, law, slot.tag),
+                                          study.Unit(law + " " + slot.tag), realization.get());
+        slot.stored = Stored(r, slot.scene, realized ? seed : 0,
+                             realized ? summary.packings.back() : SensitivityPacking());
+        state.SaveRun(law + "_" + slot.tag, slot.key, slot.stored);
+      }
+      SensitivityLawResult& lr = summary.laws[slot.law];
+      lr.runs.push_back(slot.stored.run);
+      lr.wall_s += slot.stored.run.wall_s;
+      if (lr.runs.size() == 1) {
+        lr.umf_m_s = slot.stored.umf_m_s;
+        lr.background_m_s = slot.stored.background_m_s;
+        lr.background_mode = slot.stored.background_mode;
+        lr.has_snapshot = slot.stored.has_snapshot;
+        if (slot.stored.has_snapshot) lr.snapshot = std::move(slot.stored.snapshot);
       }
     }
   }
@@ -611,6 +696,7 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
 
   // How the uncertainty was formed, in words (for D, or for the headline numbers).
   const bool headline = summary.has_headline();
+  const std::string kind = model.realization_kind();
   const std::string seed_range =
       "seeds " + std::to_string(seeds.front()) + ".." + std::to_string(seeds.back());
   const std::string se_text = "SE = s/sqrt(n) the standard error of the mean (n = 2: |x1 - x2|/2)";
@@ -737,7 +823,8 @@ std::string SensitivitySummary::FullReport() const {
   for (const SensitivityPacking& p : packings) {
     if (p.particles == 0) continue;  // a realization without particles (DBM: a seed) says nothing
     s << "  packing seed " << p.seed << ": " << p.particles << " particles, settled bed "
-      << Cm(p.settled_bed_height_m) << " cm, settling " << Num(p.settle_wall_s, 3) << " s wall\n";
+      << Cm(p.settled_bed_height_m) << " cm, settling " << Num(p.settle_wall_s, 3) << " s wall"
+      << (p.reused ? " (kept from an earlier part of the study)" : "") << "\n";
   }
   for (const SensitivityLawResult& lr : laws) {
     if (headline) {
@@ -757,7 +844,7 @@ std::string SensitivitySummary::FullReport() const {
       s << "    seed " << r.seed << ", grid " << GridText(r.cells_x, r.cells_y, r.cells_z) << ": ";
       if (headline) {
         s << HeadlineText(r.headline) << "; " << r.gas_steps << " steps, " << Num(r.wall_s, 3)
-          << " s wall\n";
+          << " s wall" << (r.reused ? " (kept)" : "") << "\n";
       } else {
         s << "D " << (r.bubble_found ? Cm(r.bubble_diameter_m) + " cm" : std::string("none"));
         double at_t_ref = 0.0, change = 0.0;
@@ -766,7 +853,8 @@ std::string SensitivitySummary::FullReport() const {
             << Num(change, 3) << ")";
         }
         s << ", " << r.gas_steps << " gas / " << r.dem_steps << " DEM steps, " << Num(r.wall_s, 3)
-          << " s wall, momentum mismatch " << Num(r.momentum_mismatch, 2) << "\n";
+          << " s wall, momentum mismatch " << Num(r.momentum_mismatch, 2)
+          << (r.reused ? " (kept from an earlier part of the study)" : "") << "\n";
       }
     }
   }

@@ -144,6 +144,12 @@ std::shared_ptr<const BedRealization> BedModel::Realize(const Scene&, std::share
               "bed model '" + key() + "' is deterministic: it has no realizations to prepare");
 }
 
+bool BedModel::SaveRealization(const BedRealization&, const std::string&) const { return false; }
+
+std::shared_ptr<const BedRealization> BedModel::LoadRealization(const std::string&) const {
+  return nullptr;
+}
+
 ConsumerResult consumer_result(const Scene& scene, const Law& law, const BedResult& result) {
   ConsumerResult stored;
   stored.scene_name = scene.name;

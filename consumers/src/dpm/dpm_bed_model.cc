@@ -3,6 +3,10 @@
 // settled with the scene's seed; its time resolution the DEM steps per contact time.
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -14,6 +18,7 @@
 #include "bed/builtin_models.h"
 #include "dpm/dpm_scene.h"
 #include "draglab/consumers/dpm.h"
+#include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/error.h"
 
@@ -28,6 +33,70 @@ class DpmPacking : public BedRealization {
  public:
   Particles settled;
 };
+
+// A packing's file (SaveRealization): this magic line, then seed, particle count, settled bed
+// height and preparation time, then the particle arrays, each whole, in native byte order (the
+// file serves a study resumed on the machine that stopped it).
+constexpr char kPackingMagic[] = "draglab dpm packing 1\n";
+constexpr std::size_t kPackingMagicSize = sizeof(kPackingMagic) - 1;
+
+/// The particle arrays of a packing file, in their order.
+std::vector<std::vector<double>*> PackingArrays(Particles& p) {
+  return {&p.x,  &p.y,  &p.z,      &p.vx,     &p.vy,     &p.vz,       &p.wx,
+          &p.wy, &p.wz, &p.fx_ext, &p.fy_ext, &p.fz_ext, &p.diameter, &p.density};
+}
+
+struct PackingHeader {
+  std::uint64_t seed = 0;
+  std::int64_t particles = 0;
+  double bed_height_m = 0.0;
+  double prepare_wall_s = 0.0;
+};
+
+void SavePacking(const DpmPacking& packing, const std::string& path) {
+  Particles copy = packing.settled;  // PackingArrays takes mutable arrays
+  const PackingHeader header{packing.seed, static_cast<std::int64_t>(copy.size()),
+                             packing.bed_height_m, packing.prepare_wall_s};
+  std::vector<core::FilePiece> pieces = {{kPackingMagic, kPackingMagicSize},
+                                         {&header, sizeof(header)}};
+  for (std::vector<double>* a : PackingArrays(copy))
+    pieces.push_back({a->data(), a->size() * sizeof(double)});
+  pieces.push_back({copy.id.data(), copy.id.size() * sizeof(std::int64_t)});
+  core::write_file_atomically(path, pieces, "packing state file");
+}
+
+std::shared_ptr<const BedRealization> LoadPacking(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return nullptr;
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  PackingHeader header;
+  if (bytes.size() < kPackingMagicSize + sizeof(header) ||
+      bytes.compare(0, kPackingMagicSize, kPackingMagic) != 0)
+    return nullptr;
+  std::memcpy(&header, bytes.data() + kPackingMagicSize, sizeof(header));
+  auto packing = std::make_shared<DpmPacking>();
+  const auto n = static_cast<std::size_t>(header.particles);
+  const std::size_t arrays = PackingArrays(packing->settled).size();
+  if (header.particles < 0 ||
+      bytes.size() !=
+          kPackingMagicSize + sizeof(header) + n * (arrays * sizeof(double) + sizeof(std::int64_t)))
+    return nullptr;
+  const char* at = bytes.data() + kPackingMagicSize + sizeof(header);
+  for (std::vector<double>* a : PackingArrays(packing->settled)) {
+    a->resize(n);
+    std::memcpy(a->data(), at, n * sizeof(double));
+    at += n * sizeof(double);
+  }
+  packing->settled.id.resize(n);
+  std::memcpy(packing->settled.id.data(), at, n * sizeof(std::int64_t));
+  std::string why;
+  if (!packing->settled.IsValid(&why)) return nullptr;
+  packing->seed = header.seed;
+  packing->particles = header.particles;
+  packing->bed_height_m = header.bed_height_m;
+  packing->prepare_wall_s = header.prepare_wall_s;
+  return packing;
+}
 
 class DpmBedModel : public BedModel {
  public:
@@ -66,6 +135,18 @@ class DpmBedModel : public BedModel {
     packing->prepare_wall_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return packing;
+  }
+
+  bool SaveRealization(const BedRealization& realization, const std::string& path) const override {
+    const auto* packing = dynamic_cast<const DpmPacking*>(&realization);
+    if (!packing)
+      throw Error(ErrorCode::kInvalidArgument,
+                  "dpm: the given realization was not made by the dpm model");
+    SavePacking(*packing, path);
+    return true;
+  }
+  std::shared_ptr<const BedRealization> LoadRealization(const std::string& path) const override {
+    return LoadPacking(path);
   }
 
   TimeResolution time_resolution() const override {

@@ -191,6 +191,13 @@ class BedModel {
   virtual std::shared_ptr<const BedRealization> Realize(const Scene& scene,
                                                         std::shared_ptr<const Law> law,
                                                         const BedProgress& progress) const;
+  /// Writes a realization made by this model's Realize to `path` (atomically), so that a long
+  /// study stopped part-way goes on without preparing it again; false: this model does not keep
+  /// its realizations (the default). Throws Error(kIo) when the file cannot be written.
+  virtual bool SaveRealization(const BedRealization& realization, const std::string& path) const;
+  /// The realization SaveRealization wrote to `path`, bit for bit; null when the file is missing,
+  /// is not such a file, or the model does not keep realizations.
+  virtual std::shared_ptr<const BedRealization> LoadRealization(const std::string& path) const;
 
   virtual TimeResolution time_resolution() const = 0;
   /// The scene's value of time_resolution().name.

@@ -109,6 +109,13 @@ struct SensitivityOptions {
   /// Run controls every model takes (the simulated time, the output folder); each run writes
   /// the files its scene asks for into a subfolder per law and grid.
   BedRunOptions run;
+  /// Not empty: the study keeps each finished run, and each realization its model can keep
+  /// (BedModel::SaveRealization: the DPM's settled packings), in this folder as it goes, and
+  /// takes from it what the same study (the same scene text, seed, grid, law, time step,
+  /// duration and t_ref) already finished, so that a study stopped part-way goes on where it
+  /// was when run again; the results are those of an uninterrupted study, bit for bit. Created
+  /// when the first file is written.
+  std::string state_directory;
   bool IsValid(std::string* error) const;
 };
 
@@ -139,6 +146,7 @@ struct SensitivityRun {
   /// holds or rains out.
   std::vector<BedSample> series;
   HeadlineNumbers headline;  ///< BedResult::headline (empty for dpm and tfm).
+  bool reused = false;       ///< Taken from the state folder (SensitivityOptions::state_directory).
 };
 
 /// D with its numerical uncertainty [m] (see the file comment for the methods).
@@ -212,7 +220,8 @@ struct SensitivityPacking {
   std::uint64_t seed = 0;
   std::int64_t particles = 0;
   double settled_bed_height_m = 0.0;
-  double settle_wall_s = 0.0;  ///< What preparing it cost.
+  double settle_wall_s = 0.0;  ///< What preparing it cost (when it was prepared).
+  bool reused = false;         ///< Taken from the state folder, or not needed: every run was.
 };
 
 /// Result of run_sensitivity.
