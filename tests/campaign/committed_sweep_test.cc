@@ -182,7 +182,8 @@ namespace {
 // (data/datasets/standard/standard.csv; docs/campaigns.md, "A dataset in parts").
 const std::vector<Part> kStandardParts = {{"standard", "standard_low"},
                                           {"standard", "standard_re100"},
-                                          {"standard", "standard_re300_mid"}};
+                                          {"standard", "standard_re300_mid"},
+                                          {"standard", "standard_re300_dense"}};
 const std::string kStandardDataset = kDatasets + "standard/standard.csv";
 
 TEST(CommittedStandard, EachPartIsTheRunOfItsCommittedSpecAtTheRulesResolutions) {
