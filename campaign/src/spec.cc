@@ -3,6 +3,7 @@
 #include <cctype>
 #include <climits>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -49,7 +50,7 @@ const core::toml_schema::Schema& sections() {
       {"lbm",
        {"resolutions", "min_resolution", "max_resolution", "target_error", "collision", "boundary",
         "tolerance", "max_steps", "precision", "ranks_per_unit"}},
-      {"dataset", {"extrapolation"}},
+      {"dataset", {"extrapolation", "extend_with", "extend_with_id"}},
   };
   return s;
 }
@@ -427,6 +428,20 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
       s.ranks_per_unit = static_cast<int>(v);
     }
     if (id == "dataset.extrapolation") s.extrapolation = text();
+    if (id == "dataset.extend_with") {
+      s.extend_with = text();
+      if (s.extend_with.empty()) bad(field + " is empty (a dataset CSV file, or leave it out)");
+    }
+    if (id == "dataset.extend_with_id") {
+      s.extend_with_id = text();
+      const bool hex12 =
+          s.extend_with_id.size() == 12 &&
+          s.extend_with_id.find_first_not_of("0123456789abcdef") == std::string::npos;
+      if (!hex12) {
+        bad(field + " = \"" + s.extend_with_id +
+            "\" is not a dataset id (12 lower-case hex digits, as `draglab dataset list` shows)");
+      }
+    }
   });
   // Required keys, then contradictions a default would hide.
   for (const char* required : {"campaign.name", "grid.phi", "grid.re", "lbm.resolutions"}) {
@@ -442,6 +457,9 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
     bad(origin +
         ": [lbm] min_resolution, max_resolution and target_error apply only to resolutions = "
         "\"rule\"");
+  }
+  if (given.count("dataset.extend_with_id") && !given.count("dataset.extend_with")) {
+    bad(origin + ": [dataset] extend_with_id applies only with extend_with (the dataset file)");
   }
   if (given.count("packing.spheres") && given.count("packing.box_size")) {
     bad(origin + ": [packing] spheres and box_size contradict each other: give one of them");
@@ -462,7 +480,14 @@ CampaignSpec parse_campaign_spec_text(const std::string& toml_text, const std::s
 }
 
 CampaignSpec parse_campaign_spec(const std::string& path) {
-  return parse_campaign_spec_text(core::read_text_input(path, "campaign spec"), path);
+  CampaignSpec spec = parse_campaign_spec_text(core::read_text_input(path, "campaign spec"), path);
+  // A spec names its dataset file from where the spec lies, as a preset's does.
+  const std::filesystem::path extension(spec.extend_with);
+  if (!spec.extend_with.empty() && extension.is_relative() && path != "-") {
+    spec.extend_with =
+        (std::filesystem::path(path).parent_path() / extension).lexically_normal().string();
+  }
+  return spec;
 }
 
 }  // namespace campaign

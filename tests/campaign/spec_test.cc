@@ -2,11 +2,14 @@
 // range or the valid keys); the presets in data/campaigns parse and are big enough for a fit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "campaign_internal.h"
 #include "draglab/campaign/campaign.h"
+#include "draglab/drag_db/dataset.h"
 #include "draglab/error.h"
 #include "draglab/lbm/resolution.h"
 
@@ -197,6 +200,39 @@ TEST(CampaignSpec, RanksPerUnitIsCheckedAndNotPartOfTheIdentity) {
   EXPECT_NE(error.find("[lbm] ranks_per_unit = -2"), std::string::npos) << error;
 }
 
+TEST(CampaignSpec, AnExtensionDatasetIsCheckedAndNotPartOfTheIdentity) {
+  const CampaignSpec plain = parse_campaign_spec_text(kValid, "spec.toml");
+  const CampaignSpec extended =
+      parse_campaign_spec_text(edit("extrapolation = \"richardson\"",
+                                    "extrapolation = \"richardson\"\nextend_with = \"../d/x.csv\"\n"
+                                    "extend_with_id = \"0123456789ab\""),
+                               "spec.toml");
+  EXPECT_EQ(extended.extend_with, "../d/x.csv");  // the text: no file to resolve it from
+  EXPECT_EQ(extended.extend_with_id, "0123456789ab");
+  // It changes the dataset the pipeline fits, not a unit: the same campaign resumes.
+  EXPECT_EQ(extended.to_json(), plain.to_json());
+  EXPECT_NE(parse_error(edit("extrapolation = \"richardson\"",
+                             "extrapolation = \"richardson\"\nextend_with_id = \"0123456789ab\""))
+                .find("extend_with_id applies only with extend_with"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("extrapolation = \"richardson\"",
+                             "extrapolation = \"richardson\"\nextend_with = \"x.csv\"\n"
+                             "extend_with_id = \"ABC\""))
+                .find("[dataset] extend_with_id = \"ABC\" is not a dataset id"),
+            std::string::npos);
+  EXPECT_NE(parse_error(edit("extrapolation = \"richardson\"",
+                             "extrapolation = \"richardson\"\nextend_with = \"\""))
+                .find("[dataset] extend_with is empty"),
+            std::string::npos);
+  // From a file, the path is the spec folder's: the quick preset names the shipped dataset.
+  const CampaignSpec quick =
+      parse_campaign_spec(std::string(DRAGLAB_DATA_DIR) + "/campaigns/quick.toml");
+  EXPECT_EQ(quick.extend_with,
+            std::filesystem::path(std::string(DRAGLAB_DATA_DIR) + "/datasets/standard/standard.csv")
+                .lexically_normal()
+                .string());
+}
+
 TEST(CampaignSpec, FloatPrecisionIsPartOfTheIdentityAndDoubleKeepsOlderHashes) {
   const CampaignSpec plain = parse_campaign_spec_text(kValid, "spec.toml");
   EXPECT_EQ(plain.precision, "double");
@@ -361,6 +397,30 @@ TEST(CampaignSpec, PresetsParseAndAreFitWorthy) {
     EXPECT_TRUE(finite_re);
     EXPECT_GE(s.realizations, 2);
   }
+}
+
+// The quick preset pins the committed standard dataset: a regenerated file without a new pin would
+// make ./run.sh refuse to start, so the pin and the file are checked together here. Its points
+// outside the quick grid reach the bundled beds (phi 0.58, Re up to about 300).
+TEST(CampaignSpec, TheQuickPresetsExtensionIsTheCommittedStandardDataset) {
+  const CampaignSpec quick =
+      parse_campaign_spec(std::string(DRAGLAB_DATA_DIR) + "/campaigns/quick.toml");
+  const Dataset standard = read_dataset_csv(quick.extend_with);
+  EXPECT_EQ(standard.id, quick.extend_with_id);
+  const auto [phi_lo, phi_hi] = std::minmax_element(quick.phi.begin(), quick.phi.end());
+  const auto [re_lo, re_hi] = std::minmax_element(quick.re.begin(), quick.re.end());
+  const DatasetBox grid{*phi_lo, *phi_hi, *re_lo, *re_hi};
+  int outside = 0;
+  double phi_max = 0.0, re_max = 0.0;
+  for (const DatasetPoint& p : standard.points) {
+    if (grid.contains(p)) continue;
+    ++outside;
+    phi_max = std::max(phi_max, p.phi);
+    re_max = std::max(re_max, p.re);
+  }
+  EXPECT_EQ(outside, 19);
+  EXPECT_GE(phi_max, 0.58);
+  EXPECT_GE(re_max, 290.0);
 }
 
 TEST(CampaignSpec, SeedsAreDeterministicAndIndependent) {

@@ -31,6 +31,9 @@ D="$draglab --db $DB"
 # --- fixtures ---------------------------------------------------------------------------------
 grep -v '^#' "$data/datasets/quick/quick.csv" >"$in/good.csv"
 cp "$data/campaigns/quick.toml" "$in/spec.toml"
+# The quick spec's extension, where its relative path points from $in.
+mkdir -p "$work/datasets/standard"
+cp "$data/datasets/standard/standard.csv" "$work/datasets/standard/standard.csv"
 cp "$data/scenes/dpm_bubble_quick.toml" "$in/dpm.toml"
 cp "$data/scenes/dbm_tiny.toml" "$in/dbm.toml"
 cp "$data/scenes/dpm_tiny.toml" "$in/dpm_tiny.toml"

@@ -4,8 +4,9 @@
 // What is checked: the content hash is a function of the points only (stable, order-sensitive,
 // changed by any value), a store/load round trip is bit-exact, storing the same points twice
 // returns the existing dataset, prefixes resolve (and ambiguous or unknown ones are refused),
-// the rows are immutable from the sqlite3 C API too (UPDATE, DELETE, INSERT OR REPLACE), and the
-// CSV form round-trips and refuses malformed files naming line and column.
+// the rows are immutable from the sqlite3 C API too (UPDATE, DELETE, INSERT OR REPLACE), the
+// CSV form round-trips and refuses malformed files naming line and column, and a dataset extended
+// beyond its grid's box takes exactly the other dataset's points outside it (counted by hand).
 #include "draglab/drag_db/dataset.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +17,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+
+#include <nlohmann/json.hpp>
 
 #include "draglab/drag_db/database.h"
 #include "draglab/error.h"
@@ -242,6 +246,76 @@ TEST(DatasetStore, CsvRoundTripAndMalformedFiles) {
   // A file name that is not UTF-8 still imports (its name is kept with the bad byte replaced).
   std::ofstream(dir.file("bad\xDEname.csv")) << "phi,re,F,F_uncertainty\n0.3,0,5.1,0.1\n";
   EXPECT_NO_THROW(read_dataset_csv(dir.file("bad\xDEname.csv")));
+}
+
+// sample() covers phi 0.2-0.4 x Re 0-10. The extension has 3 points inside that box (left to the
+// base) and 3 outside it: phi 0.5 (beyond phi), Re 30 (beyond Re), phi 0.1 (below phi).
+Dataset extension_sample() {
+  Dataset e = sample(2.0);
+  e.name = "wider";
+  for (auto [phi, re] : {std::pair{0.5, 0.0}, std::pair{0.3, 30.0}, std::pair{0.1, 10.0}}) {
+    DatasetPoint p = e.points.front();
+    p.phi = phi;
+    p.re_target = re;
+    p.re = re;
+    e.points.push_back(p);
+  }
+  e.points.erase(e.points.begin(), e.points.begin() + 3);  // keep 3 of sample's 6 inside points
+  e.hash = dataset_hash(e.points);
+  e.id = e.hash.substr(0, 12);
+  return e;
+}
+
+TEST(DatasetExtend, TakesTheOtherDatasetsPointsOutsideTheBoxOnly) {
+  TempDir dir;
+  Database db(dir.file("x.db"));
+  Dataset base = sample();
+  base.method = R"({"source":"campaign","extrapolation":"inverse_d"})";
+  base = store_dataset(db, base);
+  const Dataset extension = extension_sample();
+  const DatasetBox box{0.2, 0.4, 0.0, 10.0};
+  const Dataset extended = extend_dataset(base, box, extension, "wider.csv");
+  ASSERT_EQ(extended.points.size(), 9u);  // 6 of the base's and the 3 outside the box
+  for (std::size_t i = 1; i < extended.points.size(); ++i) {
+    const DatasetPoint &a = extended.points[i - 1], &b = extended.points[i];
+    EXPECT_TRUE(a.phi < b.phi || (a.phi == b.phi && a.re_target < b.re_target)) << i;
+  }
+  // Inside the box the base's values stand (the extension's F there is twice theirs).
+  int from_base = 0;
+  for (const DatasetPoint& p : extended.points)
+    for (const DatasetPoint& q : base.points)
+      if (p.phi == q.phi && p.re_target == q.re_target && p.F == q.F) ++from_base;
+  EXPECT_EQ(from_base, 6);
+  EXPECT_EQ(extended.name, base.name);
+  const nlohmann::json method = nlohmann::json::parse(extended.method);
+  EXPECT_EQ(method.at("extrapolation"), "inverse_d");  // the base's method is kept
+  const nlohmann::json& with = method.at("extended_with");
+  EXPECT_EQ(with.at("base_dataset"), base.id);
+  EXPECT_EQ(with.at("dataset"), extension.id);
+  EXPECT_EQ(with.at("source"), "wider.csv");
+  EXPECT_EQ(with.at("points").size(), 3u);
+  const Dataset stored = store_dataset(db, extended);
+  EXPECT_NE(stored.id, base.id);
+  EXPECT_EQ(load_dataset(db, stored.id).points.size(), 9u);
+}
+
+TEST(DatasetExtend, RefusesWhatWouldNotExtendTheBase) {
+  const Dataset base = sample(), extension = extension_sample();
+  // An extension all inside the box adds nothing.
+  Dataset inside = base;
+  try {
+    extend_dataset(base, {0.2, 0.4, 0.0, 10.0}, inside, "same.csv");
+    FAIL() << "an extension inside the box must be refused";
+  } catch (const Error& e) {
+    EXPECT_TRUE(e.is_bad_input());
+    EXPECT_NE(std::string(e.what()).find("adds nothing"), std::string::npos) << e.what();
+  }
+  // A base point outside the box it claims to cover.
+  EXPECT_THROW(extend_dataset(base, {0.2, 0.3, 0.0, 10.0}, extension, "w.csv"), Error);
+  // Size-class points: their F is per species, not a mixture's.
+  Dataset classes = extension;
+  classes.points.back().y = 1.5;
+  EXPECT_THROW(extend_dataset(base, {0.2, 0.4, 0.0, 10.0}, classes, "c.csv"), Error);
 }
 
 }  // namespace

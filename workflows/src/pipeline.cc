@@ -128,6 +128,42 @@ bool run_check(const std::string& db_path, const LawRecord& record, const consum
   return true;
 }
 
+/// The spec's extension dataset, read and checked before the campaign (bad input, exit 2): its
+/// file, its pinned id, and at least one point outside the grid's box.
+std::unique_ptr<Dataset> read_extension(const campaign::CampaignSpec& spec,
+                                        const std::string& spec_path, const DatasetBox& box) {
+  if (spec.extend_with.empty()) return nullptr;
+  const std::string field = spec_path + ": [dataset] extend_with = " + spec.extend_with;
+  auto extension = std::make_unique<Dataset>();
+  try {
+    *extension = read_dataset_csv(spec.extend_with);
+  } catch (const Error& e) {
+    throw Error(ErrorCode::kInvalidArgument, field + ": " + e.what());
+  }
+  if (!spec.extend_with_id.empty() && extension->id != spec.extend_with_id) {
+    throw Error(ErrorCode::kInvalidArgument,
+                field + ": the file holds dataset " + extension->id + ", the spec expects " +
+                    spec.extend_with_id +
+                    " (extend_with_id): restore the file, or check it and set the new id");
+  }
+  const auto outside = std::count_if(extension->points.begin(), extension->points.end(),
+                                     [&](const DatasetPoint& p) { return !box.contains(p); });
+  if (outside == 0) {
+    throw Error(
+        ErrorCode::kInvalidArgument,
+        fmt::format("{}: none of its {} points lies outside the grid's box phi [{:g}, "
+                    "{:g}] x Re [{:g}, {:g}], so it adds nothing",
+                    field, extension->points.size(), box.phi_lo, box.phi_hi, box.re_lo, box.re_hi));
+  }
+  return extension;
+}
+
+DatasetBox grid_box(const campaign::CampaignSpec& spec) {
+  const auto [phi_lo, phi_hi] = std::minmax_element(spec.phi.begin(), spec.phi.end());
+  const auto [re_lo, re_hi] = std::minmax_element(spec.re.begin(), spec.re.end());
+  return {*phi_lo, *phi_hi, *re_lo, *re_hi};
+}
+
 std::string join(const std::vector<std::string>& items) {
   std::string text;
   for (const std::string& item : items) text += (text.empty() ? "" : ", ") + item;
@@ -175,6 +211,8 @@ PipelineSummary run_pipeline(const PipelineOptions& options, const Messages& mes
                     "): add phi or re values");
   }
   if (options.report) core::check_output_directory(out.out_dir, "--out");
+  out.grid_box = grid_box(spec);
+  const std::unique_ptr<Dataset> extension = read_extension(spec, options.spec_path, out.grid_box);
   std::unique_ptr<consumers::Scene> regress_scene;
   if (!options.regress_scene.empty()) {
     if (!options.regress)
@@ -207,6 +245,20 @@ PipelineSummary run_pipeline(const PipelineOptions& options, const Messages& mes
     std::vector<std::string> skipped;
     out.dataset = campaign::build_dataset(db, out.campaign.id, &skipped);
     for (const std::string& s : skipped) messages.warn("dataset: left out " + s);
+    if (extension) {
+      out.campaign_dataset_id = out.dataset.id;
+      out.extension_id = extension->id;
+      out.extension_source = spec.extend_with;
+      const std::size_t own = out.dataset.points.size();
+      out.dataset = store_dataset(
+          db, extend_dataset(out.dataset, out.grid_box, *extension, spec.extend_with));
+      out.extension_points = out.dataset.points.size() - own;
+      messages.info(fmt::format(
+          "pipeline: dataset {} = the campaign's {} ({} points) and {} points of dataset {} "
+          "outside its grid ({})",
+          out.dataset.id, out.campaign_dataset_id, own, out.extension_points, out.extension_id,
+          spec.extend_with));
+    }
     fitter::FitOptions fit_options;  // vdh2004, free k0, k1, c10, c11, c12
     fit_options.cv_folds = out.dataset.points.size() >= 10 ? 5 : 0;
     out.cv_folds = fit_options.cv_folds;
@@ -214,7 +266,7 @@ PipelineSummary run_pipeline(const PipelineOptions& options, const Messages& mes
     out.fit = fitter::fit_law(points, fit_options);
     out.law = publish_fit(db, fitter::fitted_record(out.fit, fit_options, law_name, out.dataset.id,
                                                     out.dataset.hash, points));
-    // 4. Comparison over the campaign grid.
+    // 4. Comparison over the dataset's points.
     const auto fitted = db.load(out.law.reference(), RangePolicy::kExtrapolate);
     out.comparison =
         compare_over_grid(db, *fitted, out.law.reference() + " (fit)", out.dataset, messages);
@@ -271,6 +323,15 @@ nlohmann::json PipelineSummary::ToJson() const {
           {"units_failed", campaign.units_failed},
           {"dataset", dataset.id},
           {"points", dataset.points.size()},
+          {"extended_with", extension_id.empty()
+                                ? nlohmann::json(nullptr)
+                                : nlohmann::json{{"campaign_dataset", campaign_dataset_id},
+                                                 {"dataset", extension_id},
+                                                 {"file", extension_source},
+                                                 {"points", extension_points},
+                                                 {"grid_box",
+                                                  {{"phi", {grid_box.phi_lo, grid_box.phi_hi}},
+                                                   {"re", {grid_box.re_lo, grid_box.re_hi}}}}}},
           {"law", law.name},
           {"version", law.version},
           {"params", params},
@@ -307,8 +368,17 @@ std::string PipelineSummary::FullReport() const {
                      spec_name, campaign.units_done, campaign.units_total, campaign.units_failed,
                      campaign_s);
   out << fmt::format(
-      "dataset {}: {} (phi, Re) points, F with realization and resolution uncertainty\n\n",
+      "dataset {}: {} (phi, Re) points, F with realization and resolution uncertainty\n",
       dataset.id, dataset.points.size());
+  if (!extension_id.empty()) {
+    out << fmt::format(
+        "  {} measured by this campaign (dataset {}, phi {:g}-{:g}, Re {:g}-{:g}) and {} taken "
+        "from dataset {} outside that box\n  ({})\n",
+        dataset.points.size() - extension_points, campaign_dataset_id, grid_box.phi_lo,
+        grid_box.phi_hi, grid_box.re_lo, grid_box.re_hi, extension_points, extension_id,
+        extension_source);
+  }
+  out << "\n";
   out << "Eq. 6 refitted (Ceres, weighted least squares on F; 95 % intervals):\n"
       << "  beta d^2/mu = [A + C0] phi^2/eps + [B + C1] (phi/eps) Re,\n"
       << "  C0 = a eps^n (1 + b sqrt(phi))/phi,  C1 = c0 + c1 phi + c2 phi^2\n";
@@ -360,7 +430,7 @@ std::string PipelineSummary::FullReport() const {
               ? (fit.constraints_satisfied ? "satisfied" : "VIOLATED: " + fit.constraint_report)
               : "not checked")
       << "\n\n";
-  out << "Over the campaign grid (relative differences):\n";
+  out << "Over the dataset's points (relative differences):\n";
   out << fmt::format("  {:<34}{:>12}{:>12}{:>16}{:>16}\n", "law", "RMS vs data", "max vs data",
                      "RMS vs bvk2007", "max vs bvk2007");
   for (const PipelineComparison& r : comparison) {

@@ -76,6 +76,15 @@ struct CampaignSpec {
   /// resumed with another value (the drag agrees to round-off).
   int ranks_per_unit = 1;
   std::string extrapolation = "richardson";  ///< [dataset] richardson, inverse_d or finest.
+  /// [dataset] extend_with: a dataset CSV (read_dataset_csv) whose points outside this grid's
+  /// (phi, Re) box join the campaign's dataset when the pipeline builds it (extend_dataset): the
+  /// points a quick campaign cannot compute in its time, from data measured elsewhere. A relative
+  /// path is taken from the spec file's folder. It changes no unit, so it is not part of the
+  /// spec's identity (to_json); the dataset's method records it.
+  std::string extend_with;
+  /// [dataset] extend_with_id: the dataset id (12 hex digits) the file must have; "" = any. Pins
+  /// the data a preset publishes from, so an edited file is named rather than fitted.
+  std::string extend_with_id;
   bool IsValid(std::string* error) const;
   /// The resolutions the point (phi, Re) runs at, ascending: `resolutions`, or the rule's.
   std::vector<double> point_resolutions(double phi, double re) const;

@@ -68,6 +68,27 @@ Dataset load_dataset(const Database& db, const std::string& id_or_prefix);
 /// All datasets, newest first, without their points.
 std::vector<Dataset> list_datasets(const Database& db);
 
+/// A (phi, Re_target) box, bounds included (to 1e-9: a packing's phi is the grid's to round-off).
+struct DatasetBox {
+  double phi_lo = 0.0, phi_hi = 0.0, re_lo = 0.0, re_hi = 0.0;
+  bool contains(const DatasetPoint& p) const {
+    constexpr double kSlack = 1e-9;
+    return p.phi >= phi_lo - kSlack && p.phi <= phi_hi + kSlack && p.re_target >= re_lo - kSlack &&
+           p.re_target <= re_hi + kSlack;
+  }
+};
+
+/// `base` extended beyond `box` (the grid base was measured on) by the points of `extension`
+/// that lie outside it: a campaign measured over a small box, completed where it cannot measure in
+/// its time by data measured elsewhere (the quick preset and the shipped standard dataset). Inside
+/// the box base's points alone count. The result keeps base's name and campaign, its points
+/// sorted by (phi, Re_target); its method is base's with "extended_with": base's id, the
+/// extension's id, hash, name, `extension_source` (its file), the box and the points taken.
+/// Throws Error(kInvalidArgument) if no point of `extension` lies outside the box, if a point of
+/// base lies outside it, or if either holds size-class (y) points.
+Dataset extend_dataset(const Dataset& base, const DatasetBox& box, const Dataset& extension,
+                       const std::string& extension_source);
+
 /// CSV with a header line; columns phi,re,F,F_uncertainty are required (re_target defaults to
 /// re, the other fields to 0/empty; y, if given, must be > 0 in every row), '#' lines are comments.
 /// Throws Error(kInvalidArgument) naming the line and column for malformed input (non-numeric, phi

@@ -5,6 +5,10 @@
 //   NLopt check (fitter/) -> new law version, published -> report -> regression check of the
 //   published version on the registered consumer scenes (workflows/regress.h).
 //
+// A spec with [dataset] extend_with adds a shipped dataset's points outside the campaign's grid
+// (extend_dataset) before the fit: the quick preset measures phi <= 0.4, Re <= 25 in minutes and
+// takes the standard dataset's denser and faster points, so the law it publishes covers the beds.
+//
 // Re-running is cheap and safe: the campaign resumes (finished units are kept), the dataset is
 // identified by its content hash, and a fit that gives a law identical to the latest published
 // version of the name (same content hash, same dataset) reuses it instead of adding a version.
@@ -56,7 +60,7 @@ struct PipelineProgress {
   std::function<void()> stage_done;       ///< After each of the two (ends a progress line).
 };
 
-/// One law over the campaign grid: relative differences from the data and from bvk2007@1.
+/// One law over the dataset's points: relative differences from the data and from bvk2007@1.
 struct PipelineComparison {
   std::string law;
   double rms_vs_data = 0.0, max_vs_data = 0.0;
@@ -67,7 +71,13 @@ struct PipelineComparison {
 struct PipelineSummary {
   campaign::CampaignStatus campaign;
   std::string spec_name;
-  Dataset dataset;
+  Dataset dataset;  ///< What the law is fitted to: the campaign's, extended if the spec says so.
+  /// With the spec's [dataset] extend_with: the campaign's own dataset, the extension's id and
+  /// file, and how many of its points (outside the grid's box) joined. Empty / 0 without.
+  std::string campaign_dataset_id;
+  std::string extension_id, extension_source;
+  std::size_t extension_points = 0;
+  DatasetBox grid_box;
   LawRecord law;  ///< The published version (new, or the identical one reused).
   fitter::FitResult fit;
   int cv_folds = 0;
