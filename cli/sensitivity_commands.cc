@@ -66,6 +66,8 @@ struct SensitivityArgs {
   bool t_ref_given = false;
   std::string out_dir;
   bool resume = false;  // --resume: keep the finished runs in DIR/state, go on from them
+  double checkpoint_interval_s = 600.0;  // --checkpoint-interval, with --resume
+  bool checkpoint_interval_given = false;
   bool no_figure = false;
   std::string beside;  // --beside OTHER/sensitivity.json: fig5.png, OTHER's panels above these
   bool work_precision = false;
@@ -325,6 +327,12 @@ void run_sensitivity_command(const CliContext& ctx, const SensitivityArgs& args)
   workflows::StudyOutput output;
   output.out_dir = args.out_dir.empty() ? "out/" + scene.name + "_sensitivity" : args.out_dir;
   if (args.resume) sens.state_directory = output.out_dir + "/state";
+  if (args.checkpoint_interval_given && !args.resume) {
+    throw UsageError(
+        "--checkpoint-interval applies with --resume (the checkpoints are kept in "
+        "its state folder)");
+  }
+  sens.checkpoint_interval_s = args.checkpoint_interval_s;
   output.figure = !args.no_figure;
   output.beside = args.beside;
   output.quiet = ctx.quiet;
@@ -406,6 +414,13 @@ void add_sensitivity_commands(CLI::App& app, CliContext& ctx) {
                 "take from there what the same study already finished: a long study stopped "
                 "part-way (killed, or a session's end) goes on where it was when run again with "
                 "the same command, with the results of an uninterrupted one");
+  cmd->add_option("--checkpoint-interval", args->checkpoint_interval_s,
+                  "With --resume: wall seconds between the checkpoints of a packing still "
+                  "settling, so that a settling longer than a sitting goes on from where it "
+                  "stopped, [0, 1e6]")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str()
+      ->each([args](const std::string&) { args->checkpoint_interval_given = true; });
   cmd->add_flag("--no-figure", args->no_figure,
                 "Write the JSON data only (draw later with /usr/bin/python3 "
                 "scripts/draglab_fig4.py DATA.json DIR)");

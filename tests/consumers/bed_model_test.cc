@@ -229,7 +229,7 @@ TEST(BedModel, DpmRunsFromOnePackingAsFromTheirOwnSettling) {
   const Scene scene = parse_scene(scene_text("dpm"), "tiny");
   const BedModel& dpm = find_bed_model("dpm");
   EXPECT_EQ(dpm.realization_kind(), "packing");
-  const std::shared_ptr<const BedRealization> packing = dpm.Realize(scene, ergun(), nullptr);
+  const std::shared_ptr<const BedRealization> packing = dpm.Realize(scene, ergun(), nullptr, {});
   ASSERT_TRUE(packing);
   EXPECT_EQ(packing->seed, scene.seed);
   EXPECT_GT(packing->particles, 0);
@@ -272,7 +272,7 @@ TEST(BedModel, TimeResolutionHooksSetTheValueThatSetsTheStep) {
 
   const BedModel& tfm = find_bed_model("tfm");
   EXPECT_EQ(tfm.realization_kind(), "");  // deterministic
-  EXPECT_THROW(tfm.Realize(scene, ergun(), nullptr), Error);
+  EXPECT_THROW(tfm.Realize(scene, ergun(), nullptr, {}), Error);
   EXPECT_EQ(tfm.time_resolution().name, "cfl");
   EXPECT_FALSE(tfm.time_resolution().larger_is_finer);
   EXPECT_EQ(tfm.time_resolution_of(tfm.WithTimeResolution(scene, 0.15)), 0.15);

@@ -501,7 +501,7 @@ TEST_F(DbmSceneTest, AnInjectionSeedIsItsRealization) {
   EXPECT_EQ(model.realization_kind(), "injection seed");
   Scene other = s;
   other.seed = 2;
-  const auto seed2 = model.Realize(other, nullptr, nullptr);
+  const auto seed2 = model.Realize(other, nullptr, nullptr, {});
   EXPECT_THROW(model.Run(s, law("gidaspow@1"), BedRunOptions(), nullptr, seed2.get()), Error);
 }
 

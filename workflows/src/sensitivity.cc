@@ -175,10 +175,10 @@ WorkPrecisionRow RowOf(const SensitivityRun& run, double time_resolution) {
 /// Prepares the realization of `scene` (its seed) for every law and grid of that seed.
 std::shared_ptr<const BedRealization> Realize(const BedModel& model, const Scene& scene,
                                               std::shared_ptr<const Law> law,
-                                              const BedProgress& progress,
-                                              SensitivityPacking* info) {
+                                              const BedProgress& progress, SensitivityPacking* info,
+                                              const consumers::RealizeOptions& options = {}) {
   std::shared_ptr<const BedRealization> realization =
-      model.Realize(scene, std::move(law), progress);
+      model.Realize(scene, std::move(law), progress, options);
   info->seed = realization->seed;
   info->particles = realization->particles;
   info->settled_bed_height_m = realization->bed_height_m;
@@ -242,7 +242,7 @@ class StudyProgress {
 /// (and kept there), and only if one of the runs is still to be done; its record either way.
 SensitivityPacking PrepareRealization(const BedModel& model, const Scene& scene, std::uint64_t seed,
                                       const std::string& law, const LawLoader& load_law,
-                                      const detail::StudyState& state,
+                                      const detail::StudyState& state, double checkpoint_interval_s,
                                       const std::vector<StudyRunSlot>& slots, StudyProgress* study,
                                       std::shared_ptr<const BedRealization>* realization) {
   const std::string kind = model.realization_kind();
@@ -270,8 +270,11 @@ SensitivityPacking PrepareRealization(const BedModel& model, const Scene& scene,
     return info;
   }
   SensitivityPacking info;
-  *realization =
-      Realize(model, seeded, Load(load_law, law), study->Unit(PrepareText(kind, seed)), &info);
+  consumers::RealizeOptions keep;
+  keep.checkpoint_path = state.RealizationCheckpoint(label, key);
+  keep.checkpoint_interval_s = checkpoint_interval_s;
+  *realization = Realize(model, seeded, Load(load_law, law), study->Unit(PrepareText(kind, seed)),
+                         &info, keep);
   state.SaveRealization(model, label, key, **realization);
   return info;
 }
@@ -372,6 +375,11 @@ bool SensitivityOptions::IsValid(std::string* error) const {
   }
   if (ok && !run.IsValid(&why)) {
     why = "SensitivityOptions.run: " + why;
+    ok = false;
+  }
+  if (ok && !(checkpoint_interval_s >= 0.0 && checkpoint_interval_s <= 1e6)) {
+    why = "SensitivityOptions.checkpoint_interval_s must be in [0, 1e6] s, got " +
+          Num(checkpoint_interval_s);
     ok = false;
   }
   if (!ok && error) *error = why;
@@ -626,7 +634,8 @@ SensitivitySummary run_sensitivity(const Scene& scene, const LawLoader& load_law
     std::shared_ptr<const BedRealization> realization;
     if (realized) {
       summary.packings.push_back(PrepareRealization(model, scene, seed, laws.front(), load_law,
-                                                    state, slots, &study, &realization));
+                                                    state, options.checkpoint_interval_s, slots,
+                                                    &study, &realization));
     }
     for (StudyRunSlot& slot : slots) {
       const std::string& law = laws[slot.law];

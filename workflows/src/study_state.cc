@@ -293,6 +293,13 @@ void StudyState::SaveRealization(const consumers::BedModel& model, const std::st
   model.SaveRealization(realization, Path(label, key, ".bin"));
 }
 
+std::string StudyState::RealizationCheckpoint(const std::string& label,
+                                              const std::string& key) const {
+  if (!enabled()) return "";
+  core::make_directories(directory_, "the study's state folder");
+  return Path(label, key, ".checkpoint");
+}
+
 }  // namespace detail
 }  // namespace workflows
 }  // namespace draglab

@@ -60,6 +60,9 @@ class StudyState {
   /// Keeps it, where the model can (BedModel::SaveRealization).
   void SaveRealization(const consumers::BedModel& model, const std::string& label,
                        const std::string& key, const consumers::BedRealization& realization) const;
+  /// Where the realization under `key` keeps its checkpoint while it is prepared
+  /// (RealizeOptions::checkpoint_path), the folder created; "" when no state is kept.
+  std::string RealizationCheckpoint(const std::string& label, const std::string& key) const;
 
  private:
   std::string Path(const std::string& label, const std::string& key,

@@ -139,7 +139,8 @@ const BedModel& find_bed_model(const std::string& key) {
 }
 
 std::shared_ptr<const BedRealization> BedModel::Realize(const Scene&, std::shared_ptr<const Law>,
-                                                        const BedProgress&) const {
+                                                        const BedProgress&,
+                                                        const RealizeOptions&) const {
   throw Error(ErrorCode::kInvalidArgument,
               "bed model '" + key() + "' is deterministic: it has no realizations to prepare");
 }

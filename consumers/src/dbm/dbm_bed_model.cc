@@ -518,7 +518,8 @@ class DbmBedModel : public BedModel {
 
   std::string realization_kind() const override { return "injection seed"; }
   std::shared_ptr<const BedRealization> Realize(const Scene& scene, std::shared_ptr<const Law>,
-                                                const BedProgress&) const override {
+                                                const BedProgress&,
+                                                const RealizeOptions&) const override {
     auto seed = std::make_shared<DbmInjectionSeed>();
     seed->seed = scene.seed;
     return seed;

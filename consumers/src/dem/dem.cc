@@ -7,12 +7,17 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 
+#include "draglab/core/files.h"
 #include "draglab/core/text.h"
 #include "draglab/error.h"
 
@@ -879,6 +884,10 @@ bool SettleOptions::IsValid(std::string* error) const {
   if (!(max_time > 0.0) || !std::isfinite(max_time)) {
     return fail("max_time = " + Num(max_time) + " s: must be > 0");
   }
+  if (!(checkpoint_interval_s >= 0.0 && checkpoint_interval_s <= 1e6)) {
+    return fail("checkpoint_interval_s = " + Num(checkpoint_interval_s) +
+                " s: must be in [0, 1e6]");
+  }
   return true;
 }
 
@@ -890,6 +899,92 @@ std::string SettleResult::BriefReport() const {
     << Num(weight_n > 0 ? floor_force_n / weight_n : 0.0);
   return s.str();
 }
+
+namespace {
+
+// A settling checkpoint: this magic line, the key line (what made the settling), the progress
+// display's two numbers, then the DEM state (DemSystem::SaveState).
+constexpr char kSettleMagic[] = "draglab settle checkpoint 1\n";
+
+// FNV-1a over bytes: the key's digest of the per-particle diameters.
+std::uint64_t Fnv1a(const void* data, std::size_t size, std::uint64_t h = 1469598103934665603ULL) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; ++i) h = (h ^ b[i]) * 1099511628211ULL;
+  return h;
+}
+
+// Every input of a settling, exactly (%a), on one line: a checkpoint made with other options or
+// particles is not taken up.
+std::string SettleKey(const DemOptions& o, const SettleOptions& s, int threads) {
+  std::string key;
+  const auto add = [&key](double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%a ", v);
+    key += buf;
+  };
+  for (int a = 0; a < 3; ++a) {
+    add(o.box_min[a]);
+    add(o.box_max[a]);
+    add(o.periodic[a] ? 1.0 : 0.0);
+    add(o.gravity[a]);
+  }
+  for (double v : {o.normal_stiffness, o.restitution, o.friction, o.wall_restitution,
+                   o.wall_friction, o.tangential_stiffness_ratio, o.tangential_damping_ratio, o.dt,
+                   o.min_steps_per_contact, o.max_overlap_fraction, o.neighbor_skin_fraction}) {
+    add(v);
+  }
+  for (double v : {s.diameter, s.density, s.insertion_solids_fraction, s.kinetic_energy_tolerance,
+                   s.max_time}) {
+    add(v);
+  }
+  key += "n " + std::to_string(s.n) + " seed " + std::to_string(s.seed) + " diameters " +
+         std::to_string(Fnv1a(s.diameters.data(), s.diameters.size() * sizeof(double))) +
+         " threads " + std::to_string(threads);
+  return key;
+}
+
+struct SettleCheckpoint {
+  double peak_ratio = 0.0, reported = 0.0;
+  std::unique_ptr<DemSystem> dem;
+};
+
+void WriteSettleCheckpoint(const std::string& path, const std::string& key, double peak_ratio,
+                           double reported, const DemSystem& dem) {
+  const std::string state = dem.SaveState();
+  const std::string line = key + "\n";
+  const double numbers[2] = {peak_ratio, reported};
+  core::write_file_atomically(path,
+                              {{kSettleMagic, sizeof(kSettleMagic) - 1},
+                               {line.data(), line.size()},
+                               {numbers, sizeof numbers},
+                               {state.data(), state.size()}},
+                              "SettleOptions.checkpoint_path");
+}
+
+// The checkpoint at `path` if there is one made with `key`; none (nothing to go on from) when the
+// file is missing, another settling's, or not a checkpoint.
+SettleCheckpoint ReadSettleCheckpoint(const std::string& path, const std::string& key,
+                                      const DemOptions& run) {
+  SettleCheckpoint c;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return c;
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string head = std::string(kSettleMagic) + key + "\n";
+  if (bytes.size() < head.size() + 2 * sizeof(double) || bytes.compare(0, head.size(), head) != 0)
+    return c;
+  double numbers[2];
+  std::memcpy(numbers, bytes.data() + head.size(), sizeof numbers);
+  try {
+    c.dem = DemSystem::LoadState(run, bytes.substr(head.size() + sizeof numbers));
+  } catch (const Error&) {
+    return c;
+  }
+  c.peak_ratio = numbers[0];
+  c.reported = numbers[1];
+  return c;
+}
+
+}  // namespace
 
 SettleResult settle_particles(const DemOptions& options, const SettleOptions& settle,
                               const DemProgress& progress) {
@@ -990,8 +1085,18 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
         static_cast<int>(parts.size()));
     parts.add(q[0], q[1], q[2], di, settle.density);
   }
-  DemSystem dem(run, std::move(parts));
-  dem.sort_particles();
+  // A checkpoint of this settling, if one is there, takes the place of the inserted cloud.
+  const std::string key = SettleKey(run, settle, omp_get_max_threads());
+  SettleCheckpoint resumed;
+  if (!settle.checkpoint_path.empty())
+    resumed = ReadSettleCheckpoint(settle.checkpoint_path, key, run);
+  std::unique_ptr<DemSystem> system = std::move(resumed.dem);
+  if (!system) {
+    system = std::make_unique<DemSystem>(run, std::move(parts));
+    system->sort_particles();
+  }
+  DemSystem& dem = *system;
+  const double resumed_at_s = dem.time();
   const double m = settle.density * vp;
   const double ke_scale = m * g * d_mean;
   // Fall time from the column top plus relaxation; check every ~1 ms of simulated time.
@@ -1001,9 +1106,16 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
   // energy from its peak to the tolerance, on a log scale (the decay is roughly exponential).
   const double fall_height = std::max(d, column - settle.n * vp / (0.6 * cross));
   const double fall_time = std::sqrt(2.0 * fall_height / g);
-  double peak_ratio = 0.0, reported = 0.0;
+  double peak_ratio = resumed.peak_ratio, reported = resumed.reported;
   double ratio = std::numeric_limits<double>::infinity();
+  auto last_checkpoint = std::chrono::steady_clock::now();
   while (dem.time() < settle.max_time) {
+    if (!settle.checkpoint_path.empty() &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >=
+            settle.checkpoint_interval_s) {
+      WriteSettleCheckpoint(settle.checkpoint_path, key, peak_ratio, reported, dem);
+      last_checkpoint = std::chrono::steady_clock::now();
+    }
     dem.advance(check);
     ratio = dem.kinetic_energy() / settle.n / ke_scale;
     if (progress) {
@@ -1016,7 +1128,10 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
       const double f =
           0.3 * std::min(1.0, dem.time() / fall_time) + 0.7 * std::clamp(decay, 0.0, 1.0);
       reported = std::max(reported, std::min(f, 0.99));
-      progress(reported, "settling: KE/(m g d) = " + Num(ratio));
+      progress(reported, (resumed_at_s > 0.0 ? "settling (went on from a checkpoint at t = " +
+                                                   Num(resumed_at_s) + " s): KE/(m g d) = "
+                                             : std::string("settling: KE/(m g d) = ")) +
+                             Num(ratio));
     }
     // At rest: small kinetic energy, and the top particle has landed (not still in free fall).
     if (ratio < settle.kinetic_energy_tolerance && dem.time() > 0.05) break;
@@ -1048,6 +1163,9 @@ SettleResult settle_particles(const DemOptions& options, const SettleOptions& se
   result.floor_force_n = -dem.wall_force(Wall::kYMin)[1];
   result.weight_n = settle.n * m * g;
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.resumed_at_s = resumed_at_s;
+  // At rest: the checkpoint has served (a failed settling keeps it, for a longer max_time).
+  if (!settle.checkpoint_path.empty()) std::remove(settle.checkpoint_path.c_str());
   return result;
 }
 

@@ -57,6 +57,9 @@ bool DpmOptions::IsValid(std::string* error) const {
     return bad("settle_max_time_s must be > 0, got " + Num(settle_max_time_s));
   if (!(gas_dt_s >= 0.0) || !std::isfinite(gas_dt_s))
     return bad("gas_dt_s must be >= 0 (0: from the scene), got " + Num(gas_dt_s));
+  if (!(settle_checkpoint_interval_s >= 0.0 && settle_checkpoint_interval_s <= 1e6))
+    return bad("settle_checkpoint_interval_s must be in [0, 1e6], got " +
+               Num(settle_checkpoint_interval_s));
   return true;
 }
 
@@ -192,6 +195,8 @@ void DpmSimulation::Settle(const DpmProgress& progress) {
   so.seed = s.seed;
   so.kinetic_energy_tolerance = opt_.settle_kinetic_tolerance;
   so.max_time = opt_.settle_max_time_s;
+  so.checkpoint_path = opt_.settle_checkpoint_path;
+  so.checkpoint_interval_s = opt_.settle_checkpoint_interval_s;
   SettleResult settled = settle_particles(d, so, [&](double f, const std::string& stage) {
     if (progress) progress(f, "settle: " + stage);
   });

@@ -123,9 +123,13 @@ class DpmBedModel : public BedModel {
   std::string realization_kind() const override { return "packing"; }
 
   std::shared_ptr<const BedRealization> Realize(const Scene& scene, std::shared_ptr<const Law> law,
-                                                const BedProgress& progress) const override {
+                                                const BedProgress& progress,
+                                                const RealizeOptions& options) const override {
     const auto t0 = std::chrono::steady_clock::now();
-    DpmSimulation settler(scene, std::move(law), DpmOptions());  // settling has no gas
+    DpmOptions settle;
+    settle.settle_checkpoint_path = options.checkpoint_path;
+    settle.settle_checkpoint_interval_s = options.checkpoint_interval_s;
+    DpmSimulation settler(scene, std::move(law), settle);  // settling has no gas
     settler.Settle(progress);
     auto packing = std::make_shared<DpmPacking>();
     packing->settled = settler.dem().particles();

@@ -36,6 +36,14 @@ namespace draglab {
 namespace consumers {
 
 /// Run controls every model understands (tests and the CLI override a few scene values).
+/// How Realize keeps a long preparation's work (BedModel::Realize).
+struct RealizeOptions {
+  /// A checkpoint file, written as the preparation goes and read when it starts; removed when it
+  /// has finished. Empty: none. Models whose preparation is quick ignore it.
+  std::string checkpoint_path;
+  double checkpoint_interval_s = 600.0;  ///< Wall seconds between checkpoints, [0, 1e6].
+};
+
 struct BedRunOptions {
   double duration_s = 0.0;       ///< Simulated time; 0: the scene's, else > 0.
   std::string output_directory;  ///< For the files the scene asks for; empty: the model's default.
@@ -186,11 +194,13 @@ class BedModel {
   /// What a realization is ("packing"); empty: the model is deterministic and has none.
   virtual std::string realization_kind() const { return ""; }
   /// Prepares the realization of scene.seed, to be passed to Run for every law and grid of that
-  /// seed (`law` only for models whose preparation needs one). Throws Error(kInvalidArgument)
-  /// for a model without realizations.
+  /// seed (`law` only for models whose preparation needs one). A preparation of hours (the DPM's
+  /// settling) keeps a checkpoint at options.checkpoint_path and goes on from it when run again.
+  /// Throws Error(kInvalidArgument) for a model without realizations.
   virtual std::shared_ptr<const BedRealization> Realize(const Scene& scene,
                                                         std::shared_ptr<const Law> law,
-                                                        const BedProgress& progress) const;
+                                                        const BedProgress& progress,
+                                                        const RealizeOptions& options) const;
   /// Writes a realization made by this model's Realize to `path` (atomically), so that a long
   /// study stopped part-way goes on without preparing it again; false: this model does not keep
   /// its realizations (the default). Throws Error(kIo) when the file cannot be written.

@@ -22,6 +22,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -146,6 +147,15 @@ class DemSystem {
   /// particles. Indices change: call only between steps, before caller-side per-index data.
   void sort_particles();
 
+  /// The complete state (particles, forces, contact history, neighbour list, time and counters)
+  /// as bytes, so that a system restored from them continues bit for bit as this one would with
+  /// the same options and thread count: a checkpoint for the machine and build that wrote it
+  /// (native byte order), not an exchange format.
+  std::string SaveState() const;
+  /// The system SaveState wrote, with `options` (the saved system's; the caller keys its
+  /// checkpoints so). Throws Error(kInvalidArgument) for bytes that are not such a state.
+  static std::unique_ptr<DemSystem> LoadState(const DemOptions& options, const std::string& bytes);
+
  private:
   void build_cells();
   void build_neighbor_list();
@@ -205,6 +215,13 @@ struct SettleOptions {
   /// Stop when the mean kinetic energy per particle is below this fraction of m g d, (0, 1e-2].
   double kinetic_energy_tolerance = 1e-8;
   double max_time = 5.0;  ///< Simulated time limit [s], > 0.
+  /// A checkpoint file of the settling, so that one stopped part-way (a kill, a session's end)
+  /// goes on from where it was, bit for bit: written atomically every checkpoint_interval_s of
+  /// wall time, read at the start when present and made with the same options and particles,
+  /// removed once the bed is at rest. Empty: none.
+  std::string checkpoint_path;
+  /// Wall seconds between checkpoints, [0, 1e6]; 0 writes one at every kinetic-energy check.
+  double checkpoint_interval_s = 600.0;
   bool IsValid(std::string* error) const;
 };
 
@@ -218,6 +235,7 @@ struct SettleResult {
   double floor_force_n = 0.0;         ///< Force on the floor along gravity [N].
   double weight_n = 0.0;              ///< Total weight N m |g| [N].
   double wall_s = 0.0;
+  double resumed_at_s = 0.0;  ///< Simulated time of the checkpoint it went on from; 0: none.
   std::string BriefReport() const;
 };
 

@@ -49,6 +49,10 @@ struct DpmOptions {
   /// Settling: mean kinetic energy per particle below this fraction of m g d, (0, 1e-2].
   double settle_kinetic_tolerance = 1e-4;
   double settle_max_time_s = 3.0;  ///< Settling time limit [s], > 0.
+  /// A checkpoint of the settling (SettleOptions::checkpoint_path): a settling stopped part-way
+  /// goes on from it, bit for bit. Empty: none.
+  std::string settle_checkpoint_path;
+  double settle_checkpoint_interval_s = 600.0;  ///< Wall seconds between checkpoints, [0, 1e6].
   /// Gas step [s]; 0: the scene's gas_dt_s, else SceneDerived::recommended_gas_dt_s. >= 0.
   double gas_dt_s = 0.0;
   /// Output directory for fields/particles files (scene [outputs]); empty: the scene's

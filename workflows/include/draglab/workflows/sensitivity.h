@@ -116,6 +116,10 @@ struct SensitivityOptions {
   /// was when run again; the results are those of an uninterrupted study, bit for bit. Created
   /// when the first file is written.
   std::string state_directory;
+  /// With state_directory: wall seconds between the checkpoints of a realization still being
+  /// prepared (the DPM's settling, RealizeOptions), so that one longer than a sitting goes on from
+  /// where it stopped; [0, 1e6].
+  double checkpoint_interval_s = 600.0;
   bool IsValid(std::string* error) const;
 };
 
